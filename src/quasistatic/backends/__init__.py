@@ -1,0 +1,1 @@
+"""Solver backends, one per module, behind a registry keyed by name."""

@@ -1,0 +1,120 @@
+"""What every backend takes and returns, and the polyhedral helpers they share."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.linalg
+
+from ..evaluate import RawMotion
+from ..solution import Mode, Status
+from .highs import INF, solve_lp
+
+__all__ = ["Options", "BackendResult", "twist_extremes", "cone_is_trivial", "value_ranges"]
+
+ZERO = 1e-9  # scene-relative: below this a residual, velocity or force is zero
+
+
+@dataclass(frozen=True)
+class Options:
+    """Solver options shared by all backends.
+
+    Attributes
+    ----------
+    max_solutions : int
+        Most distinct motions listed for ``ambiguous``.
+    modes : tuple of mode names or None, optional
+        Prescribed contact modes (None entries are free): the mode-specified solve.
+    time_limit : float
+        Seconds a certified search may take before it reports ``failed``.
+    """
+
+    max_solutions: int = 16
+    modes: tuple[Mode | None, ...] | None = None
+    time_limit: float = 60.0
+
+
+@dataclass(frozen=True)
+class BackendResult:
+    """A backend's verdict in scene-relative units.
+
+    ``motions`` holds one motion for ``solved``, every distinct one for
+    ``ambiguous`` and none otherwise; ``force_ranges`` is set when the forces
+    of the (single) motion are indeterminate.
+    """
+
+    status: Status
+    message: str
+    motions: tuple[RawMotion, ...] = ()
+    force_ranges: list[tuple[float, float | None]] | None = None
+    details: dict[str, Any] = field(default_factory=dict)
+
+
+def cone_is_trivial(equalities: np.ndarray, inequalities: np.ndarray) -> bool:
+    """True when ``{d : E d = 0, I d >= 0}`` is only the origin."""
+    n = equalities.shape[1] if equalities.size else inequalities.shape[1]
+    basis = scipy.linalg.null_space(equalities, rcond=1e-10) if equalities.shape[0] else np.eye(n)
+    if basis.shape[1] == 0:
+        return True
+    A = inequalities @ basis
+    if A.shape[0] == 0 or scipy.linalg.null_space(A, rcond=1e-10).shape[1] > 0:
+        return False
+    lp = solve_lp(A.sum(axis=0), A, np.zeros(A.shape[0]), np.ones(A.shape[0]), maximize=True)
+    return lp.status == "optimal" and lp.objective <= 1e-7
+
+
+def twist_extremes(
+    n_twist: int,
+    A_eq: np.ndarray,
+    b_eq: np.ndarray,
+    A_in: np.ndarray,
+    b_in: np.ndarray,
+    col_lower: np.ndarray | None = None,
+) -> tuple[list[np.ndarray], bool]:
+    """Extreme points of a polyhedron along each of its first ``n_twist`` coordinates.
+
+    Polyhedron: ``A_eq x = b_eq, A_in x >= b_in`` (columns free unless
+    ``col_lower``). Returns the distinct finite extremes and whether the twist
+    projection is unbounded.
+    """
+    A = np.vstack([A_eq, A_in])
+    lower = np.r_[b_eq, b_in]
+    upper = np.r_[b_eq, np.full(b_in.size, INF)]
+    points: list[np.ndarray] = []
+    unbounded = False
+    for j in range(n_twist):
+        for sign in (1.0, -1.0):
+            cost = np.zeros(A.shape[1])
+            cost[j] = sign
+            lp = solve_lp(cost, A, lower, upper, col_lower)
+            if lp.status == "optimal":
+                q = lp.x[:n_twist]
+                if not any(np.max(np.abs(q - p)) <= 1e-7 for p in points):
+                    points.append(q)
+            else:
+                unbounded = True
+    return points, unbounded
+
+
+def value_ranges(
+    A_eq: np.ndarray,
+    b_eq: np.ndarray,
+    targets: np.ndarray,
+    col_lower: np.ndarray,
+) -> list[tuple[float, float | None]]:
+    """Range of each linear function ``targets[i] . x`` over ``{A_eq x = b_eq, x >= col_lower}``."""
+    ranges: list[tuple[float, float | None]] = []
+    for row in targets:
+        low = solve_lp(row, A_eq, b_eq, b_eq, col_lower)
+        high = solve_lp(row, A_eq, b_eq, b_eq, col_lower, maximize=True)
+        lo = low.objective if low.status == "optimal" else 0.0
+        hi = high.objective if high.status == "optimal" else None
+        ranges.append((max(lo, 0.0), hi))
+    return ranges
+
+
+def ranges_are_wide(ranges: list[tuple[float, float | None]], tol: float = 1e-7) -> bool:
+    """True when some range is unbounded or wider than ``tol`` (scene-relative)."""
+    return any(hi is None or hi - lo > tol for lo, hi in ranges)

@@ -1,0 +1,92 @@
+"""A thin, reusable wrapper around HiGHS (``highspy``) for the LPs of this library."""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
+from typing import Literal
+
+import highspy
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import SolverError
+
+__all__ = ["LPResult", "solve_lp", "INF"]
+
+INF = float("inf")
+LPStatus = Literal["optimal", "infeasible", "unbounded", "unbounded_or_infeasible", "error"]
+
+# Every HiGHS model status, mapped explicitly.
+_STATUS: dict[highspy.HighsModelStatus, LPStatus] = {
+    highspy.HighsModelStatus.kOptimal: "optimal",
+    highspy.HighsModelStatus.kInfeasible: "infeasible",
+    highspy.HighsModelStatus.kUnbounded: "unbounded",
+    highspy.HighsModelStatus.kUnboundedOrInfeasible: "unbounded_or_infeasible",
+    highspy.HighsModelStatus.kModelEmpty: "optimal",
+}
+
+_local = threading.local()
+
+
+def _highs() -> highspy.Highs:
+    solver = getattr(_local, "highs", None)
+    if solver is None:
+        solver = highspy.Highs()
+        solver.setOptionValue("output_flag", False)
+        _local.highs = solver
+    return solver
+
+
+@dataclass(frozen=True)
+class LPResult:
+    """Status, primal point, row duals (>= 0 on active lower bounds) and objective."""
+
+    status: LPStatus
+    x: np.ndarray
+    row_dual: np.ndarray
+    objective: float
+
+
+def solve_lp(
+    cost: np.ndarray,
+    A: np.ndarray | sp.spmatrix,
+    row_lower: np.ndarray,
+    row_upper: np.ndarray,
+    col_lower: np.ndarray | None = None,
+    col_upper: np.ndarray | None = None,
+    maximize: bool = False,
+) -> LPResult:
+    """Solve ``min cost.x  s.t.  row_lower <= A x <= row_upper, col_lower <= x <= col_upper``.
+
+    Columns are free unless bounds are given. Infinite bounds use ``float('inf')``.
+    """
+    n = cost.size
+    matrix = sp.csc_matrix(A)
+    m = matrix.shape[0]
+    lp = highspy.HighsLp()
+    lp.num_col_ = n
+    lp.num_row_ = m
+    lp.col_cost_ = -cost if maximize else cost
+    lp.col_lower_ = np.full(n, -INF) if col_lower is None else col_lower
+    lp.col_upper_ = np.full(n, INF) if col_upper is None else col_upper
+    lp.row_lower_ = row_lower
+    lp.row_upper_ = row_upper
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+    lp.a_matrix_.start_ = matrix.indptr
+    lp.a_matrix_.index_ = matrix.indices
+    lp.a_matrix_.value_ = matrix.data
+    solver = _highs()
+    try:
+        solver.passModel(lp)
+        solver.run()
+    except Exception as exc:  # a crash inside HiGHS, not a status
+        raise SolverError("highs", f"HiGHS failed: {exc}") from exc
+    status = _STATUS.get(solver.getModelStatus(), "error")
+    solution = solver.getSolution()
+    x = np.array(solution.col_value) if n else np.zeros(0)
+    duals = np.array(solution.row_dual) if m else np.zeros(0)
+    if maximize:
+        duals = -duals
+    objective = float(cost @ x) if status == "optimal" else float("nan")
+    return LPResult(status, x, duals, objective)
