@@ -15,7 +15,7 @@ from .solution import Mode, Motion, Solution
 
 __all__ = ["solve", "METHODS"]
 
-METHODS = ("auto", "lp")
+METHODS = ("auto", "lp", "scip")
 _MODE_NAMES = ("rolling", "sliding", "separating")
 
 
@@ -69,10 +69,7 @@ def _choose(method: str, problem: Problem) -> str:
         return method
     if problem.is_frictionless:
         return "lp"
-    raise QuasistaticError(
-        f"contacts {_frictional(problem)} have mu > 0 and no frictional solver is installed yet; "
-        "set 'friction: none' to drop friction on purpose"
-    )
+    return "scip"
 
 
 def _frictional(problem: Problem) -> list[int]:

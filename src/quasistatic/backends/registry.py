@@ -40,6 +40,14 @@ BACKENDS: dict[str, Backend] = {
     b.name: b
     for b in (
         Backend("lp", ".lp", "solve_frictionless", "frictionless LP (HiGHS), the paper's velocity/force formulation", frictionless_only=True),
+        Backend(
+            "scip",
+            ".scip",
+            "solve_certified",
+            "certified: SCIP mixed-integer search over every contact mode, complete list of motions",
+            requires="pyscipopt",
+            install_hint="pip install pyscipopt",
+        ),
     )
 }
 

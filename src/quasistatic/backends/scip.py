@@ -1,0 +1,225 @@
+"""Certified path: SCIP proves a motion exists or that none does, and lists them all.
+
+The polyhedral laws (2-D exact cone, or a 3-D pyramid) become a mixed-integer
+feasibility problem: each complementarity pair ``0 <= x _|_ w >= 0`` gets a
+binary ``z`` with indicator constraints ``z = 1 => x <= 0`` and
+``z = 0 => w <= 0``. No big-M: indicator constraints carry no bounds to guess.
+Every pattern SCIP finds is excluded with a no-good cut and the search goes on,
+so the list of motions is complete. Each pattern's motions form a polyhedron
+whose twist extent is measured by LPs: a single twist, or a continuum.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..evaluate import MODE_TOLERANCE, RawMotion
+from ..problem import Problem
+from .base import BackendResult, Options, twist_extremes
+from .diagnose import diagnose
+from .forces import force_ranges
+from .highs import solve_lp
+from .polyhedral import LCPForm, aligned_edges, polyhedral_form
+
+__all__ = ["solve_certified", "enumerate_motions", "certified_polyhedral"]
+
+_SLIDE_MIN = 10.0 * MODE_TOLERANCE  # scene-relative slip speed that counts as sliding when a mode is prescribed
+
+
+def solve_certified(problem: Problem, options: Options) -> BackendResult:
+    """The certified answer for polyhedral friction models."""
+    if not problem.friction.is_polyhedral(problem.dimension):
+        raise NotImplementedError("the exact 3-D cone is certified through a pyramid refinement; see solve_exact_3d")
+    edges = aligned_edges(problem, problem.friction.edges)
+    return certified_polyhedral(problem, edges, options)
+
+
+def certified_polyhedral(problem: Problem, edges: np.ndarray, options: Options) -> BackendResult:
+    form = polyhedral_form(problem, edges)
+    motions, complete = enumerate_motions(form, options)
+    if not motions:
+        if not complete:
+            return BackendResult("failed", "failed: the certified search hit its time limit before finding a motion")
+        if options.modes is not None:
+            return BackendResult("jammed", "jammed: no motion exists with the prescribed contact modes", details={"modes": list(options.modes)})
+        return diagnose(problem, edges)
+    return summarise(form, motions, complete, options)
+
+
+def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: Options) -> BackendResult:
+    """One motion: solved (with force ranges); several or a continuum: ambiguous."""
+    details = {"search": "complete" if complete else f"stopped after {len(motions)} motions (limit or time)"}
+    if len(motions) == 1 and not motions[0].continuum and complete:
+        ranges = force_ranges(form.problem, form.edges, motions[0].q)
+        message = "solved: one motion" + ("; the contact forces are indeterminate" if ranges else " with unique contact forces")
+        return BackendResult("solved", message, tuple(motions), ranges, details)
+    kinds = "a continuum of motions" if len(motions) == 1 else f"{len(motions)} distinct motions"
+    more = "" if complete else " (the list may be incomplete)"
+    return BackendResult(
+        "ambiguous",
+        f"ambiguous: {kinds} satisfy the laws{more}; the rigid model cannot tell which happens",
+        tuple(motions),
+        details=details,
+    )
+
+
+@dataclass
+class _Model:
+    scip: object
+    x: list
+    z: list
+
+
+def _build(form: LCPForm, options: Options) -> _Model:
+    import pyscipopt
+
+    scip = pyscipopt.Model()
+    scip.hideOutput()
+    scip.setParam("limits/time", options.time_limit)
+    scip.setParam("numerics/feastol", 1e-9)
+    N = form.n_vars
+    x = [scip.addVar(lb=None if j < form.n_q else 0.0, ub=None, name=f"x{j}") for j in range(N)]
+    for row, rhs in zip(form.E_eq, form.e_eq, strict=True):
+        scip.addCons(_dot(row, x) == rhs)
+    z = []
+    for i, col in enumerate(form.pair_cols):
+        w = scip.addVar(lb=0.0, ub=None, name=f"w{i}")
+        scip.addCons(_dot(form.W[i], x) - w == form.r[i])
+        zi = scip.addVar(vtype="B", name=f"z{i}")
+        scip.addConsIndicator(x[col] <= 0.0, zi)
+        scip.addConsIndicator(w <= 0.0, zi, activeone=False)
+        z.append(zi)
+    _prescribe_modes(scip, form, x, options)
+    return _Model(scip, x, z)
+
+
+def _prescribe_modes(scip: object, form: LCPForm, x: list, options: Options) -> None:
+    if options.modes is None:
+        return
+    problem = form.problem
+    m = problem.n_contacts
+    lam0 = form.n_q + m + m * form.n_edges
+    for i, mode in enumerate(options.modes):
+        if mode is None:
+            continue
+        normal = problem.Jn[i]
+        if mode == "separating":
+            scip.addCons(_dot(normal, x) >= problem.bn[i] + _SLIDE_MIN)  # type: ignore[attr-defined]
+            continue
+        scip.addCons(_dot(normal, x) <= problem.bn[i])  # type: ignore[attr-defined]
+        if mode == "rolling":
+            for row, rhs in zip(problem.Jt[i], problem.bt[i], strict=True):
+                scip.addCons(_dot(row, x) == rhs)  # type: ignore[attr-defined]
+        else:
+            scip.addCons(x[lam0 + i] >= _SLIDE_MIN)  # type: ignore[attr-defined]
+
+
+def _dot(row: np.ndarray, x: list) -> object:
+    import pyscipopt
+
+    return pyscipopt.quicksum(float(a) * v for a, v in zip(row, x, strict=False) if a != 0.0) + 0.0
+
+
+def enumerate_motions(form: LCPForm, options: Options) -> tuple[list[RawMotion], bool]:
+    """Every distinct motion (up to ``options.max_solutions``), and whether the search was complete."""
+    model = _build(form, options)
+    scip = model.scip
+    motions: list[RawMotion] = []
+    patterns = 0
+    max_patterns = 64 * max(options.max_solutions, 1)
+    while True:
+        scip.optimize()  # type: ignore[attr-defined]
+        status = scip.getStatus()  # type: ignore[attr-defined]
+        if status == "infeasible":
+            return motions, True
+        if scip.getNSols() == 0:  # type: ignore[attr-defined]
+            return motions, False
+        best = scip.getBestSol()  # type: ignore[attr-defined]
+        xs = np.array([scip.getSolVal(best, v) for v in model.x])  # type: ignore[attr-defined]
+        zs = np.array([round(scip.getSolVal(best, v)) for v in model.z])  # type: ignore[attr-defined]
+        motion = _pattern_motion(form, xs, zs, options)
+        if not any(_same(motion, other) for other in motions):
+            motions.append(motion)
+        patterns += 1
+        if len(motions) > options.max_solutions or patterns >= max_patterns:
+            return motions[: options.max_solutions], False
+        scip.freeTransform()  # type: ignore[attr-defined]
+        import pyscipopt
+
+        scip.addCons(  # type: ignore[attr-defined]
+            pyscipopt.quicksum((1 - v) if zi else v for v, zi in zip(model.z, zs, strict=True)) >= 1
+        )
+
+
+def _pattern_motion(form: LCPForm, x: np.ndarray, z: np.ndarray, options: Options) -> RawMotion:
+    """The motion (single twist or continuum) of one complementarity pattern."""
+    N = form.n_vars
+    cols = form.pair_cols
+    fixed_zero = np.eye(N)[cols[z == 1]]
+    A_eq = np.vstack([form.E_eq, fixed_zero, form.W[z == 0]])
+    b_eq = np.r_[form.e_eq, np.zeros(len(fixed_zero)), form.r[z == 0]]
+    A_in, b_in = form.W[z == 1], form.r[z == 1]
+    A_eq, b_eq, A_in, b_in = _with_prescribed_modes(form, options, A_eq, b_eq, A_in, b_in)
+    lower = np.r_[np.full(form.n_q, -np.inf), np.zeros(N - form.n_q)]
+    extremes, unbounded = twist_extremes(form.n_q, A_eq, b_eq, A_in, b_in, lower)
+    q = x[: form.n_q]
+    continuum = unbounded or any(np.max(np.abs(e - q)) > 1e-7 for e in extremes)
+    if not continuum:
+        return RawMotion(q, form.forces(x), (), False)
+    # Represent a continuum by a point inside it, so its modes are those of its interior.
+    x = relative_interior_point(A_eq, b_eq, A_in, b_in, lower, x)
+    return RawMotion(x[: form.n_q], form.forces(x), tuple(extremes), unbounded)
+
+
+def relative_interior_point(
+    A_eq: np.ndarray, b_eq: np.ndarray, A_in: np.ndarray, b_in: np.ndarray, lower: np.ndarray, fallback: np.ndarray
+) -> np.ndarray:
+    """A point of the polyhedron whose inequalities are as slack as possible (each capped at 1)."""
+    N, k = A_eq.shape[1], A_in.shape[0]
+    A = np.block([[A_eq, np.zeros((A_eq.shape[0], k))], [A_in, -np.eye(k)]])
+    lo = np.r_[b_eq, b_in]
+    hi = np.r_[b_eq, np.full(k, np.inf)]
+    cost = np.r_[np.zeros(N), np.ones(k)]
+    lp = solve_lp(cost, A, lo, hi, np.r_[lower, np.zeros(k)], np.r_[np.full(N, np.inf), np.ones(k)], maximize=True)
+    return lp.x[:N] if lp.status == "optimal" else fallback
+
+
+def _with_prescribed_modes(
+    form: LCPForm, options: Options, A_eq: np.ndarray, b_eq: np.ndarray, A_in: np.ndarray, b_in: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Prescribed modes as extra rows: rolling pins the slip, the others bound it away from zero."""
+    if options.modes is None:
+        return A_eq, b_eq, A_in, b_in
+    problem = form.problem
+    m = problem.n_contacts
+    lam0 = form.n_q + m + m * form.n_edges
+    rows, rhs = [A_in], [b_in]
+    eq_rows, eq_rhs = [A_eq], [b_eq]
+    for i, mode in enumerate(options.modes):
+        row = np.zeros(form.n_vars)
+        if mode == "rolling":
+            block = np.zeros((problem.dimension, form.n_vars))
+            block[:, : form.n_q] = problem.J[i]
+            eq_rows.append(block)
+            eq_rhs.append(problem.b[i])
+        elif mode == "separating":
+            row[: form.n_q] = problem.Jn[i]
+            rows.append(row[None])
+            rhs.append(np.array([problem.bn[i] + _SLIDE_MIN]))
+        elif mode == "sliding":
+            row[lam0 + i] = 1.0
+            rows.append(row[None])
+            rhs.append(np.array([_SLIDE_MIN]))
+    return np.vstack(eq_rows), np.concatenate(eq_rhs), np.vstack(rows), np.concatenate(rhs)
+
+
+def _same(a: RawMotion, b: RawMotion) -> bool:
+    if a.continuum != b.continuum or a.unbounded != b.unbounded:
+        return False
+    if not a.continuum:
+        return bool(np.max(np.abs(a.q - b.q)) <= 1e-7)
+    return len(a.extremes) == len(b.extremes) and all(
+        any(np.max(np.abs(e - f)) <= 1e-7 for f in b.extremes) for e in a.extremes
+    )
