@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import SolverError
 from ..evaluate import MODE_TOLERANCE, RawMotion
 from ..problem import Problem
 from .base import BackendResult, Options, twist_extremes
@@ -25,13 +26,16 @@ from .polyhedral import LCPForm, aligned_edges, polyhedral_form
 
 __all__ = ["solve_certified", "enumerate_motions", "certified_polyhedral"]
 
+_DISTINCT = 1e-5  # scene-relative twist difference that makes two motions distinct
 _SLIDE_MIN = 10.0 * MODE_TOLERANCE  # scene-relative slip speed that counts as sliding when a mode is prescribed
 
 
 def solve_certified(problem: Problem, options: Options) -> BackendResult:
     """The certified answer for polyhedral friction models."""
     if not problem.friction.is_polyhedral(problem.dimension):
-        raise NotImplementedError("the exact 3-D cone is certified through a pyramid refinement; see solve_exact_3d")
+        from .exact3d import solve_exact_3d
+
+        return solve_exact_3d(problem, options)
     edges = aligned_edges(problem, problem.friction.edges)
     return certified_polyhedral(problem, edges, options)
 
@@ -77,8 +81,9 @@ def _build(form: LCPForm, options: Options) -> _Model:
 
     scip = pyscipopt.Model()
     scip.hideOutput()
+    scip.setParam("display/verblevel", 0)
     scip.setParam("limits/time", options.time_limit)
-    scip.setParam("numerics/feastol", 1e-9)
+    scip.setParam("numerics/feastol", 1e-7)
     N = form.n_vars
     x = [scip.addVar(lb=None if j < form.n_q else 0.0, ub=None, name=f"x{j}") for j in range(N)]
     for row, rhs in zip(form.E_eq, form.e_eq, strict=True):
@@ -123,14 +128,24 @@ def _dot(row: np.ndarray, x: list) -> object:
 
 
 def enumerate_motions(form: LCPForm, options: Options) -> tuple[list[RawMotion], bool]:
-    """Every distinct motion (up to ``options.max_solutions``), and whether the search was complete."""
+    """Every distinct motion (up to ``options.max_solutions``), and whether the search was complete.
+
+    A single motion is excluded by a box around its twist (so the many
+    degenerate mode patterns that share it are excluded at once); a continuum
+    by a no-good cut on its contact-level pattern (closed/open, sliding/not).
+    """
+    import pyscipopt
+
     model = _build(form, options)
     scip = model.scip
     motions: list[RawMotion] = []
-    patterns = 0
-    max_patterns = 64 * max(options.max_solutions, 1)
+    m = form.problem.n_contacts
+    coarse = list(range(m)) + list(range(len(model.z) - m, len(model.z)))
     while True:
-        scip.optimize()  # type: ignore[attr-defined]
+        try:
+            scip.optimize()  # type: ignore[attr-defined]
+        except Exception as exc:  # SCIP raises bare Exceptions on internal failures
+            raise SolverError("scip", f"SCIP failed: {exc}") from exc
         status = scip.getStatus()  # type: ignore[attr-defined]
         if status == "infeasible":
             return motions, True
@@ -142,15 +157,28 @@ def enumerate_motions(form: LCPForm, options: Options) -> tuple[list[RawMotion],
         motion = _pattern_motion(form, xs, zs, options)
         if not any(_same(motion, other) for other in motions):
             motions.append(motion)
-        patterns += 1
-        if len(motions) > options.max_solutions or patterns >= max_patterns:
-            return motions[: options.max_solutions], False
+        if len(motions) >= options.max_solutions:
+            return motions, False
         scip.freeTransform()  # type: ignore[attr-defined]
-        import pyscipopt
+        if motion.continuum:
+            picked = [(model.z[i], zs[i]) for i in coarse]
+            scip.addCons(pyscipopt.quicksum((1 - v) if zi else v for v, zi in picked) >= 1)  # type: ignore[attr-defined]
+        else:
+            _exclude_twist(scip, model.x[: form.n_q], xs[: form.n_q])
 
-        scip.addCons(  # type: ignore[attr-defined]
-            pyscipopt.quicksum((1 - v) if zi else v for v, zi in zip(model.z, zs, strict=True)) >= 1
-        )
+
+def _exclude_twist(scip: object, q: list, center: np.ndarray) -> None:
+    """Require some twist entry to differ from ``center`` by at least _DISTINCT."""
+    import pyscipopt
+
+    choices = []
+    for j, (var, value) in enumerate(zip(q, center, strict=True)):
+        up = scip.addVar(vtype="B", name=f"up{j}_{id(center)}")  # type: ignore[attr-defined]
+        down = scip.addVar(vtype="B", name=f"down{j}_{id(center)}")  # type: ignore[attr-defined]
+        scip.addConsIndicator(-var <= -(value + _DISTINCT), up)  # type: ignore[attr-defined]
+        scip.addConsIndicator(var <= value - _DISTINCT, down)  # type: ignore[attr-defined]
+        choices += [up, down]
+    scip.addCons(pyscipopt.quicksum(choices) >= 1)  # type: ignore[attr-defined]
 
 
 def _pattern_motion(form: LCPForm, x: np.ndarray, z: np.ndarray, options: Options) -> RawMotion:
