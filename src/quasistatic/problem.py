@@ -132,7 +132,7 @@ def assemble(scene: Scene) -> Problem:
     """Build the scene-relative matrices of the contact laws."""
     dim = scene.dimension
     scales = _scales(scene)
-    L, F, V = scales.length, scales.force, scales.velocity
+    L, V = scales.length, scales.velocity
     k = scene.twist_size
     n_dof = k * len(scene.bodies)
     m = len(scene.contacts)

@@ -290,18 +290,21 @@ def _validate_contact(
     robot_name = movers[contact.other].robot if contact.other in movers else None
     if robot_name is None:
         if contact.jacobian is not None:
-            raise SceneError(f"{path}.jacobian", "...", f"only contacts with a robot-driven mover take a jacobian; {contact.other!r} is not one")
+            reason = f"only contacts with a robot-driven mover take a jacobian; {contact.other!r} is not one"
+            raise SceneError(f"{path}.jacobian", "...", reason)
         return
     joints = robots[robot_name].joint_velocities
     n_joints = len(joints)
     if contact.jacobian is None:
-        raise SceneError(f"{path}.jacobian", None, f"required: {contact.other!r} is driven by robot {robot_name!r} ({dim} x {n_joints} expected)")
+        reason = f"required: {contact.other!r} is driven by robot {robot_name!r} ({dim} x {n_joints} expected)"
+        raise SceneError(f"{path}.jacobian", None, reason)
     try:
         jac = np.array(contact.jacobian, dtype=float)
     except (TypeError, ValueError):
         raise SceneError(f"{path}.jacobian", contact.jacobian, f"expected a {dim} x {n_joints} matrix of numbers") from None
     if jac.shape != (dim, n_joints):
-        raise SceneError(f"{path}.jacobian", f"shape {jac.shape}", f"expected shape ({dim}, {n_joints}): {dim} rows, one column per joint of robot {robot_name!r}")
+        reason = f"expected shape ({dim}, {n_joints}): {dim} rows, one column per joint of robot {robot_name!r}"
+        raise SceneError(f"{path}.jacobian", f"shape {jac.shape}", reason)
     if not np.all(np.isfinite(jac)):
         raise SceneError(f"{path}.jacobian", contact.jacobian, "every entry must be a finite number")
     jac.setflags(write=False)
@@ -419,7 +422,9 @@ _MODELS_BY_DEPTH: dict[str, type[pydantic.BaseModel]] = {
 
 
 def _scene_error(exc: pydantic.ValidationError) -> SceneError:
-    error = exc.errors()[0]
+    errors = exc.errors()
+    # A misspelt key shows as both "missing" and "extra": report the extra one, with a hint.
+    error = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
     loc = [part for part in error["loc"] if part not in ("_MoverFile",)]
     path = _format_path(loc)
     kind = error["type"]

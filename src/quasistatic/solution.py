@@ -257,4 +257,4 @@ class Solution:
 
 
 def _floats(array: np.ndarray) -> list[float]:
-    return [float(x) for x in np.asarray(array).ravel()]
+    return [float(x) + 0.0 for x in np.asarray(array).ravel()]  # + 0.0: no "-0.0" in output

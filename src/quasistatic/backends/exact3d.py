@@ -25,7 +25,6 @@ from ..evaluate import MODE_TOLERANCE, RawMotion
 from ..problem import Problem
 from .base import BackendResult, Options
 from .diagnose import diagnose
-from .forces import force_ranges
 from .polyhedral import aligned_edges, polyhedral_form
 from .scip import enumerate_motions, summarise
 

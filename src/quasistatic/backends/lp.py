@@ -87,4 +87,7 @@ def _certificate_holds(residual: np.ndarray) -> bool:
 
 def _ambiguous_message(unbounded: bool) -> str:
     extent = "unbounded" if unbounded else "bounded"
-    return f"ambiguous: a {extent} continuum of motions satisfies the laws (frictionless contacts leave it undetermined); its extreme motions are listed"
+    return (
+        f"ambiguous: an {extent} continuum of motions satisfies the laws "
+        "(frictionless contacts leave it undetermined); its extreme motions are listed"
+    )

@@ -39,7 +39,13 @@ class Backend:
 BACKENDS: dict[str, Backend] = {
     b.name: b
     for b in (
-        Backend("lp", ".lp", "solve_frictionless", "frictionless LP (HiGHS), the paper's velocity/force formulation", frictionless_only=True),
+        Backend(
+            "lp",
+            ".lp",
+            "solve_frictionless",
+            "frictionless LP (HiGHS), the paper's velocity/force formulation",
+            frictionless_only=True,
+        ),
         Backend(
             "scip",
             ".scip",

@@ -47,7 +47,8 @@ def certified_polyhedral(problem: Problem, edges: np.ndarray, options: Options) 
         if not complete:
             return BackendResult("failed", "failed: the certified search hit its time limit before finding a motion")
         if options.modes is not None:
-            return BackendResult("jammed", "jammed: no motion exists with the prescribed contact modes", details={"modes": list(options.modes)})
+            message = "jammed: no motion exists with the prescribed contact modes"
+            return BackendResult("jammed", message, details={"modes": list(options.modes)})
         return diagnose(problem, edges)
     return summarise(form, motions, complete, options)
 

@@ -1,0 +1,117 @@
+"""Command line: ``quasistatic demo | solve SCENE | check SCENE``. A thin layer, no physics.
+
+Exit codes: 0 when the library gave an answer (``solved``, ``ambiguous``,
+``jammed`` or ``unstable``: a diagnosis is an answer), 1 when the solve
+``failed``, 2 for bad input (an unreadable or invalid scene, an unknown
+method, malformed ``--modes``).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, NoReturn, TypeVar
+
+import typer
+
+from .errors import QuasistaticError
+from .report import make_console, render_solution
+from .scene import Scene, load_scene
+from .solution import Mode, Solution
+from .solve import METHODS, solve
+
+__all__ = ["app", "main"]
+
+DEMO_SCENE = "two_finger_lift.yaml"
+_MODE_WORDS: dict[str, Mode | None] = {
+    "rolling": "rolling",
+    "sliding": "sliding",
+    "separating": "separating",
+    "free": None,
+}
+_T = TypeVar("_T")
+
+app = typer.Typer(
+    name="quasistatic",
+    help="Quasi-static manipulation: predict how pushed or grasped objects move, their contact forces and modes.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+JsonOption = Annotated[
+    bool, typer.Option("--json", help="Print the solution as JSON (Solution.to_dict()) and nothing else.")
+]
+SceneArgument = Annotated[Path, typer.Argument(metavar="SCENE", help="Scene file (.yaml, .yml or .json).")]
+
+
+@app.command()
+def demo(as_json: JsonOption = False) -> None:
+    """Solve the built-in example (two fingertips lifting a box) and print the result."""
+    with resources.as_file(resources.files("quasistatic") / "examples" / DEMO_SCENE) as path:
+        scene = _guarded(lambda: load_scene(path))
+    _report(_guarded(lambda: solve(scene)), as_json)
+
+
+@app.command("solve")
+def solve_command(
+    scene_file: SceneArgument,
+    as_json: JsonOption = False,
+    method: Annotated[str, typer.Option(help=f"Solver: {', '.join(METHODS)}.")] = "auto",
+    modes: Annotated[
+        str | None,
+        typer.Option(help="Prescribed contact modes, one per contact in order: rolling, sliding, separating or free."),
+    ] = None,
+    max_solutions: Annotated[int, typer.Option(min=1, help="Most distinct motions listed when ambiguous.")] = 16,
+) -> None:
+    """Solve a scene file: twists, contact forces and modes, power balance and audit."""
+    scene = _guarded(lambda: load_scene(scene_file))
+    prescribed = _guarded(lambda: _parse_modes(modes)) if modes is not None else None
+    solution = _guarded(lambda: solve(scene, method=method, modes=prescribed, max_solutions=max_solutions))
+    _report(solution, as_json)
+
+
+@app.command()
+def check(scene_file: SceneArgument) -> None:
+    """Validate a scene file without solving it."""
+    scene: Scene = _guarded(lambda: load_scene(scene_file))
+    typer.echo(
+        f"ok: {len(scene.bodies)} bodies, {len(scene.movers)} movers, {len(scene.contacts)} contacts, "
+        f"dimension {scene.dimension}, friction {scene.friction}"
+    )
+
+
+def main() -> None:
+    """Entry point of the ``quasistatic`` command."""
+    app()
+
+
+def _parse_modes(text: str) -> list[Mode | None]:
+    words = [word.strip().lower() for word in text.split(",")]
+    for index, word in enumerate(words):
+        if word not in _MODE_WORDS:
+            raise ValueError(f"--modes entry {index} is {word!r}; expected one of {', '.join(_MODE_WORDS)}")
+    return [_MODE_WORDS[word] for word in words]
+
+
+def _guarded(action: Callable[[], _T]) -> _T:
+    """Run a library call; bad input becomes one ``error:`` line on stderr and exit code 2."""
+    try:
+        return action()
+    except (QuasistaticError, ValueError) as exc:
+        _fail(str(exc))
+
+
+def _fail(message: str) -> NoReturn:
+    typer.echo(f"error: {' '.join(message.split())}", err=True)
+    raise typer.Exit(2)
+
+
+def _report(solution: Solution, as_json: bool) -> None:
+    if as_json:
+        typer.echo(json.dumps(solution.to_dict(), indent=2))
+    else:
+        render_solution(solution, make_console())
+    raise typer.Exit(1 if solution.status == "failed" else 0)

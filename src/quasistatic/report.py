@@ -1,0 +1,205 @@
+"""Terminal report of a Solution: rich tables, no physics.
+
+Everything here only formats what a :class:`~quasistatic.solution.Solution`
+already holds; numbers are shown in the scene's own units.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Mapping, Sequence
+
+import numpy as np
+from rich import box
+from rich.console import Console
+from rich.table import Table
+from rich.text import Text
+
+from .solution import ContactResult, Motion, Solution
+
+__all__ = ["render_solution", "make_console", "format_float", "format_vector"]
+
+_STATUS_STYLE = {
+    "solved": "bold green",
+    "ambiguous": "bold yellow",
+    "jammed": "bold magenta",
+    "unstable": "bold magenta",
+    "failed": "bold red",
+}
+_MODE_STYLE = {"rolling": "green", "sliding": "yellow", "separating": "cyan"}
+_PIPE_WIDTH = 120
+_DISPLAY_ZERO = 1e-12  # relative to a vector's largest entry: shown as 0
+
+
+def format_float(value: float, scale: float = 0.0) -> str:
+    """Compact text for one number (``{:.6g}``), never ``-0``.
+
+    Values within ``1e-12 * scale`` of zero (solver round-off next to the
+    column's largest entry) are shown as ``0``.
+    """
+    value = float(value)
+    if abs(value) <= _DISPLAY_ZERO * scale:
+        value = 0.0
+    text = f"{value:.6g}"
+    if text.startswith("-") and float(text) == 0.0:
+        return text[1:]
+    return text
+
+
+def format_vector(values: Sequence[float] | np.ndarray, scale: float | None = None) -> str:
+    """``[a, b, c]``; entries within ``1e-12 * scale`` of zero shown as 0 (scale: the largest entry by default)."""
+    array = np.asarray(values, dtype=float).ravel()
+    if scale is None:
+        scale = float(np.max(np.abs(array), initial=0.0))
+    return "[" + ", ".join(format_float(x, scale) for x in array) + "]"
+
+
+def make_console() -> Console:
+    """A console on stdout; 120 columns when it is not a terminal (a pipe, a file) unless ``COLUMNS`` is set."""
+    console = Console()
+    if not console.is_terminal and "COLUMNS" not in os.environ:
+        console = Console(width=_PIPE_WIDTH)
+    return console
+
+
+def render_solution(solution: Solution, console: Console) -> None:
+    """Print a solution: status, method, twists, contacts, power balance and audit.
+
+    Parameters
+    ----------
+    solution : Solution
+        What :func:`quasistatic.solve` returned.
+    console : rich.console.Console
+        Where to print.
+    """
+    status = Text(solution.status, style=_STATUS_STYLE.get(solution.status, "bold"))
+    console.print(Text.assemble("status: ", status))
+    console.print(Text(solution.message))
+    console.print(Text(f"method: {solution.method}   friction model: {solution.friction}"))
+    certificate = solution.details.get("certificate") if solution.details else None
+    if certificate is not None:
+        console.print(Text(f"certificate: {certificate}"))
+    motion = solution.motion
+    if motion is None:
+        return
+    ambiguous = solution.status == "ambiguous" and bool(solution.solutions)
+    if ambiguous:
+        _render_solutions(solution.solutions, console)
+    suffix = " (motion 1)" if ambiguous else ""
+    for table in (
+        _twist_table(motion.twists, f"body twists{suffix}"),
+        _contact_table(motion.contacts, solution.forces_indeterminate, f"contacts{suffix}"),
+        _power_table(motion),
+        _audit_table(motion),
+    ):
+        console.print()
+        console.print(table)
+
+
+def _twist_table(twists: Mapping[str, np.ndarray], title: str) -> Table:
+    table = _table(title)
+    table.add_column("body")
+    table.add_column("v (velocity of com)", justify="right")
+    table.add_column("ω (angular velocity)", justify="right")
+    for name, twist in twists.items():
+        linear, angular = _split_twist(twist)
+        spin = format_float(angular[0]) if angular.size == 1 else format_vector(angular)
+        table.add_row(Text(name), format_vector(linear), spin)
+    return table
+
+
+def _table(title: str | Text) -> Table:
+    return Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, show_edge=False, pad_edge=False)
+
+
+def _split_twist(twist: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    twist = np.asarray(twist, dtype=float)
+    linear = 2 if twist.size == 3 else 3
+    return twist[:linear], twist[linear:]
+
+
+def _contact_table(contacts: Iterable[ContactResult], with_ranges: bool, title: str) -> Table:
+    table = _table(title)
+    table.caption = "f_n: normal force on body; force: on body; slip, u_n: velocity of body relative to other"
+    table.caption_justify = "left"
+    for name, justify in (
+        ("#", "right"),
+        ("body", "left"),
+        ("other", "left"),
+        ("mode", "left"),
+        ("f_n", "right"),
+        ("force", "right"),
+        ("slip", "right"),
+        ("u_n", "right"),
+    ):
+        table.add_column(name, justify=justify, overflow="fold")  # type: ignore[arg-type]
+    if with_ranges:
+        table.add_column("f_n range", justify="right")
+    contacts = tuple(contacts)
+    force_scale = max((float(np.max(np.abs(c.force), initial=0.0)) for c in contacts), default=0.0)
+    speed_scale = max(
+        (max(float(np.max(np.abs(c.slip), initial=0.0)), abs(c.normal_velocity)) for c in contacts), default=0.0
+    )
+    for index, contact in enumerate(contacts):
+        row: list[str | Text] = [
+            str(index),
+            Text(contact.body),
+            Text(contact.other),
+            Text(contact.mode, style=_MODE_STYLE.get(contact.mode, "")),
+            format_float(contact.normal_force, force_scale),
+            format_vector(contact.force, force_scale),
+            format_vector(contact.slip, speed_scale),
+            format_float(contact.normal_velocity, speed_scale),
+        ]
+        if with_ranges:
+            row.append(_format_range(contact.normal_force_range))
+        table.add_row(*row)
+    return table
+
+
+def _format_range(bounds: tuple[float, float | None] | None) -> str:
+    if bounds is None:
+        return "-"
+    lo, hi = bounds
+    return f"[{format_float(lo)}, inf)" if hi is None else f"[{format_float(lo)}, {format_float(hi)}]"
+
+
+def _power_table(motion: Motion) -> Table:
+    table = _table("power balance")
+    for name in ("input", "gravity", "dissipation", "residual"):
+        table.add_column(name, justify="right")
+    power = motion.power
+    scale = max(abs(power.input), abs(power.gravity), abs(power.dissipation))
+    table.add_row(*(format_float(x, scale) for x in (power.input, power.gravity, power.dissipation, power.residual)))
+    return table
+
+
+def _audit_table(motion: Motion) -> Table:
+    audit = motion.audit
+    verdict = Text("passed", style="green") if audit.passed else Text("FAILED", style="bold red")
+    title = Text.assemble("audit (scene-relative residuals, tolerance ", format_float(audit.tolerance), "): ", verdict)
+    table = _table(title)
+    residuals = audit.residuals()
+    failures = set(audit.failures())
+    for name in residuals:
+        table.add_column(name, justify="right")
+    table.add_row(*(Text(format_float(v), style="bold red" if k in failures else "") for k, v in residuals.items()))
+    return table
+
+
+def _render_solutions(motions: Sequence[Motion], console: Console) -> None:
+    console.print()
+    console.print(Text(f"motions that satisfy the laws: {len(motions)} listed (a continuum of motions is one entry)"))
+    for number, motion in enumerate(motions, start=1):
+        modes = ", ".join(motion.modes)
+        kind = ""
+        if motion.continuum:
+            kind = " continuum (unbounded)" if motion.unbounded else " continuum (bounded)"
+        console.print(Text(f"  motion {number}:{kind} modes [{modes}]"))
+        for name, twist in motion.twists.items():
+            console.print(Text(f"    {name}: twist {format_vector(twist)}"))
+        if motion.continuum and motion.extreme_twists:
+            console.print(Text("    extreme twists:"))
+            for extreme in motion.extreme_twists:
+                text = "; ".join(f"{name} {format_vector(t)}" for name, t in extreme.items())
+                console.print(Text(f"      {text}"))
