@@ -13,7 +13,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import pydantic
@@ -291,7 +291,7 @@ def _validate_contact(
     if robot_name is None:
         if contact.jacobian is not None:
             reason = f"only contacts with a robot-driven mover take a jacobian; {contact.other!r} is not one"
-            raise SceneError(f"{path}.jacobian", "...", reason)
+            raise SceneError(f"{path}.jacobian", contact.jacobian, reason)
         return
     joints = robots[robot_name].joint_velocities
     n_joints = len(joints)
@@ -320,39 +320,49 @@ def _unknown(kind: str, name: Any, known: Any) -> str:
 
 # --------------------------------------------------------------------------- files
 
+def _not_bool_or_text(value: Any) -> Any:
+    """YAML's ``true`` or ``"0.1"`` is not a number here, whatever pydantic's lax mode says."""
+    if isinstance(value, (bool, str)):
+        raise ValueError("expected a number")
+    return value
+
+
+_Number = Annotated[float, pydantic.BeforeValidator(_not_bool_or_text)]
+
+
 class _FileModel(pydantic.BaseModel):
     model_config = pydantic.ConfigDict(extra="forbid", allow_inf_nan=True, strict=False)
 
 
 class _BodyFile(_FileModel):
-    mass: float
-    com: list[float]
-    wrench: list[float] | None = None
+    mass: _Number
+    com: list[_Number]
+    wrench: list[_Number] | None = None
 
 
 class _MoverFile(_FileModel):
-    twist: list[float] | None = None
-    origin: list[float] | None = None
+    twist: list[_Number] | None = None
+    origin: list[_Number] | None = None
     robot: str | None = None
 
 
 class _RobotFile(_FileModel):
-    joint_velocities: list[float]
+    joint_velocities: list[_Number]
 
 
 class _ContactFile(_FileModel):
     body: str
     other: str
-    point: list[float]
-    normal: list[float]
-    mu: float = 0.0
-    jacobian: list[list[float]] | None = None
+    point: list[_Number]
+    normal: list[_Number]
+    mu: _Number = 0.0
+    jacobian: list[list[_Number]] | None = None
 
 
 class _SceneFile(_FileModel):
     quasistatic: int
     dimension: Literal[2, 3] = 3
-    gravity: list[float] | None = None
+    gravity: list[_Number] | None = None
     friction: str = "exact"
     bodies: dict[str, _BodyFile]
     movers: dict[str, _MoverFile | None] = {}
