@@ -201,10 +201,6 @@ def test_bad_scene_exits_2_with_one_line(tmp_path: Path, command: str, case: str
     _assert_one_line_error(invoke(command, _write(tmp_path, text)), *fragments)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="library: a misspelled *required* key is reported as 'required key is missing', without the hint",
-)
 @pytest.mark.parametrize(
     "text",
     [GOOD_SCENE.replace("bodies:", "bodeis:"), GOOD_SCENE.replace("normal: [0.0, 1.0]}", "normall: [0.0, 1.0]}", 1)],

@@ -6,7 +6,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.linalg
 
 from ..evaluate import RawMotion
 from ..solution import Mode, Status
@@ -52,14 +51,28 @@ class BackendResult:
     details: dict[str, Any] = field(default_factory=dict)
 
 
+def null_space(A: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    """Orthonormal basis of the null space of A, singular values below ``tol`` counted as zero.
+
+    The threshold is absolute: the matrices are scene-relative, so 1e-9 means
+    "zero" whatever the scene's units (scipy's default is relative to the
+    largest singular value, which calls a 1x1 matrix of 1e-17 full rank).
+    """
+    if A.shape[0] == 0:
+        return np.eye(A.shape[1])
+    _, sigma, vt = np.linalg.svd(A)
+    rank = int(np.sum(sigma > tol))
+    return vt[rank:].T
+
+
 def cone_is_trivial(equalities: np.ndarray, inequalities: np.ndarray) -> bool:
     """True when ``{d : E d = 0, I d >= 0}`` is only the origin."""
     n = equalities.shape[1] if equalities.size else inequalities.shape[1]
-    basis = scipy.linalg.null_space(equalities, rcond=1e-10) if equalities.shape[0] else np.eye(n)
+    basis = null_space(equalities) if equalities.shape[0] else np.eye(n)
     if basis.shape[1] == 0:
         return True
     A = inequalities @ basis
-    if A.shape[0] == 0 or scipy.linalg.null_space(A, rcond=1e-10).shape[1] > 0:
+    if A.shape[0] == 0 or null_space(A).shape[1] > 0:
         return False
     lp = solve_lp(A.sum(axis=0), A, np.zeros(A.shape[0]), np.ones(A.shape[0]), maximize=True)
     return lp.status == "optimal" and lp.objective <= 1e-7

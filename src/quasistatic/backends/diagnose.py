@@ -38,7 +38,7 @@ def kinematic_certificate(problem: Problem) -> np.ndarray | None:
     A = np.vstack([Jn.T, bn[None, :]])
     rhs = np.r_[np.zeros(n), 1.0]
     lp = solve_lp(np.zeros(m), A, rhs, rhs, np.zeros(m))
-    if lp.status == "optimal" and np.max(np.abs(A @ lp.x - rhs), initial=0.0) <= 1e-9:
+    if lp.status == "optimal" and np.max(np.abs(A @ lp.x - rhs), initial=0.0) <= 1e-7:
         return lp.x
     return None
 

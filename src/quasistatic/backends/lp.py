@@ -17,6 +17,8 @@ from .highs import INF, solve_lp
 
 __all__ = ["solve_frictionless", "JAMMED_MESSAGE", "UNSTABLE_MESSAGE"]
 
+CERTIFICATE_TOL = 1e-7  # HiGHS meets constraints to 1e-7; a certificate is checked to the same
+
 JAMMED_MESSAGE = (
     "jammed: no motion of the free bodies is compatible with the commanded mover motion "
     "(the movers would have to penetrate them); change the commanded motion"
@@ -76,13 +78,13 @@ def _verdict(problem: Problem, status: str) -> BackendResult:
         return BackendResult("jammed", JAMMED_MESSAGE, details={"certificate": "farkas", "multipliers": farkas.x.tolist()})
     # Unstable: a twist d with Jn d >= 0 and g.d = 1 does unbounded work.
     ray = solve_lp(np.zeros(n), np.vstack([Jn, g[None, :]]), np.r_[np.zeros(m), 1.0], np.r_[np.full(m, INF), 1.0])
-    if ray.status == "optimal" and np.all(Jn @ ray.x >= -1e-9) and abs(g @ ray.x - 1.0) < 1e-9:
+    if ray.status == "optimal" and np.all(Jn @ ray.x >= -CERTIFICATE_TOL) and abs(g @ ray.x - 1.0) < CERTIFICATE_TOL:
         return BackendResult("unstable", UNSTABLE_MESSAGE, details={"certificate": "ray", "direction": ray.x.tolist()})
     return BackendResult("failed", f"failed: HiGHS reported {status} but no certificate could be checked")
 
 
 def _certificate_holds(residual: np.ndarray) -> bool:
-    return bool(np.max(np.abs(residual), initial=0.0) <= 1e-9)
+    return bool(np.max(np.abs(residual), initial=0.0) <= CERTIFICATE_TOL)
 
 
 def _ambiguous_message(unbounded: bool) -> str:
