@@ -601,11 +601,7 @@ def slope_scene_3d(speed: float, guides: bool = True) -> dict[str, Any]:
     at the com (normals +z and -z) and pin vz = 0.
     """
     flat = slope_scene(speed)
-    contacts = [
-        {**c, "point": [*c["point"], z], "normal": [*c["normal"], 0.0]}
-        for c in flat["contacts"]
-        for z in (-DEPTH / 2, DEPTH / 2)
-    ]
+    contacts = [{**c, "point": [*c["point"], z], "normal": [*c["normal"], 0.0]} for c in flat["contacts"] for z in (-DEPTH / 2, DEPTH / 2)]
     com = [*flat["bodies"]["block"]["com"], 0.0]
     if guides:
         contacts += [
@@ -760,3 +756,36 @@ def test_nearly_axis_normal_unstable_scene() -> None:
     )
     sol = qs.solve(qs.load_scene(data))
     assert sol.status == "unstable", sol.message
+
+
+def test_prescribed_modes_are_honoured_or_refused() -> None:
+    """Box on two frictionless fingertips rising at 0.01 m/s (rolling both) with side walls.
+
+    Prescribing 'separating' at a lifting fingertip leaves no motion (the other
+    finger cannot lift the box alone without tipping it into a wall): the
+    answer must then be `jammed`, never the unprescribed motion.
+    """
+    scene = qs.load_scene(
+        {
+            "quasistatic": 1,
+            "dimension": 2,
+            "bodies": {"box": {"mass": 0.5, "com": [0.0, 0.05]}},
+            "movers": {"f": {"twist": [0.0, 0.01, 0.0]}, "wall": {}},
+            "contacts": [
+                {"body": "box", "other": "f", "point": [-0.04, 0.0], "normal": [0.0, 1.0]},
+                {"body": "box", "other": "f", "point": [0.04, 0.0], "normal": [0.0, 1.0]},
+                {"body": "box", "other": "wall", "point": [-0.05, 0.05], "normal": [1.0, 0.0]},
+                {"body": "box", "other": "wall", "point": [0.05, 0.05], "normal": [-1.0, 0.0]},
+            ],
+        }
+    )
+    free = qs.solve(scene)
+    assert free.status == "solved"
+    assert free.modes[:2] == ("rolling", "rolling")
+    rolling = qs.solve(scene, modes=["rolling", "rolling", None, None])
+    assert rolling.status == "solved"
+    assert rolling.twists["box"] == pytest.approx([0.0, 0.01, 0.0], abs=1e-9)
+    lifted_off = qs.solve(scene, modes=["separating", None, None, None])
+    assert lifted_off.status == "jammed"
+    with pytest.raises(ValueError, match="modes"):
+        qs.solve(scene, method="lp", modes=["rolling"] * 4)

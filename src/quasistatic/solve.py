@@ -52,7 +52,7 @@ def solve(
     """
     problem = scene if isinstance(scene, Problem) else assemble(scene)
     options = Options(max_solutions=max_solutions, modes=_check_modes(modes, problem), time_limit=time_limit)
-    name = _choose(method, problem)
+    name = _choose(method, problem, options.modes is not None)
     backend = get_backend(name)
     if backend.frictionless_only and not problem.is_frictionless:
         raise QuasistaticError(
@@ -63,11 +63,13 @@ def solve(
     return _audited(problem, result, name, tolerance)
 
 
-def _choose(method: str, problem: Problem) -> str:
+def _choose(method: str, problem: Problem, modes_given: bool) -> str:
     if method != "auto":
+        if modes_given and method == "lp":
+            raise ValueError("modes: method 'lp' cannot prescribe contact modes; use method 'auto' or 'scip'")
         get_backend(method)
         return method
-    if problem.is_frictionless:
+    if problem.is_frictionless and not modes_given:
         return "lp"
     return "scip"
 
