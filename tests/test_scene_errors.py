@@ -113,9 +113,7 @@ def test_unknown_optional_top_level_key_suggests_the_right_one() -> None:
     ],
     ids=["body-wrench", "mover-twist", "contact-jacobian", "contact-mu"],
 )
-def test_unknown_optional_nested_key_suggests_the_right_one(
-    mutate: Callable[[dict[str, Any]], None], field: str, suggestion: str
-) -> None:
+def test_unknown_optional_nested_key_suggests_the_right_one(mutate: Callable[[dict[str, Any]], None], field: str, suggestion: str) -> None:
     data = scene_2d()
     mutate(data)
     key = field.rsplit(".", 1)[1]
@@ -488,9 +486,7 @@ JUNK = st.recursive(
 )
 _KEYS = st.one_of(
     st.text(max_size=10),
-    st.sampled_from(
-        ["mass", "com", "wrench", "twist", "origin", "robot", "jacobian", "mu", "normal", "point", "body", "other"]
-    ),
+    st.sampled_from(["mass", "com", "wrench", "twist", "origin", "robot", "jacobian", "mu", "normal", "point", "body", "other"]),
 )
 
 
