@@ -1,4 +1,4 @@
-"""Command line: ``quasistatic demo | solve SCENE | check SCENE``. A thin layer, no physics.
+"""Command line: ``quasistatic demo | solve SCENE | check SCENE | validate``. A thin layer, no physics.
 
 Exit codes: 0 when the library gave an answer (``solved``, ``ambiguous``,
 ``jammed`` or ``unstable``: a diagnosis is an answer), 1 when the solve
@@ -21,6 +21,7 @@ from .report import make_console, render_solution
 from .scene import Scene, load_scene
 from .solution import Mode, Solution
 from .solve import METHODS, solve
+from .validation import render_results, run_validation
 
 __all__ = ["app", "main"]
 
@@ -81,6 +82,16 @@ def check(scene_file: SceneArgument) -> None:
         f"ok: {len(scene.bodies)} bodies, {len(scene.movers)} movers, {len(scene.contacts)} contacts, "
         f"dimension {scene.dimension}, friction {scene.friction}"
     )
+
+
+@app.command()
+def validate(
+    folder: Annotated[Path, typer.Option(help="Folder holding cases.yaml and its scenes.")] = Path("validation"),
+) -> None:
+    """Run the validation suite (classical results with known answers) and print a table; exit 1 if any case fails."""
+    results = _guarded(lambda: run_validation(folder))
+    render_results(results, make_console())
+    raise typer.Exit(0 if all(r.passed for r in results) else 1)
 
 
 def main() -> None:
