@@ -219,7 +219,7 @@ def _small_folder(tmp_path: Path, ids: set[str]) -> Path:
     data["cases"] = [c for c in data["cases"] if c["id"] in ids]
     for case in data["cases"]:
         case.pop("extrude", None)
-    (tmp_path / "scenes").mkdir()
+    (tmp_path / "scenes").mkdir(parents=True)
     for case in data["cases"]:
         shutil.copy(FOLDER / case["scene"], tmp_path / case["scene"])
     (tmp_path / "cases.yaml").write_text(yaml.safe_dump(data))
