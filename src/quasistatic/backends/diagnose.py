@@ -15,7 +15,9 @@ from ..problem import Problem
 from .base import BackendResult
 from .highs import solve_lp
 
-__all__ = ["diagnose", "equilibrium_exists", "kinematic_certificate"]
+__all__ = ["diagnose", "equilibrium_exists", "kinematic_certificate", "CERTIFICATE_TOL"]
+
+CERTIFICATE_TOL = 1e-7  # HiGHS meets constraints to 1e-7; a certificate is checked to the same
 
 JAMMED_KINEMATIC = (
     "jammed: no motion of the free bodies is compatible with the commanded mover motion "
@@ -38,7 +40,7 @@ def kinematic_certificate(problem: Problem) -> np.ndarray | None:
     A = np.vstack([Jn.T, bn[None, :]])
     rhs = np.r_[np.zeros(n), 1.0]
     lp = solve_lp(np.zeros(m), A, rhs, rhs, np.zeros(m))
-    if lp.status == "optimal" and np.max(np.abs(A @ lp.x - rhs), initial=0.0) <= 1e-7:
+    if lp.status == "optimal" and np.max(np.abs(A @ lp.x - rhs), initial=0.0) <= CERTIFICATE_TOL:
         return lp.x
     return None
 

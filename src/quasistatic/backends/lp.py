@@ -13,11 +13,11 @@ import numpy as np
 from ..evaluate import RawMotion
 from ..problem import Problem
 from .base import ZERO, BackendResult, Options, cone_is_trivial, ranges_are_wide, twist_extremes, value_ranges
+from .diagnose import CERTIFICATE_TOL, kinematic_certificate
 from .highs import INF, solve_lp
 
 __all__ = ["solve_frictionless", "JAMMED_MESSAGE", "UNSTABLE_MESSAGE"]
 
-CERTIFICATE_TOL = 1e-7  # HiGHS meets constraints to 1e-7; a certificate is checked to the same
 
 JAMMED_MESSAGE = (
     "jammed: no motion of the free bodies is compatible with the commanded mover motion "
@@ -68,23 +68,16 @@ def _force_ranges(Jn: np.ndarray, g: np.ndarray, slack: np.ndarray) -> list[tupl
 
 def _verdict(problem: Problem, status: str) -> BackendResult:
     """Jammed or unstable, each confirmed by a checked certificate."""
-    Jn, bn, g = problem.Jn, problem.bn, problem.g
+    Jn, g = problem.Jn, problem.g
     m, n = Jn.shape
-    # Jammed (kinematic): y >= 0, Jn^T y = 0, bn.y = 1 proves Jn q >= bn has no solution.
-    A = np.vstack([Jn.T, bn[None, :]])
-    rhs = np.r_[np.zeros(n), 1.0]
-    farkas = solve_lp(np.zeros(m), A, rhs, rhs, np.zeros(m))
-    if farkas.status == "optimal" and _certificate_holds(A @ farkas.x - rhs):
-        return BackendResult("jammed", JAMMED_MESSAGE, details={"certificate": "farkas", "multipliers": farkas.x.tolist()})
+    multipliers = kinematic_certificate(problem)
+    if multipliers is not None:
+        return BackendResult("jammed", JAMMED_MESSAGE, details={"certificate": "farkas", "multipliers": multipliers.tolist()})
     # Unstable: a twist d with Jn d >= 0 and g.d = 1 does unbounded work.
     ray = solve_lp(np.zeros(n), np.vstack([Jn, g[None, :]]), np.r_[np.zeros(m), 1.0], np.r_[np.full(m, INF), 1.0])
     if ray.status == "optimal" and np.all(Jn @ ray.x >= -CERTIFICATE_TOL) and abs(g @ ray.x - 1.0) < CERTIFICATE_TOL:
         return BackendResult("unstable", UNSTABLE_MESSAGE, details={"certificate": "ray", "direction": ray.x.tolist()})
     return BackendResult("failed", f"failed: HiGHS reported {status} but no certificate could be checked")
-
-
-def _certificate_holds(residual: np.ndarray) -> bool:
-    return bool(np.max(np.abs(residual), initial=0.0) <= CERTIFICATE_TOL)
 
 
 def _ambiguous_message(unbounded: bool) -> str:
