@@ -199,12 +199,17 @@ def _load(body: object, scene: Scene) -> np.ndarray:
     return wrench
 
 
+_SMALLEST_LENGTH = 1e-150  # a length whose square (in moments and inertia-free products) stays a normal float
+
+
 def _scales(scene: Scene) -> Scales:
     points = np.array([c.point for c in scene.contacts] + [b.com for b in scene.bodies], dtype=float)
     origin = points.mean(axis=0)
     length = float(np.max(np.linalg.norm(points - origin, axis=1)))
-    if length <= 0.0:
-        length = float(np.max(np.abs(points))) or 1.0
+    if length <= 0.0:  # every point coincides: only their distance from the world origin sets a size
+        length = float(np.max(np.abs(points)))
+        if not _SMALLEST_LENGTH <= length <= 1.0 / _SMALLEST_LENGTH:
+            length = 1.0
     dim = scene.dimension
     loads = [_load(body, scene) for body in scene.bodies]
     force = max([float(np.linalg.norm(w[:dim])) for w in loads] + [float(np.linalg.norm(w[dim:])) / length for w in loads])

@@ -34,6 +34,8 @@ def _highs() -> highspy.Highs:
     if solver is None:
         solver = highspy.Highs()
         solver.setOptionValue("output_flag", False)
+        # Scene-relative data: an entry of 1e-10 is a real (tiny) tilt, not noise to drop.
+        solver.setOptionValue("small_matrix_value", 1e-12)  # the smallest HiGHS accepts
         _local.highs = solver
     return solver
 

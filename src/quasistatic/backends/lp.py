@@ -73,10 +73,11 @@ def _verdict(problem: Problem, status: str) -> BackendResult:
     multipliers = kinematic_certificate(problem)
     if multipliers is not None:
         return BackendResult("jammed", JAMMED_MESSAGE, details={"certificate": "farkas", "multipliers": multipliers.tolist()})
-    # Unstable: a twist d with Jn d >= 0 and g.d = 1 does unbounded work.
-    ray = solve_lp(np.zeros(n), np.vstack([Jn, g[None, :]]), np.r_[np.zeros(m), 1.0], np.r_[np.full(m, INF), 1.0])
-    if ray.status == "optimal" and np.all(Jn @ ray.x >= -CERTIFICATE_TOL) and abs(g @ ray.x - 1.0) < CERTIFICATE_TOL:
-        return BackendResult("unstable", UNSTABLE_MESSAGE, details={"certificate": "ray", "direction": ray.x.tolist()})
+    # Unstable: a twist d with Jn d >= 0 and g.d > 0 does unbounded work; box |d| <= 1 keeps the LP bounded.
+    ray = solve_lp(g, Jn, np.zeros(m), np.full(m, INF), np.full(n, -1.0), np.full(n, 1.0), maximize=True)
+    if ray.status == "optimal" and ray.objective > CERTIFICATE_TOL and np.all(Jn @ ray.x >= -CERTIFICATE_TOL * ray.objective):
+        direction = ray.x / ray.objective
+        return BackendResult("unstable", UNSTABLE_MESSAGE, details={"certificate": "ray", "direction": direction.tolist()})
     return BackendResult("failed", f"failed: HiGHS reported {status} but no certificate could be checked")
 
 
