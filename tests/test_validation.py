@@ -16,6 +16,7 @@ import pytest
 import yaml
 from rich.console import Console
 
+import quasistatic as qs
 from quasistatic import QuasistaticError, load_scene
 from quasistatic.validation import (
     Case,
@@ -35,38 +36,25 @@ FOLDER = ROOT / "validation"
 CASES = load_cases(FOLDER)
 STATUSES = {"solved", "ambiguous", "jammed", "unstable"}
 
-MERGED_CONTINUA = (
-    "library bug: backends/scip.py _same() treats two continua as one motion when they share their finite "
-    "extreme twists and unboundedness, whatever their contact modes; the level grasp's (sliding, sliding) "
-    "slip-down continuum is merged into the (sliding, rolling) one and never listed"
+GRASP_3D = (
+    "3-D level grasp (two contacts per finger): besides the lift and the slip-down, the box may pivot about "
+    "either finger's contact pair while the other pair slides; the certified 8-edge search meets many such "
+    "continua and hits its 60 s time limit before listing the all-sliding slip-down"
 )
-PYRAMID_CONTINUUM = (
-    "3-D exact cone (in progress): a continuum of motions of the 8-edge pyramid (slip directions across one "
-    "pyramid face) is returned unrefined, so a unique exact-cone motion is reported ambiguous, or failed when "
-    "the continuum violates maximum dissipation"
-)
-TOO_CLOSE = (
-    "3-D exact cone (in progress): without an equilibrium in the exact cones but with one in the circumscribed "
-    "8-edge pyramid (friction within 8 % of the limit) the answer is failed ('too close to call'), not unstable"
+OUT_OF_PLANE = (
+    "finding, not a solver bug: with exact (isotropic) cones the extruded peg also has a sliding motion out of "
+    "the plane (v_y, v_z and a tilt w_x; every contact on its cone, friction exactly opposite the slip, checked "
+    "by the audit and by hand), which the planar analysis excludes; so the 3-D twin of a 'stays' case is "
+    "ambiguous (or failed where that motion's exact refinement does not converge), and does not agree with 2-D"
 )
 XFAIL = {
-    "grasp-level": MERGED_CONTINUA,
-    "grasp-level-3d": MERGED_CONTINUA,
-    "push-up-20-3d": PYRAMID_CONTINUUM,
-    "push-down-20-3d": PYRAMID_CONTINUUM,
-    "push-up-30-3d": PYRAMID_CONTINUUM,
-    "box-push-low-3d": PYRAMID_CONTINUUM,
-    "whitney-fx0-m021-3d": PYRAMID_CONTINUUM,
-    "whitney-fx10-m015-3d": PYRAMID_CONTINUUM,
-    "whitney-fx-20-m040-3d": PYRAMID_CONTINUUM,
-    "whitney-fx5-m017-3d": PYRAMID_CONTINUUM,
-    "whitney-fx30-m-005-3d": PYRAMID_CONTINUUM,
-    "whitney-fx-30-m048-3d": PYRAMID_CONTINUUM,
-    "ladder-slips-3d": TOO_CLOSE,
-    "ladder-smooth-wall-slips-3d": TOO_CLOSE,
-    "whitney-fx0-m019-3d": TOO_CLOSE,
-    "whitney-fx5-m014-3d": TOO_CLOSE,
-    "whitney-fx30-m-009-3d": TOO_CLOSE,
+    "grasp-level-3d": GRASP_3D,
+    "whitney-fx0-m021-3d": OUT_OF_PLANE,
+    "whitney-fx10-m015-3d": OUT_OF_PLANE,
+    "whitney-fx-20-m040-3d": OUT_OF_PLANE,
+    "whitney-fx5-m017-3d": OUT_OF_PLANE,
+    "whitney-fx30-m-005-3d": OUT_OF_PLANE,
+    "whitney-fx-30-m048-3d": OUT_OF_PLANE,
 }
 
 
@@ -201,7 +189,9 @@ def test_a_wrong_expectation_fails_with_a_reason() -> None:
 
 
 def test_render_results_prints_every_case(tmp_path: Path) -> None:
-    results = run_validation(FOLDER, include_slow=False, select=lambda c: c.id in {"slope-block-20", "grasp-level"})
+    results = run_validation(FOLDER, include_slow=False, select=lambda c: c.id == "slope-block-20")
+    case = next(c for c in CASES if c.id == "grasp-level")
+    results.append(run_case(Case(**{**case.__dict__, "expect": {"status": "unstable"}})))  # a wrong expectation
     console = Console(record=True, width=200)
     render_results(results, console)
     text = console.export_text()
@@ -264,3 +254,38 @@ def test_expected_values_match_closed_forms() -> None:
     assert ranges[0] == pytest.approx([w / 2 + t * wall[0], w / 2 + t * wall[1]], abs=1e-6)
     assert expect["grasp-offset-020"]["normal_force_ranges"][0][0] == pytest.approx(0.5 * g / (2 * (0.3 - 0.02 / 0.1)))
     assert expect["box-push-high"]["normal_forces"][2] == pytest.approx(2 * g * 0.2 / (2 * 0.25))
+
+
+def test_whitney_peg_in_3d_has_a_genuine_out_of_plane_sliding_motion() -> None:
+    """Why the 3-D twins of the Whitney 'stays' cases are ambiguous (see OUT_OF_PLANE).
+
+    Checked here from the scene alone, not from the library's matrices: the
+    listed sliding motion has every contact closed and on its cone with
+    friction exactly opposite its slip, the contact forces balance the
+    applied wrench, and the load's power equals the friction dissipation.
+    """
+    case = next(c for c in CASES if c.id == "whitney-fx0-m021-3d")
+    scene = qs.load_scene(scene_data(case))
+    sol = qs.solve(scene, all_solutions=True)
+    assert sol.status == "ambiguous"
+    sliding = [m for m in sol.solutions if all(c.mode == "sliding" for c in m.contacts)]
+    assert sliding, "the out-of-plane sliding motion is listed"
+    peg = scene.bodies[0]
+    twist = sliding[0].twists["peg"]
+    assert abs(twist[2]) > 1e-3 * np.linalg.norm(twist[:3])  # it leaves the plane
+    force, moment, dissipation = np.zeros(3), np.zeros(3), 0.0
+    for data, result in zip(scene.contacts, sliding[0].contacts, strict=True):
+        r = np.asarray(data.point) - np.asarray(peg.com)
+        v = twist[:3] + np.cross(twist[3:], r)
+        n = np.asarray(data.normal)
+        f_n = float(result.force @ n)
+        f_t, v_t = result.force - f_n * n, v - (v @ n) * n
+        assert abs(v @ n) <= 1e-9 * np.linalg.norm(v)
+        np.testing.assert_allclose(f_t, -data.mu * f_n * v_t / np.linalg.norm(v_t), rtol=1e-6, atol=1e-9)
+        force += result.force
+        moment += np.cross(r, result.force)
+        dissipation -= float(f_t @ v_t)
+    wrench = np.asarray(peg.wrench)
+    np.testing.assert_allclose(force + wrench[:3], 0.0, atol=1e-9)
+    np.testing.assert_allclose(moment + wrench[3:], 0.0, atol=1e-9)
+    assert float(wrench[:3] @ twist[:3] + wrench[3:] @ twist[3:]) == pytest.approx(dissipation, rel=1e-6)

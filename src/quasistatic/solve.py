@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 from .audit import DEFAULT_TOLERANCE
 from .backends.base import BackendResult, Options
-from .backends.registry import get_backend
+from .backends.registry import BACKENDS, get_backend
 from .errors import QuasistaticError
 from .evaluate import to_motion
 from .problem import Problem, assemble
@@ -15,7 +16,7 @@ from .solution import Mode, Motion, Solution
 
 __all__ = ["solve", "METHODS"]
 
-METHODS = ("auto", "lp", "scip")
+METHODS = ("auto", "lp", "fast", "scip", "paper")
 _MODE_NAMES = ("rolling", "sliding", "separating")
 
 
@@ -24,6 +25,7 @@ def solve(
     method: str = "auto",
     *,
     modes: Sequence[Mode | None] | None = None,
+    all_solutions: bool = False,
     max_solutions: int = 16,
     tolerance: float = DEFAULT_TOLERANCE,
     time_limit: float = 60.0,
@@ -35,9 +37,15 @@ def solve(
     scene : Scene or Problem
         A validated scene (or one already assembled, to solve it again cheaply).
     method : str
-        ``auto`` (default) or a backend name from :data:`METHODS`.
+        ``auto`` (default) or a backend name from :data:`METHODS`. ``auto``
+        solves frictionless scenes by LP (certified) and frictional ones by
+        the fast path first; when the fast path finds no audited motion, or
+        when ``all_solutions`` or ``modes`` are given, by the certified search.
     modes : sequence of {"rolling", "sliding", "separating", None}, optional
         Prescribe contact modes, one entry per contact (None leaves it free).
+    all_solutions : bool
+        Certify the answer: list every motion (``ambiguous`` when there are
+        several) instead of returning the first audited one the fast path finds.
     max_solutions : int
         Most distinct motions listed when the answer is ``ambiguous``.
     tolerance : float
@@ -52,26 +60,38 @@ def solve(
     """
     problem = scene if isinstance(scene, Problem) else assemble(scene)
     options = Options(max_solutions=max_solutions, modes=_check_modes(modes, problem), time_limit=time_limit)
-    name = _choose(method, problem, options.modes is not None)
-    backend = get_backend(name)
-    if backend.frictionless_only and not problem.is_frictionless:
-        raise QuasistaticError(
-            f"method {name!r} is frictionless but contacts {_frictional(problem)} have mu > 0; "
-            "use method 'auto', or set 'friction: none' to drop friction on purpose"
-        )
-    result = backend.load()(problem, options)
-    return _audited(problem, result, name, tolerance)
+    names = _choose(method, problem, options.modes is not None, all_solutions)
+    fallback: dict[str, str] = {}
+    for name in names:
+        backend = get_backend(name)
+        if backend.frictionless_only and not problem.is_frictionless:
+            raise QuasistaticError(
+                f"method {name!r} is frictionless but contacts {_frictional(problem)} have mu > 0; "
+                "use method 'auto', or set 'friction: none' to drop friction on purpose"
+            )
+        solution = _audited(problem, backend.load()(problem, options), name, tolerance)
+        if fallback:
+            solution = dataclasses.replace(solution, details={**solution.details, "fallback": fallback})
+        if solution.ok or name == names[-1]:
+            return solution
+        fallback[name] = solution.message
+    raise AssertionError("unreachable: the last method always returns")
 
 
-def _choose(method: str, problem: Problem, modes_given: bool) -> str:
+def _choose(method: str, problem: Problem, modes_given: bool, all_solutions: bool) -> tuple[str, ...]:
+    """Methods to try in order; a later one runs only when the earlier one found no audited motion."""
     if method != "auto":
-        if modes_given and method == "lp":
-            raise ValueError("modes: method 'lp' cannot prescribe contact modes; use method 'auto' or 'scip'")
         get_backend(method)
-        return method
+        if modes_given and method != "scip":
+            raise ValueError(f"modes: method {method!r} cannot prescribe contact modes; use method 'auto' or 'scip'")
+        if all_solutions and method in ("fast", "paper"):
+            raise ValueError(f"all_solutions: method {method!r} finds one motion; use method 'auto' or 'scip'")
+        return (method,)
     if problem.is_frictionless and not modes_given:
-        return "lp"
-    return "scip"
+        return ("lp",)
+    if modes_given or all_solutions or "fast" not in BACKENDS:
+        return ("scip",)
+    return ("fast", "scip")
 
 
 def _frictional(problem: Problem) -> list[int]:

@@ -7,11 +7,12 @@ from typing import Any
 
 import numpy as np
 
-from ..evaluate import RawMotion
+from ..evaluate import MODE_TOLERANCE, RawMotion
+from ..problem import Problem
 from ..solution import Mode, Status
 from .highs import INF, solve_lp
 
-__all__ = ["Options", "BackendResult", "twist_extremes", "cone_is_trivial", "value_ranges"]
+__all__ = ["Options", "BackendResult", "twist_extremes", "cone_is_trivial", "value_ranges", "contact_modes"]
 
 ZERO = 1e-9  # scene-relative: below this a residual, velocity or force is zero
 
@@ -49,6 +50,20 @@ class BackendResult:
     motions: tuple[RawMotion, ...] = ()
     force_ranges: list[tuple[float, float | None]] | None = None
     details: dict[str, Any] = field(default_factory=dict)
+
+
+def contact_modes(problem: Problem, q: np.ndarray) -> tuple[Mode, ...]:
+    """Each contact's mode at the scene-relative twist ``q`` (same thresholds as the report)."""
+    u = np.einsum("mdn,n->md", problem.J, q) - problem.b
+    modes: list[Mode] = []
+    for u_i in u:
+        if u_i[-1] > MODE_TOLERANCE:
+            modes.append("separating")
+        elif np.linalg.norm(u_i[:-1]) > MODE_TOLERANCE:
+            modes.append("sliding")
+        else:
+            modes.append("rolling")
+    return tuple(modes)
 
 
 def null_space(A: np.ndarray, tol: float = 1e-9) -> np.ndarray:

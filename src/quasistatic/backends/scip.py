@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import SolverError
 from ..evaluate import MODE_TOLERANCE, RawMotion
 from ..problem import Problem
-from .base import BackendResult, Options, twist_extremes
+from .base import BackendResult, Options, contact_modes, twist_extremes
 from .diagnose import diagnose
 from .forces import force_ranges
 from .highs import solve_lp
@@ -73,8 +73,9 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
 @dataclass
 class _Model:
     scip: object
-    x: list
-    z: list
+    x: list  # unknowns [q, cn, beta, lam]
+    w: list  # complementarity slacks, one per pair
+    z: list  # pattern binaries: 1 puts the pair's variable at zero, 0 its slack
 
 
 def _build(form: LCPForm, options: Options) -> _Model:
@@ -89,16 +90,17 @@ def _build(form: LCPForm, options: Options) -> _Model:
     x = [scip.addVar(lb=None if j < form.n_q else 0.0, ub=None, name=f"x{j}") for j in range(N)]
     for row, rhs in zip(form.E_eq, form.e_eq, strict=True):
         scip.addCons(_dot(row, x) == rhs)
-    z = []
+    z, w = [], []
     for i, col in enumerate(form.pair_cols):
-        w = scip.addVar(lb=0.0, ub=None, name=f"w{i}")
-        scip.addCons(_dot(form.W[i], x) - w == form.r[i])
+        wi = scip.addVar(lb=0.0, ub=None, name=f"w{i}")
+        scip.addCons(_dot(form.W[i], x) - wi == form.r[i])
         zi = scip.addVar(vtype="B", name=f"z{i}")
         scip.addConsIndicator(x[col] <= 0.0, zi)
-        scip.addConsIndicator(w <= 0.0, zi, activeone=False)
+        scip.addConsIndicator(wi <= 0.0, zi, activeone=False)
         z.append(zi)
+        w.append(wi)
     _prescribe_modes(scip, form, x, options)
-    return _Model(scip, x, z)
+    return _Model(scip, x, w, z)
 
 
 def _prescribe_modes(scip: object, form: LCPForm, x: list, options: Options) -> None:
@@ -132,16 +134,15 @@ def enumerate_motions(form: LCPForm, options: Options) -> tuple[list[RawMotion],
     """Every distinct motion (up to ``options.max_solutions``), and whether the search was complete.
 
     A single motion is excluded by a box around its twist (so the many
-    degenerate mode patterns that share it are excluded at once); a continuum
-    by a no-good cut on its contact-level pattern (closed/open, sliding/not).
+    degenerate patterns that share it are excluded at once). A continuum is
+    excluded as a set: some pair its pattern holds at zero must move away
+    from zero. A cut on the pattern's binaries would not do: a face of a
+    larger continuum (the level grasp's sliding-rolling edge of its
+    sliding-sliding slip) shares binaries with it and would hide it.
     """
-    import pyscipopt
-
     model = _build(form, options)
     scip = model.scip
     motions: list[RawMotion] = []
-    m = form.problem.n_contacts
-    coarse = list(range(m)) + list(range(len(model.z) - m, len(model.z)))
     while True:
         try:
             scip.optimize()  # type: ignore[attr-defined]
@@ -156,16 +157,28 @@ def enumerate_motions(form: LCPForm, options: Options) -> tuple[list[RawMotion],
         xs = np.array([scip.getSolVal(best, v) for v in model.x])  # type: ignore[attr-defined]
         zs = np.array([round(scip.getSolVal(best, v)) for v in model.z])  # type: ignore[attr-defined]
         motion = _pattern_motion(form, xs, zs, options)
-        if not any(_same(motion, other) for other in motions):
+        if not any(_same(form.problem, motion, other) for other in motions):
             motions.append(motion)
         if len(motions) >= options.max_solutions:
             return motions, False
         scip.freeTransform()  # type: ignore[attr-defined]
         if motion.continuum:
-            picked = [(model.z[i], zs[i]) for i in coarse]
-            scip.addCons(pyscipopt.quicksum((1 - v) if zi else v for v, zi in picked) >= 1)  # type: ignore[attr-defined]
+            _exclude_polyhedron(scip, model, zs, form)
         else:
             _exclude_twist(scip, model.x[: form.n_q], xs[: form.n_q])
+
+
+def _exclude_polyhedron(scip: object, model: _Model, pattern: np.ndarray, form: LCPForm) -> None:
+    """Leave the polyhedron of ``pattern``: some variable or slack it holds at zero reaches _DISTINCT."""
+    import pyscipopt
+
+    held = [model.x[col] if zi else w for col, w, zi in zip(form.pair_cols, model.w, pattern, strict=True)]
+    leave = []
+    for var in held:
+        flag = scip.addVar(vtype="B")  # type: ignore[attr-defined]
+        scip.addConsIndicator(-var <= -_DISTINCT, flag)  # type: ignore[attr-defined]
+        leave.append(flag)
+    scip.addCons(pyscipopt.quicksum(leave) >= 1)  # type: ignore[attr-defined]
 
 
 def _exclude_twist(scip: object, q: list, center: np.ndarray) -> None:
@@ -197,8 +210,10 @@ def _pattern_motion(form: LCPForm, x: np.ndarray, z: np.ndarray, options: Option
     continuum = unbounded or any(np.max(np.abs(e - q)) > 1e-7 for e in extremes)
     if not continuum:
         return RawMotion(q, form.forces(x), (), False)
-    # Represent a continuum by a point inside it, so its modes are those of its interior.
-    x = relative_interior_point(A_eq, b_eq, A_in, b_in, lower, x)
+    # Represent a continuum by a point inside it, so its modes are those of its interior:
+    # every inequality as slack as it can be, the pairs' own variables (slip speeds) included.
+    free_pairs = np.eye(N)[cols[z == 0]]
+    x = relative_interior_point(A_eq, b_eq, np.vstack([A_in, free_pairs]), np.r_[b_in, np.zeros(len(free_pairs))], lower, x)
     return RawMotion(x[: form.n_q], form.forces(x), tuple(extremes), unbounded)
 
 
@@ -244,11 +259,19 @@ def _with_prescribed_modes(
     return np.vstack(eq_rows), np.concatenate(eq_rhs), np.vstack(rows), np.concatenate(rhs)
 
 
-def _same(a: RawMotion, b: RawMotion) -> bool:
+def _same(problem: Problem, a: RawMotion, b: RawMotion) -> bool:
+    """Same motion: equal twists, or continua with the same modes and the same extremes.
+
+    Continua are compared by their modes too: the slip-down family of a level
+    grasp and its rolling-sliding edge share every finite extreme, yet are
+    different motions.
+    """
     if a.continuum != b.continuum or a.unbounded != b.unbounded:
         return False
     if not a.continuum:
         return bool(np.max(np.abs(a.q - b.q)) <= 1e-7)
+    if contact_modes(problem, a.q) != contact_modes(problem, b.q):
+        return False
     return len(a.extremes) == len(b.extremes) and all(
         any(np.max(np.abs(e - f)) <= 1e-7 for f in b.extremes) for e in a.extremes
     )
