@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from .audit import DEFAULT_TOLERANCE, audit_motion, relative_velocities
+from .audit import DEFAULT_TOLERANCE, audit_motion_velocities
 from .problem import Problem
 from .solution import ContactResult, Mode, Motion
 
@@ -43,9 +44,12 @@ class RawMotion:
 
 def physical_twists(problem: Problem, q: np.ndarray) -> dict[str, np.ndarray]:
     """Scene-relative stacked twists to named physical twists."""
-    k = problem.scene.twist_size
-    units = problem.scales.twist_units(problem.dimension)
-    return {b.name: q[i * k : (i + 1) * k] * units for i, b in enumerate(problem.scene.bodies)}
+    scene, scales = problem.scene, problem.scales
+    k, d = scene.twist_size, scene.dimension
+    V = scales.velocity
+    units = np.array([V] * d + [V / scales.length] * (k - d))
+    twists = np.reshape(q, (-1, k)) * units
+    return {b.name: twists[i] for i, b in enumerate(scene.bodies)}
 
 
 def to_motion(
@@ -57,14 +61,17 @@ def to_motion(
     """Audit a raw motion on the original data and name each contact's mode."""
     scene, scales = problem.scene, problem.scales
     twists = physical_twists(problem, raw.q)
-    forces = np.einsum("mij,mi->mj", problem.frames, raw.c) * scales.force
-    u = relative_velocities(scene, twists)
-    audit, power = audit_motion(scene, twists, forces, scales, tolerance)
+    forces = np.matmul(raw.c[:, None, :], problem.frames)[:, 0, :] * scales.force
+    audit, power, u = audit_motion_velocities(scene, twists, forces, scales, tolerance)
+    threshold = MODE_TOLERANCE * scales.velocity
+    # Contact by contact in scalar Python: for a few contacts that is cheaper than numpy calls.
     contacts = []
-    for i, contact in enumerate(scene.contacts):
-        n = np.asarray(contact.normal)
-        u_n = float(u[i] @ n)
-        slip = u[i] - u_n * n
+    for i, (contact, u_i, f_i) in enumerate(zip(scene.contacts, u, forces.tolist(), strict=True)):
+        n = contact.normal.tolist()  # type: ignore[attr-defined]
+        u_n = _dot(u_i, n)
+        slip = [u_i[0] - u_n * n[0], u_i[1] - u_n * n[1]]
+        if len(n) == 3:
+            slip.append(u_i[2] - u_n * n[2])
         range_i = None
         if ranges is not None:
             lo, hi = ranges[i]
@@ -73,10 +80,10 @@ def to_motion(
             ContactResult(
                 body=contact.body,
                 other=contact.other,
-                mode=_mode(u_n, slip, scales.velocity),
+                mode=_mode(u_n, math.sqrt(_dot(slip, slip)), threshold),
                 force=forces[i],
-                normal_force=float(forces[i] @ n),
-                slip=slip,
+                normal_force=_dot(f_i, n),
+                slip=np.array(slip),
                 normal_velocity=u_n,
                 normal_force_range=range_i,
             )
@@ -85,9 +92,15 @@ def to_motion(
     return Motion(twists, tuple(contacts), power, audit, raw.continuum, extremes, raw.unbounded)
 
 
-def _mode(u_n: float, slip: np.ndarray, velocity_scale: float) -> Mode:
-    if u_n > MODE_TOLERANCE * velocity_scale:
+def _dot(a: list[float] | tuple[float, ...], b: list[float]) -> float:
+    if len(a) == 2:
+        return a[0] * b[0] + a[1] * b[1]
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _mode(u_n: float, speed: float, threshold: float) -> Mode:
+    if u_n > threshold:
         return "separating"
-    if float(np.linalg.norm(slip)) > MODE_TOLERANCE * velocity_scale:
+    if speed > threshold:
         return "sliding"
     return "rolling"

@@ -54,6 +54,21 @@ BACKENDS: dict[str, Backend] = {
             requires="pyscipopt",
             install_hint="pip install pyscipopt",
         ),
+        Backend(
+            "paper",
+            ".paper",
+            "solve_paper",
+            "the paper's minimum-power program (bilinear, SCIP global optimum); one motion, uniqueness not checked",
+            requires="pyscipopt",
+            install_hint="pip install pyscipopt",
+        ),
+        Backend(
+            "fast",
+            ".fast",
+            "solve_fast",
+            "fast path: Lemke's method on the polyhedral LCP (numba), exact 3-D cones by re-aligned edges; "
+            "finds one motion, proves nothing",
+        ),
     )
 }
 
