@@ -21,6 +21,8 @@ DEMO = ROOT / "src" / "quasistatic" / "examples" / "two_finger_lift.yaml"
 # The status each example's header comment promises.
 EXPECTED_STATUS = {
     "box_push_3d.yaml": "ambiguous",
+    "puck_push_3d.yaml": "solved",
+    "push_up_slope.yaml": "solved",
     "push_into_wall.yaml": "jammed",
     "robot_tip.json": "solved",
     "robot_tip.yaml": "solved",
@@ -136,7 +138,11 @@ def test_modes_and_options_are_passed_to_solve(monkeypatch: pytest.MonkeyPatch) 
     monkeypatch.setattr(cli, "solve", spy)
     result = invoke("solve", DEMO, "--modes", "rolling, rolling,free,SLIDING", "--method", "lp", "--max-solutions", "3")
     assert result.exit_code == 0, result.output
-    assert seen == {"method": "lp", "modes": ["rolling", "rolling", None, "sliding"], "max_solutions": 3}
+    assert seen == {"method": "lp", "modes": ["rolling", "rolling", None, "sliding"], "max_solutions": 3, "all_solutions": False}
+    invoke("solve", DEMO)
+    assert seen["all_solutions"] is True  # the command line certifies by default
+    invoke("solve", DEMO, "--first-solution")
+    assert seen["all_solutions"] is False
 
 
 def test_failed_status_exits_1(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -53,7 +53,7 @@ def demo(as_json: JsonOption = False) -> None:
     """Solve the built-in example (two fingertips lifting a box) and print the result."""
     with resources.as_file(resources.files("quasistatic") / "examples" / DEMO_SCENE) as path:
         scene = _guarded(lambda: load_scene(path))
-    _report(_guarded(lambda: solve(scene)), as_json)
+    _report(_guarded(lambda: solve(scene, all_solutions=True)), as_json)
 
 
 @app.command("solve")
@@ -66,11 +66,21 @@ def solve_command(
         typer.Option(help="Prescribed contact modes, one per contact in order: rolling, sliding, separating or free."),
     ] = None,
     max_solutions: Annotated[int, typer.Option(min=1, help="Most distinct motions listed when ambiguous.")] = 16,
+    all_solutions: Annotated[
+        bool,
+        typer.Option(
+            "--all-solutions/--first-solution",
+            help="Certify: list every motion (default), or stop at the first audited one the fast path finds.",
+        ),
+    ] = True,
 ) -> None:
     """Solve a scene file: twists, contact forces and modes, power balance and audit."""
     scene = _guarded(lambda: load_scene(scene_file))
     prescribed = _guarded(lambda: _parse_modes(modes)) if modes is not None else None
-    solution = _guarded(lambda: solve(scene, method=method, modes=prescribed, max_solutions=max_solutions))
+    certify = all_solutions and method in ("auto", "scip")
+    solution = _guarded(
+        lambda: solve(scene, method=method, modes=prescribed, all_solutions=certify, max_solutions=max_solutions)
+    )
     _report(solution, as_json)
 
 
@@ -126,3 +136,4 @@ def _report(solution: Solution, as_json: bool) -> None:
     else:
         render_solution(solution, make_console())
     raise typer.Exit(1 if solution.status == "failed" else 0)
+
