@@ -4,6 +4,7 @@ Given the motion of a robot and the contacts, predict how grasped or pushed
 objects move, the contact forces and each contact's mode (Trinkle & Hunter).
 """
 
+from .batch import solve_many
 from .errors import BackendUnavailableError, QuasistaticError, SceneError, SolverError
 from .friction import FrictionModel
 from .problem import Problem, assemble
@@ -34,4 +35,5 @@ __all__ = [
     "assemble",
     "load_scene",
     "solve",
+    "solve_many",
 ]

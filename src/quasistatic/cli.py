@@ -137,3 +137,43 @@ def _report(solution: Solution, as_json: bool) -> None:
         render_solution(solution, make_console())
     raise typer.Exit(1 if solution.status == "failed" else 0)
 
+
+@app.command()
+def bench(
+    full: Annotated[bool, typer.Option("--full/--quick", help="Full families and sizes, or the quick CI subset (default).")] = False,
+    out: Annotated[Path | None, typer.Option(help="Folder for results.csv, results.json, results.md and scaling.png.")] = None,
+    repeat: Annotated[int, typer.Option(min=1, help="Timed solves per scene after the discarded warm-up solve.")] = 5,
+    family: Annotated[list[str] | None, typer.Option(help="Run only this family (repeatable).")] = None,
+    method: Annotated[list[str] | None, typer.Option(help="Run only this method (repeatable); the baseline always runs.")] = None,
+    instances: Annotated[int | None, typer.Option(min=1, help="Scenes per size (default: the family's own).")] = None,
+    cap: Annotated[float | None, typer.Option(min=0.001, help="Seconds per solve past which larger sizes are skipped.")] = None,
+    budget: Annotated[float | None, typer.Option(min=0.001, help="Seconds of timed solves aimed at per row.")] = None,
+    plot: Annotated[Path | None, typer.Option(help="Write the log-log time-vs-contacts plot here (needs matplotlib).")] = None,
+    batch: Annotated[bool, typer.Option("--batch/--no-batch", help="Measure solve_many throughput.")] = True,
+) -> None:
+    """Benchmark every method on generated problem families against baselines measured in the same run."""
+    import sys
+
+    from .bench import BenchConfig, render_result, run_benchmarks, write_results, write_scaling_plot
+
+    config = _guarded(
+        lambda: BenchConfig(
+            full=full,
+            repeat=repeat,
+            families=tuple(family) if family else None,
+            methods=tuple(method) if method else None,
+            instances=instances,
+            cap=cap if cap is not None else (30.0 if full else 5.0),
+            row_budget=budget if budget is not None else (5.0 if full else 2.0),
+            batch=batch,
+        )
+    )
+    console = make_console()
+    result = run_benchmarks(config, progress=lambda line: print(line, file=sys.stderr, flush=True))
+    render_result(result, console)
+    if out is not None:
+        for path in write_results(result, out):
+            console.print(f"wrote {path}")
+    for target in [p for p in (plot, out / "scaling.png" if out is not None else None) if p is not None]:
+        written = write_scaling_plot(result, target)
+        console.print(f"wrote {written}" if written else f"no plot written to {target} (matplotlib missing or no scaling rows)")

@@ -1,0 +1,110 @@
+"""Many solves at once: ``solve_many(problems)``, serially or over worker processes (joblib)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+from .audit import DEFAULT_TOLERANCE
+from .backends.registry import get_backend
+from .problem import Problem, assemble
+from .scene import Scene
+from .solution import Solution
+from .solve import solve
+
+__all__ = ["solve_many"]
+
+
+def solve_many(
+    problems: Iterable[Scene | Problem],
+    method: str = "auto",
+    n_jobs: int = 1,
+    *,
+    all_solutions: bool = False,
+    max_solutions: int = 16,
+    tolerance: float = DEFAULT_TOLERANCE,
+    time_limit: float = 60.0,
+    chunks_per_job: int = 4,
+) -> list[Solution]:
+    """Solve many scenes (or assembled problems), e.g. thousands of variants of one scene.
+
+    Each item is solved exactly as :func:`quasistatic.solve` would solve it,
+    audit included, and the solutions come back in input order. With
+    ``n_jobs > 1`` the items are split into ``n_jobs * chunks_per_job``
+    contiguous chunks solved in worker processes by joblib (the ``loky``
+    backend); each worker keeps its solver state (HiGHS instance, JIT code)
+    across its chunks, so the per-item overhead is a pickled problem and
+    solution. Pre-assembled :class:`~quasistatic.Problem` objects skip
+    assembly; passing scenes includes it.
+
+    Parameters
+    ----------
+    problems : iterable of Scene or Problem
+        The items to solve; any mix of the two.
+    method : str
+        ``auto`` (default) or a backend name (see :data:`quasistatic.METHODS`),
+        the same for every item.
+    n_jobs : int
+        Worker processes: 1 solves in this process (no joblib needed); -1
+        uses every core; otherwise >= 1.
+    all_solutions, max_solutions, tolerance, time_limit
+        As in :func:`quasistatic.solve`, for every item.
+    chunks_per_job : int
+        Chunks handed to each worker (more balances uneven solve times,
+        fewer lowers the overhead), >= 1.
+
+    Returns
+    -------
+    list of Solution
+        ``solutions[i]`` answers ``problems[i]``.
+
+    Raises
+    ------
+    TypeError
+        An item is neither a Scene nor a Problem (its index is named).
+    ValueError
+        An unknown method, or a bad ``n_jobs`` / ``chunks_per_job``.
+    QuasistaticError
+        As :func:`quasistatic.solve` raises for an item (e.g. ``lp`` on a
+        frictional scene); the item's index is added to the message.
+    """
+    items = list(problems)
+    for index, item in enumerate(items):
+        if not isinstance(item, (Scene, Problem)):
+            raise TypeError(f"problems[{index}]: expected a Scene or a Problem, got {type(item).__name__}")
+    if method != "auto":
+        get_backend(method)
+    if isinstance(n_jobs, bool) or not isinstance(n_jobs, int) or n_jobs == 0 or n_jobs < -1:
+        raise ValueError(f"n_jobs must be a positive number of processes or -1 (every core), got {n_jobs!r}")
+    if isinstance(chunks_per_job, bool) or not isinstance(chunks_per_job, int) or chunks_per_job < 1:
+        raise ValueError(f"chunks_per_job must be an integer >= 1, got {chunks_per_job!r}")
+    options: dict[str, Any] = {
+        "all_solutions": all_solutions,
+        "max_solutions": max_solutions,
+        "tolerance": tolerance,
+        "time_limit": time_limit,
+    }
+    if n_jobs == 1 or len(items) <= 1:
+        return _solve_chunk(items, 0, method, options)
+    try:
+        import joblib
+    except ImportError as exc:  # a declared dependency; only a broken install lacks it
+        raise ImportError("solve_many(n_jobs != 1) needs joblib: pip install 'joblib>=1.3'") from exc
+    workers = joblib.cpu_count() if n_jobs == -1 else n_jobs
+    size = max(1, -(-len(items) // (workers * chunks_per_job)))
+    starts = range(0, len(items), size)
+    parallel = joblib.Parallel(n_jobs=workers, backend="loky")
+    results = parallel(joblib.delayed(_solve_chunk)(items[s : s + size], s, method, options) for s in starts)
+    return [solution for chunk in results for solution in chunk]
+
+
+def _solve_chunk(items: Sequence[Scene | Problem], offset: int, method: str, options: dict[str, Any]) -> list[Solution]:
+    solutions = []
+    for index, item in enumerate(items, start=offset):
+        problem = item if isinstance(item, Problem) else assemble(item)
+        try:
+            solutions.append(solve(problem, method=method, **options))
+        except Exception as exc:
+            exc.add_note(f"while solving problems[{index}]")
+            raise
+    return solutions

@@ -1,0 +1,27 @@
+"""Benchmarks: speed, accuracy and scale of every method against baselines measured in the same run.
+
+Run them with ``quasistatic bench`` (or ``python -m benchmarks`` from the
+repository). :func:`run_benchmarks` returns a :class:`BenchResult`;
+:func:`render_result`, :func:`write_results` and :func:`write_scaling_plot`
+print and save it. The problem families live in :data:`FAMILIES`.
+"""
+
+from .families import FAMILIES, Family
+from .output import markdown_tables, render_result, write_results, write_scaling_plot
+from .runner import BatchRow, BenchConfig, BenchResult, Row, growth_exponents, machine_info, run_benchmarks
+
+__all__ = [
+    "FAMILIES",
+    "BatchRow",
+    "BenchConfig",
+    "BenchResult",
+    "Family",
+    "Row",
+    "growth_exponents",
+    "machine_info",
+    "markdown_tables",
+    "render_result",
+    "run_benchmarks",
+    "write_results",
+    "write_scaling_plot",
+]

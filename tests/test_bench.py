@@ -1,0 +1,99 @@
+"""The benchmark runner keeps working: a tiny subset (one family, two repeats) end to end."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from rich.console import Console
+
+import quasistatic as qs
+from quasistatic.bench import (
+    FAMILIES,
+    BenchConfig,
+    Row,
+    growth_exponents,
+    render_result,
+    run_benchmarks,
+    runner,
+    write_results,
+    write_scaling_plot,
+)
+
+
+@pytest.fixture(scope="module")
+def result() -> runner.BenchResult:
+    config = BenchConfig(families=("grasp-3d-nf",), methods=("lp", "scipy-dense"), repeat=2, instances=2, batch=False)
+    return run_benchmarks(config)
+
+
+def test_rows_cover_sizes_and_methods(result: runner.BenchResult) -> None:
+    sizes = FAMILIES["grasp-3d-nf"].quick_sizes
+    assert [(r.size, r.method) for r in result.rows] == [(s, m) for s in sizes for m in ("lp", "scipy-dense")]
+    for row in result.rows:
+        assert row.skipped is None
+        assert row.samples >= 2 and row.instances == 2
+        assert 0 < row.p25 <= row.median <= row.p75
+        assert row.assemble is not None and row.assemble > 0
+        assert sum(row.statuses.values()) == 2
+    baseline = [r for r in result.rows if r.method == "lp"]
+    assert all(r.ratio == 1.0 for r in baseline)
+    naive = [r for r in result.rows if r.method == "scipy-dense"]
+    # The naive LP agrees with the certified LP on these scenes (they are solved or unstable, never ambiguous).
+    assert all(r.compared == 2 and r.agree == 2 for r in naive)
+    assert all(r.ratio is not None and r.ratio > 0 for r in naive)
+
+
+def test_outputs(result: runner.BenchResult, tmp_path: Path) -> None:
+    csv_path, json_path, md_path = write_results(result, tmp_path)
+    assert md_path.read_text().count("| grasp-3d-nf") == 0 and "**grasp-3d-nf**" in md_path.read_text()
+    with csv_path.open() as handle:
+        lines = list(csv.DictReader(handle))
+    assert len(lines) == len(result.rows)
+    assert {"family", "method", "median", "ratio", "agree"} <= set(lines[0])
+    data = json.loads(json_path.read_text())
+    assert data["machine"]["cores"] >= 1 and data["rows"][0]["family"] == "grasp-3d-nf"
+    console = Console(file=io.StringIO(), width=160)
+    render_result(result, console)
+    text = console.file.getvalue()  # type: ignore[attr-defined]
+    assert "grasp-3d-nf" in text and "scipy-dense" in text and "(assemble)" in text
+    assert write_scaling_plot(result, tmp_path / "plot.png") is None  # no scaling family in this subset
+
+
+def test_unregistered_or_inapplicable_methods_are_reported_not_dropped(monkeypatch: pytest.MonkeyPatch) -> None:
+    problem = qs.assemble(FAMILIES["grasp-3d"].make(4, 0))
+    monkeypatch.delitem(runner.BACKENDS, "lp")
+    config = BenchConfig()
+    assert "not registered" in (runner._skip_reason("lp", problem, [], config) or "")
+    assert "frictional 3-D" in (runner._skip_reason("scipy-dense", problem, [], config) or "")
+    assert "too slow: one solve" in (runner._skip_reason("scip", problem, [(4, 2 * config.cap, 1.0)], config) or "")
+    # 2 s at 2 contacts growing as n^3 predicts 16 s at 4 contacts, over the 10 s cap.
+    assert "predicted" in (runner._skip_reason("scip", problem, [(1, 1.0, 0.25), (2, 1.0, 2.0)], config) or "")
+    assert runner._skip_reason("scip", problem, [(2, 0.1, 0.1)], config) is None
+    assert runner._skip_reason("scip", problem, [], config) is None
+
+
+def test_families_are_deterministic_and_valid() -> None:
+    for family in FAMILIES.values():
+        size = family.full_sizes[0]
+        first, again = family.make(size, 1), family.make(size, 1)
+        a, b = qs.assemble(first), qs.assemble(again)
+        for name in ("J", "b", "g", "mu"):
+            assert np.array_equal(getattr(a, name), getattr(b, name))
+        assert family.frictionless == (str(first.friction) == "none")
+
+
+def test_growth_exponent_of_a_power_law() -> None:
+    rows = [Row("f", n, "contacts", n, 1, "m", "m", median=1e-6 * n**1.5) for n in (10, 100, 1000)]
+    assert growth_exponents(rows)["f"]["m"] == pytest.approx(1.5)
+
+
+def test_bad_config() -> None:
+    with pytest.raises(ValueError, match="unknown benchmark families"):
+        BenchConfig(families=("nope",))
+    with pytest.raises(ValueError, match="repeat"):
+        BenchConfig(repeat=0)
