@@ -275,3 +275,26 @@ def test_3d_pyramid_friction_is_said_and_differs_off_axis() -> None:
     assert exact.friction == "exact"
     if sol.status == "solved":
         assert not np.allclose(sol.twists["block"], exact.twists["block"], atol=1e-6)
+
+
+def test_time_limit_bounds_the_whole_certified_solve_and_claims_nothing() -> None:
+    """A search stopped by the time limit reports failed, never a uniqueness or ambiguity it did not prove."""
+    problem = qs.assemble(puck("exact"))
+    stopped = qs.solve(problem, method="scip", time_limit=1e-6)
+    assert stopped.status == "failed"
+    assert "time limit" in stopped.message
+
+
+def test_one_motion_from_an_incomplete_search_is_not_solved() -> None:
+    """One motion found before the time limit: reported, audited, but failed (uniqueness unproven), not ambiguous."""
+    from quasistatic.backends.base import Options
+    from quasistatic.backends.polyhedral import aligned_edges, polyhedral_form
+    from quasistatic.backends.scip import enumerate_motions, summarise
+
+    problem = qs.assemble(slope(20.0, push=0.01))
+    form = polyhedral_form(problem, aligned_edges(problem, problem.friction.edges))
+    motions, complete = enumerate_motions(form, Options())
+    assert complete and len(motions) == 1
+    assert summarise(form, motions, complete, Options()).status == "solved"
+    partial = summarise(form, motions, False, Options())
+    assert partial.status == "failed" and "unique" in partial.message and len(partial.motions) == 1

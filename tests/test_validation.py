@@ -36,11 +36,6 @@ FOLDER = ROOT / "validation"
 CASES = load_cases(FOLDER)
 STATUSES = {"solved", "ambiguous", "jammed", "unstable"}
 
-GRASP_3D = (
-    "3-D level grasp (two contacts per finger): besides the lift and the slip-down, the box may pivot about "
-    "either finger's contact pair while the other pair slides; the certified 8-edge search meets many such "
-    "continua and hits its 60 s time limit before listing the all-sliding slip-down"
-)
 OUT_OF_PLANE = (
     "finding, not a solver bug: with exact (isotropic) cones the extruded peg also has a sliding motion out of "
     "the plane (v_y, v_z and a tilt w_x; every contact on its cone, friction exactly opposite the slip, checked "
@@ -48,7 +43,6 @@ OUT_OF_PLANE = (
     "ambiguous (or failed where that motion's exact refinement does not converge), and does not agree with 2-D"
 )
 XFAIL = {
-    "grasp-level-3d": GRASP_3D,
     "whitney-fx0-m021-3d": OUT_OF_PLANE,
     "whitney-fx10-m015-3d": OUT_OF_PLANE,
     "whitney-fx-20-m040-3d": OUT_OF_PLANE,

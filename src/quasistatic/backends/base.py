@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,12 +29,18 @@ class Options:
     modes : tuple of mode names or None, optional
         Prescribed contact modes (None entries are free): the mode-specified solve.
     time_limit : float
-        Seconds a certified search may take before it reports ``failed``.
+        Seconds the whole solve may take (every search it runs together)
+        before it reports ``failed``; the clock starts when the options are made.
     """
 
     max_solutions: int = 16
     modes: tuple[Mode | None, ...] | None = None
     time_limit: float = 60.0
+    started: float = field(default_factory=time.monotonic, compare=False)
+
+    def remaining(self) -> float:
+        """Seconds left of ``time_limit`` [s] (negative once it has passed)."""
+        return self.time_limit - (time.monotonic() - self.started)
 
 
 @dataclass(frozen=True)

@@ -106,7 +106,7 @@ def solve_paper(problem: Problem, options: Options) -> BackendResult:
     problem : Problem
         Scene-relative laws: ``J`` (m, d, n_dof), ``b`` (m, d), ``g`` (n_dof,), ``mu`` (m,).
     options : Options
-        ``time_limit`` [s] bounds each SCIP solve; prescribed ``modes`` are refused.
+        ``time_limit`` [s] bounds the whole solve; prescribed ``modes`` are refused.
 
     Returns
     -------
@@ -118,7 +118,7 @@ def solve_paper(problem: Problem, options: Options) -> BackendResult:
         return BackendResult("failed", "failed: the paper method does not take prescribed modes; use method 'scip'")
     if problem.dimension == 3 and problem.friction.kind == "pyramid":
         return BackendResult("failed", f"failed: the paper's program uses the exact cone (eq. 8), not {problem.friction}")
-    model = _build(problem, options.time_limit)
+    model = _build(problem, options.remaining())
     model.scip.setParam("limits/primal", GAP_TOL)  # stop at a point of gap 0: a global minimum by eq. 19
     model.scip.setParam("limits/dual", GAP_TOL)  # stop once the minimum is proven positive: no motion
     status = _optimize(model)
@@ -130,7 +130,7 @@ def solve_paper(problem: Problem, options: Options) -> BackendResult:
     if status in ("optimal", "duallimit") and model.scip.getDualbound() > GAP_TOL / 2:
         return _wedged(model, details)
     if status == "infeasible":
-        return _infeasible(problem, details, options.time_limit)
+        return _infeasible(problem, details, options.remaining())
     return BackendResult("failed", f"failed: SCIP stopped with status {status!r} before proving a global minimum", details=details)
 
 
@@ -143,7 +143,7 @@ def _solved(problem: Problem, options: Options, model: _Model, q: np.ndarray, de
     refined = _refine(problem, q, np.array([[model.scip.getSolVal(best, v) for v in c_i] for c_i in model.c]))
     c = None
     for twist in ([] if refined is None else [refined]) + [q]:
-        recovered = _forces_at(problem, twist, options.time_limit)
+        recovered = _forces_at(problem, twist, options.remaining())
         if recovered is not None:
             c, details["power_gap"] = recovered
             details["polished"] = twist is refined
@@ -258,7 +258,7 @@ def _new_model(time_limit: float) -> Any:
 
     scip = pyscipopt.Model()
     scip.hideOutput()
-    scip.setParam("limits/time", time_limit)
+    scip.setParam("limits/time", max(time_limit, 1e-3))  # the budget may already be spent
     scip.setParam("numerics/feastol", 1e-7)  # tighter makes SCIP ask SoPlex for < 1e-10, which it refuses on stdout; _refine polishes
     scip.setParam("limits/absgap", GAP_TOL / 10)
     scip.setHeuristics(pyscipopt.SCIP_PARAMSETTING.FAST)  # the default NLP multistart costs ~1 s a solve and rarely helps here
