@@ -11,7 +11,7 @@ import numpy as np
 from ..evaluate import MODE_TOLERANCE, RawMotion
 from ..problem import Problem
 from ..solution import Mode, Status
-from .highs import INF, solve_lp
+from .highs import INF, optimise_each, solve_lp
 
 __all__ = ["Options", "BackendResult", "twist_extremes", "cone_is_trivial", "value_ranges", "contact_modes"]
 
@@ -119,17 +119,14 @@ def twist_extremes(
     upper = np.r_[b_eq, np.full(b_in.size, INF)]
     points: list[np.ndarray] = []
     unbounded = False
-    for j in range(n_twist):
-        for sign in (1.0, -1.0):
-            cost = np.zeros(A.shape[1])
-            cost[j] = sign
-            lp = solve_lp(cost, A, lower, upper, col_lower)
-            if lp.status == "optimal":
-                q = lp.x[:n_twist]
-                if not any(np.max(np.abs(q - p)) <= 1e-7 for p in points):
-                    points.append(q)
-            else:
-                unbounded = True
+    objectives = [(sign * np.eye(1, A.shape[1], j)[0], False) for j in range(n_twist) for sign in (1.0, -1.0)]
+    for lp in optimise_each(objectives, A, lower, upper, col_lower):
+        if lp.status == "optimal":
+            q = lp.x[:n_twist]
+            if not any(np.max(np.abs(q - p)) <= 1e-7 for p in points):
+                points.append(q)
+        else:
+            unbounded = True
     return points, unbounded
 
 
@@ -141,9 +138,9 @@ def value_ranges(
 ) -> list[tuple[float, float | None]]:
     """Range of each linear function ``targets[i] . x`` over ``{A_eq x = b_eq, x >= col_lower}``."""
     ranges: list[tuple[float, float | None]] = []
-    for row in targets:
-        low = solve_lp(row, A_eq, b_eq, b_eq, col_lower)
-        high = solve_lp(row, A_eq, b_eq, b_eq, col_lower, maximize=True)
+    objectives = [(row, maximize) for row in targets for maximize in (False, True)]
+    results = optimise_each(objectives, A_eq, b_eq, b_eq, col_lower)
+    for low, high in zip(results[::2], results[1::2], strict=True):
         lo = low.objective if low.status == "optimal" else 0.0
         hi = high.objective if high.status == "optimal" else None
         ranges.append((max(lo, 0.0), hi))

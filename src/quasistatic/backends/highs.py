@@ -12,7 +12,7 @@ import scipy.sparse as sp
 
 from ..errors import SolverError
 
-__all__ = ["LPResult", "solve_lp", "INF"]
+__all__ = ["LPResult", "solve_lp", "optimise_each", "INF"]
 
 INF = float("inf")
 LPStatus = Literal["optimal", "infeasible", "unbounded", "unbounded_or_infeasible", "error"]
@@ -63,6 +63,45 @@ def solve_lp(
 
     Columns are free unless bounds are given. Infinite bounds use ``float('inf')``.
     """
+    solver = _load(cost, A, row_lower, row_upper, col_lower, col_upper, maximize)
+    return _run(solver, cost, maximize)
+
+
+def optimise_each(
+    objectives: list[tuple[np.ndarray, bool]],
+    A: np.ndarray | sp.spmatrix,
+    row_lower: np.ndarray,
+    row_upper: np.ndarray,
+    col_lower: np.ndarray | None = None,
+    col_upper: np.ndarray | None = None,
+) -> list[LPResult]:
+    """Solve one feasible set for each ``(cost, maximize)`` in turn, as :func:`solve_lp` would.
+
+    The model is passed to HiGHS once; each later objective starts from the
+    previous optimal basis (a range needs two LPs per unknown: warm starts make
+    the second and later ones a few pivots each).
+    """
+    if not objectives:
+        return []
+    cost, maximize = objectives[0]
+    solver = _load(cost, A, row_lower, row_upper, col_lower, col_upper, maximize)
+    results = [_run(solver, cost, maximize)]
+    columns = np.arange(cost.size, dtype=np.int32)
+    for cost, maximize in objectives[1:]:
+        solver.changeColsCost(cost.size, columns, -cost if maximize else cost)  # always minimised, as in _load
+        results.append(_run(solver, cost, maximize))
+    return results
+
+
+def _load(
+    cost: np.ndarray,
+    A: np.ndarray | sp.spmatrix,
+    row_lower: np.ndarray,
+    row_upper: np.ndarray,
+    col_lower: np.ndarray | None,
+    col_upper: np.ndarray | None,
+    maximize: bool,
+) -> highspy.Highs:
     n = cost.size
     matrix = sp.csc_matrix(A)
     m = matrix.shape[0]
@@ -81,9 +120,18 @@ def solve_lp(
     solver = _highs()
     try:
         solver.passModel(lp)
+    except Exception as exc:  # a crash inside HiGHS, not a status
+        raise SolverError("highs", f"HiGHS failed: {exc}") from exc
+    return solver
+
+
+def _run(solver: highspy.Highs, cost: np.ndarray, maximize: bool) -> LPResult:
+    n = cost.size
+    try:
         solver.run()
     except Exception as exc:  # a crash inside HiGHS, not a status
         raise SolverError("highs", f"HiGHS failed: {exc}") from exc
+    m = solver.getNumRow()
     status = _STATUS.get(solver.getModelStatus(), "error")
     solution = solver.getSolution()
     x = np.array(solution.col_value) if n else np.zeros(0)
