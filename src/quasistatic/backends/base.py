@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -29,18 +30,29 @@ class Options:
     modes : tuple of mode names or None, optional
         Prescribed contact modes (None entries are free): the mode-specified solve.
     time_limit : float
-        Seconds the whole solve may take (every search it runs together)
-        before it reports ``failed``; the clock starts when the options are made.
+        Seconds a backend's whole solve may take (every search it runs
+        together) before it reports ``failed``.
+    started : float or None
+        ``time.monotonic()`` when the backend started its clock
+        (:meth:`start_clock`); None before.
     """
 
     max_solutions: int = 16
     modes: tuple[Mode | None, ...] | None = None
     time_limit: float = 60.0
-    started: float = field(default_factory=time.monotonic, compare=False)
+    started: float | None = field(default=None, compare=False)
+
+    def start_clock(self) -> Options:
+        """These options with the time limit counting from now, unless it already runs (a backend calls it on entry).
+
+        A backend that calls another (the exact-cone search calling the paper's
+        program) passes its running clock on: the time limit is for the whole solve.
+        """
+        return self if self.started is not None else dataclasses.replace(self, started=time.monotonic())
 
     def remaining(self) -> float:
-        """Seconds left of ``time_limit`` [s] (negative once it has passed)."""
-        return self.time_limit - (time.monotonic() - self.started)
+        """Seconds left of ``time_limit`` [s] (negative once it has passed; all of it before the clock starts)."""
+        return self.time_limit if self.started is None else self.time_limit - (time.monotonic() - self.started)
 
 
 @dataclass(frozen=True)

@@ -114,6 +114,7 @@ def solve_paper(problem: Problem, options: Options) -> BackendResult:
         ``solved`` with one motion (a global minimiser; uniqueness is not
         checked), or ``jammed``, ``unstable``, ``failed``.
     """
+    options = options.start_clock()
     if options.modes is not None:
         return BackendResult("failed", "failed: the paper method does not take prescribed modes; use method 'scip'")
     if problem.dimension == 3 and problem.friction.kind == "pyramid":

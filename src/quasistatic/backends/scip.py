@@ -32,7 +32,8 @@ _SLIDE_MIN = 10.0 * MODE_TOLERANCE  # scene-relative slip speed that counts as s
 
 
 def solve_certified(problem: Problem, options: Options) -> BackendResult:
-    """The certified answer for polyhedral friction models."""
+    """The certified answer: every motion, or a proof that there is none, within ``options.time_limit``."""
+    options = options.start_clock()
     if not problem.friction.is_polyhedral(problem.dimension):
         from .exact3d import solve_exact_3d
 
