@@ -85,7 +85,8 @@ class _Model:
     w: list  # complementarity slacks, one per pair
 
 
-def _build(form: LCPForm, options: Options) -> _Model:
+def _build(form: LCPForm, options: Options, sos1: bool = True) -> _Model:
+    """The feasibility model; complementarity by SOS1, or by a binary and two indicators when ``sos1`` is False."""
     import pyscipopt
 
     scip = pyscipopt.Model()
@@ -100,7 +101,12 @@ def _build(form: LCPForm, options: Options) -> _Model:
     for i, col in enumerate(form.pair_cols):
         wi = scip.addVar(lb=0.0, ub=None, name=f"w{i}")
         scip.addCons(_dot(form.W[i], x) - wi == form.r[i])
-        scip.addConsSOS1([x[col], wi])
+        if sos1:
+            scip.addConsSOS1([x[col], wi])
+        else:
+            zi = scip.addVar(vtype="B", name=f"z{i}")
+            scip.addConsIndicator(x[col] <= 0.0, zi)
+            scip.addConsIndicator(wi <= 0.0, zi, activeone=False)
         w.append(wi)
     _prescribe_modes(scip, form, x, options)
     return _Model(scip, x, w)
@@ -142,8 +148,19 @@ def enumerate_motions(form: LCPForm, options: Options) -> tuple[list[RawMotion],
     from zero. A cut on the pattern's binaries would not do: a face of a
     larger continuum (the level grasp's sliding-rolling edge of its
     sliding-sliding slip) shares binaries with it and would hide it.
+
+    SCIP's LP solver occasionally fails on the SOS1 model's relaxations; the
+    search then starts again on the indicator form, which is slower but was
+    measured robust on the same scenes.
     """
-    model = _build(form, options)
+    try:
+        return _enumerate(form, options, sos1=True)
+    except SolverError:
+        return _enumerate(form, options, sos1=False)
+
+
+def _enumerate(form: LCPForm, options: Options, sos1: bool) -> tuple[list[RawMotion], bool]:
+    model = _build(form, options, sos1)
     scip = model.scip
     motions: list[RawMotion] = []
     while True:
