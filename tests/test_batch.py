@@ -85,3 +85,25 @@ def test_failing_item_is_named() -> None:
     with pytest.raises(qs.QuasistaticError, match="frictionless") as info:
         qs.solve_many(scenes, method="lp")
     assert "while solving problems[1]" in info.value.__notes__
+
+
+def test_forked_and_joblib_workers_give_the_same_answers(problems: list[qs.Problem], monkeypatch: pytest.MonkeyPatch) -> None:
+    """Both ways of running workers (forked, inheriting the items; joblib, pickling them) answer alike."""
+    from quasistatic import batch
+
+    items = problems + [qs.assemble(grasp_2d(3, i)) for i in range(5)]
+    serial = qs.solve_many(items, method="auto")
+    forked = qs.solve_many(items, method="auto", n_jobs=2, chunks_per_job=3)
+    monkeypatch.setattr(batch, "_can_fork", lambda: False)
+    shipped = qs.solve_many(items, method="auto", n_jobs=2, chunks_per_job=3)
+    for a, b, c in zip(serial, forked, shipped, strict=True):
+        _same(b, a)
+        _same(c, a)
+    assert not batch._INHERITED  # the inherited items are let go
+
+
+def test_failing_item_is_named_by_a_worker() -> None:
+    scenes = [grasp_2d(2, 0, friction="none")] * 3 + [grasp_2d(2, 1)]  # the last has friction: lp refuses it
+    with pytest.raises(qs.QuasistaticError, match="frictionless") as info:
+        qs.solve_many(scenes, method="lp", n_jobs=2, chunks_per_job=1)
+    assert "while solving problems[3]" in info.value.__notes__

@@ -312,3 +312,181 @@ def test_runs_without_numba() -> None:
     low = qs.solve(qs.load_scene(ROOT / "validation" / "scenes" / "box_push_low.yaml"), method="fast")
     assert [float(x) for x in lines[0].split()] == pytest.approx(list(low.twists["box"]), abs=1e-12)
     assert [float(x) for x in lines[1].split()] == pytest.approx([0.01 * math.cos(math.pi / 6), 0.005, 0, 0, 0, 0], abs=1e-9)
+
+
+# --------------------------------------------------------------------------- speed work keeps the answers
+
+
+def _lp_without_lemke(problem: qs.Problem, monkeypatch: pytest.MonkeyPatch) -> qs.Solution:
+    """The ``lp`` answer with Lemke's method switched off (HiGHS only), on a fresh copy of the problem."""
+    from quasistatic.backends import lp
+
+    monkeypatch.setattr(lp, "LEMKE_MAX_ROWS", -1)
+    try:
+        return qs.solve(qs.assemble(problem.scene), method="lp")
+    finally:
+        monkeypatch.undo()
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_lp_with_lemke_gives_the_highs_answer(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The frictionless LP's primal-dual pair from Lemke's method leads to the same verdict as HiGHS's:
+    status, twist, and the same normal-force ranges when the forces are indeterminate."""
+    from random_scenes import random_scene
+
+    problem = qs.assemble(random_scene(2 + seed % 2, seed, friction="none"))
+    fast, reference = qs.solve(problem, method="lp"), _lp_without_lemke(problem, monkeypatch)
+    assert fast.status == reference.status
+    assert fast.forces_indeterminate == reference.forces_indeterminate
+    if reference.status == "solved":
+        assert fast.audit is not None and fast.audit.passed
+        for name, twist in reference.twists.items():
+            np.testing.assert_allclose(fast.twists[name], twist, rtol=0, atol=1e-9)
+        for mine, theirs in zip(fast.contacts, reference.contacts, strict=True):
+            assert mine.mode == theirs.mode
+            if theirs.normal_force_range is None:
+                assert mine.normal_force_range is None
+                assert mine.normal_force == pytest.approx(theirs.normal_force, abs=1e-9)
+            else:
+                assert mine.normal_force_range is not None
+                assert mine.normal_force_range[0] == pytest.approx(theirs.normal_force_range[0], abs=1e-9)
+
+
+def test_lp_with_lemke_on_the_benchmark_grasps(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Frictionless 3-D grasps (8 contacts: solved, one with indeterminate forces; 4: unstable)."""
+    from quasistatic.bench.families import grasp_3d
+
+    for size, instance in itertools.product((4, 8), range(8)):
+        problem = qs.assemble(grasp_3d(size, instance, friction="none"))
+        fast, reference = qs.solve(problem), _lp_without_lemke(problem, monkeypatch)
+        assert (fast.status, fast.forces_indeterminate) == (reference.status, reference.forces_indeterminate)
+        for name, twist in reference.twists.items():
+            np.testing.assert_allclose(fast.twists[name], twist, rtol=0, atol=1e-9)
+
+
+def _some_solutions() -> list[tuple[qs.Problem, qs.Solution]]:
+    from quasistatic.bench.families import grasp_2d, grasp_3d
+
+    problems = [qs.assemble(grasp_3d(8, i, friction="none")) for i in range(3)] + [qs.assemble(grasp_2d(3, i)) for i in range(3)]
+    solved = [(p, qs.solve(p, method=m)) for p in problems for m in ("fast", "lp" if p.is_frictionless else "scip")]
+    assert sum(s.motion is not None for _, s in solved) >= 8
+    return solved
+
+
+def test_lazy_contacts_equal_the_eager_ones() -> None:
+    """A solve's per-contact results are made when first read; they are what the eager code made."""
+    import dataclasses
+    import pickle
+
+    for problem, solution in _some_solutions():
+        motion = solution.motion
+        if motion is None:
+            continue
+        modes = motion.modes  # read from the arrays, before any ContactResult exists
+        assert "contacts" not in motion.__dict__
+        contacts = motion.contacts
+        assert motion.contacts is contacts  # made once, then kept
+        assert modes == tuple(c.mode for c in contacts)
+        for c, given in zip(contacts, problem.scene.contacts, strict=True):
+            assert (c.body, c.other) == (given.body, given.other)
+            n = np.asarray(given.normal)
+            assert c.normal_force == pytest.approx(float(c.force @ n), abs=1e-12)
+            assert abs(float(c.slip @ n)) <= 1e-12
+        copy = dataclasses.replace(motion)  # an eager Motion with the same fields
+        for m in (copy, pickle.loads(pickle.dumps(motion)), pickle.loads(pickle.dumps(copy))):
+            assert m.modes == modes and m.audit == motion.audit and m.power == motion.power
+            assert m.twists.keys() == motion.twists.keys()
+            for name in m.twists:
+                np.testing.assert_array_equal(m.twists[name], motion.twists[name])
+            for a, b in zip(m.contacts, contacts, strict=True):
+                fields = ("body", "other", "mode", "normal_force", "normal_velocity", "normal_force_range")
+                assert [getattr(a, f) for f in fields] == [getattr(b, f) for f in fields]
+                np.testing.assert_array_equal(a.force, b.force)
+                np.testing.assert_array_equal(a.slip, b.slip)
+        assert solution.to_dict()["contacts"] == [c.to_dict() for c in contacts]
+
+
+_KERNEL_CASES = """
+import json, sys
+import numpy as np
+from quasistatic import audit
+from quasistatic.bench.families import grasp_2d, grasp_3d
+
+scenes = [grasp_2d(4, 0), grasp_3d(6, 1), grasp_3d(4, 2, friction="pyramid:6"), grasp_3d(8, 0, friction="none")]
+rng = np.random.default_rng(7)
+out = []
+for scene in scenes:
+    T = rng.normal(size=(len(scene.bodies), scene.twist_size))
+    forces = rng.normal(size=(len(scene.contacts), scene.dimension))
+    e = audit._evaluate(audit._geometry(scene), T, forces)
+    out.append([a.tolist() for a in (e.sums, e.velocities, e.slips, e.normal)])
+print(json.dumps(out))
+"""
+
+
+def test_audit_kernel_compiled_and_plain_python_agree() -> None:
+    """The law kernel gives the same sums, velocities and slips compiled and as plain Python (numba made unimportable)."""
+    import json
+
+    runs = []
+    for block in ("", "import sys; sys.modules['numba'] = None\n"):
+        out = subprocess.run([sys.executable, "-c", block + _KERNEL_CASES], capture_output=True, text=True, timeout=120, cwd=ROOT)
+        assert out.returncode == 0, out.stderr
+        runs.append(json.loads(out.stdout))
+    for compiled, python in zip(*runs, strict=True):
+        for a, b in zip(compiled, python, strict=True):
+            np.testing.assert_allclose(np.asarray(a), np.asarray(b), rtol=1e-13, atol=1e-15)
+
+
+def test_audit_rejects_non_finite_motions() -> None:
+    """A NaN anywhere in a motion fails its audit (max() alone would let a NaN through)."""
+    from quasistatic.audit import audit_motion
+    from quasistatic.bench.families import grasp_3d
+
+    problem = qs.assemble(grasp_3d(8, 0, friction="none"))
+    solution = qs.solve(problem, method="fast")
+    assert solution.motion is not None and solution.audit is not None and solution.audit.passed
+    forces = np.array([c.force for c in solution.contacts])
+    for where in ("twist", "force"):
+        twists = {name: t.copy() for name, t in solution.twists.items()}
+        bad = forces.copy()
+        if where == "twist":
+            next(iter(twists.values()))[4] = np.nan
+        else:
+            bad[3, 1] = np.nan
+        audit, _ = audit_motion(problem.scene, twists, bad, problem.scales)
+        assert not audit.passed, where
+
+
+def test_problem_caches_go_with_their_objects() -> None:
+    """Data derived per Problem and per Scene is dropped when the object is."""
+    import gc
+
+    from quasistatic import audit, evaluate
+    from quasistatic.bench.families import grasp_2d
+
+    gc.collect()
+    before = (len(evaluate._DERIVED), len(audit._GEOMETRY))
+    for i in range(20):
+        qs.solve(qs.assemble(grasp_2d(3, i)), method="fast")
+    gc.collect()
+    assert (len(evaluate._DERIVED), len(audit._GEOMETRY)) == before
+
+
+def test_jacobi_singular_values_match_lapack() -> None:
+    """The small-matrix SVD behind the frictionless rank tests gives LAPACK's singular values and ranks."""
+    from quasistatic.backends.lp import _rank, _singular_values
+
+    rng = np.random.default_rng(3)
+    for trial in range(500):
+        k, n = (int(x) for x in rng.integers(1, 10, size=2))
+        r = int(rng.integers(0, min(k, n) + 1))
+        A = rng.normal(size=(k, r)) @ rng.normal(size=(r, n)) * 10.0 ** rng.uniform(-12, 2) if r else np.zeros((k, n))
+        if trial % 5 == 0 and k > 1:
+            A[1] = A[0] * (1.0 + 1e-13)  # nearly dependent rows
+        ours = np.sort(_singular_values(A))[::-1]
+        lapack = np.linalg.svd(A, compute_uv=False)
+        np.testing.assert_allclose(ours, lapack, rtol=0, atol=1e-14 * max(1.0, lapack.max()))
+        for tol in (1e-9, 1e-10):
+            assert _rank(A, tol) == int(np.sum(lapack > tol))
+    assert _rank(np.zeros((0, 6)), 1e-9) == 0

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, Protocol
 
 import numpy as np
 
@@ -113,7 +113,8 @@ class Audit:
 
     @property
     def passed(self) -> bool:
-        return all(v <= self.tolerance for v in self.residuals().values())
+        t = self.tolerance  # written out: this runs after every solve (a NaN residual fails)
+        return self.equilibrium <= t and self.cone <= t and self.complementarity <= t and self.dissipation <= t and self.power <= t
 
     def residuals(self) -> dict[str, float]:
         return {
@@ -132,6 +133,14 @@ class Audit:
         return {**{k: float(v) for k, v in self.residuals().items()}, "tolerance": self.tolerance, "passed": self.passed}
 
 
+class _ContactSource(Protocol):
+    """Per-contact results kept as arrays until a Motion's ``contacts`` are first read."""
+
+    def results(self) -> tuple[ContactResult, ...]: ...
+
+    def modes(self) -> tuple[Mode, ...]: ...
+
+
 @dataclass(frozen=True)
 class Motion:
     """One motion that satisfies the laws: twists, contacts, power and its audit.
@@ -141,6 +150,7 @@ class Motion:
     twists : dict name -> array (3,) in 2-D or (6,) in 3-D
         Linear velocity of the com, then angular velocity, world frame.
     contacts : tuple of ContactResult, in scene order
+        (For a motion returned by a solve, made from the audit's arrays when first read.)
     power : PowerBalance
     audit : Audit
     continuum : bool
@@ -157,8 +167,22 @@ class Motion:
     extreme_twists: tuple[dict[str, np.ndarray], ...] = ()
     unbounded: bool = False
 
+    def __getstate__(self) -> dict[str, Any]:
+        # Twists as floats in lists: pickling small arrays costs more than the numbers in them.
+        state = dict(self.__dict__)
+        state["twists"] = [(name, np.shape(t), np.asarray(t, dtype=float).ravel().tolist()) for name, t in self.twists.items()]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        state = dict(state)
+        state["twists"] = {name: np.array(values, dtype=float).reshape(shape) for name, shape, values in state["twists"]}
+        self.__dict__.update(state)
+
     @property
     def modes(self) -> tuple[Mode, ...]:
+        source = self.__dict__.get("_contact_source")
+        if source is not None and "contacts" not in self.__dict__:
+            return source.modes()  # type: ignore[no-any-return]
         return tuple(c.mode for c in self.contacts)
 
     def to_dict(self) -> dict[str, Any]:
@@ -174,6 +198,52 @@ class Motion:
             out["unbounded"] = self.unbounded
             out["extreme_twists"] = [{n: _floats(t) for n, t in e.items()} for e in self.extreme_twists]
         return out
+
+
+class _LazyContacts:
+    """``Motion.contacts`` of a motion made by :func:`_lazy_motion`: built on first read, then kept.
+
+    A non-data descriptor: a Motion built the ordinary way holds ``contacts`` in its
+    ``__dict__``, which takes precedence, so this only runs for lazily built ones.
+    """
+
+    def __get__(self, motion: Motion | None, owner: type | None = None) -> Any:
+        if motion is None:
+            return self
+        contacts = motion.__dict__["_contact_source"].results()
+        motion.__dict__["contacts"] = contacts  # frozen: set once, as the constructor would have
+        return contacts
+
+
+Motion.contacts = _LazyContacts()  # type: ignore[assignment]  # after @dataclass, so it is no default
+
+
+def _lazy_motion(
+    twists: dict[str, np.ndarray],
+    source: _ContactSource,
+    power: PowerBalance,
+    audit: Audit,
+    continuum: bool = False,
+    extreme_twists: tuple[dict[str, np.ndarray], ...] = (),
+    unbounded: bool = False,
+) -> Motion:
+    """A Motion whose ``contacts`` are made from ``source`` when first read (equal to an eager one).
+
+    Solves that only need the twists, statuses and audits (batches, benchmarks,
+    simulation steps) then never pay for one object per contact; the source
+    (arrays) also pickles faster than the objects would.
+    """
+    motion = object.__new__(Motion)
+    motion.__dict__.update(
+        twists=twists,
+        power=power,
+        audit=audit,
+        continuum=continuum,
+        extreme_twists=extreme_twists,
+        unbounded=unbounded,
+        _contact_source=source,
+    )
+    return motion
 
 
 @dataclass(frozen=True)

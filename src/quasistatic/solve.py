@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
+import sys
 from collections.abc import Sequence
+from types import ModuleType
 
 from .audit import DEFAULT_TOLERANCE
 from .backends.base import BackendResult, Options
-from .backends.registry import BACKENDS, get_backend
+from .backends.registry import BACKENDS, Backend, Solver, get_backend
 from .errors import QuasistaticError
-from .evaluate import to_motion
+from .evaluate import derived, to_motion
 from .problem import Problem, assemble
 from .scene import Scene
 from .solution import Mode, Motion, Solution
@@ -59,17 +62,18 @@ def solve(
         Every motion in it has been audited on the original scene data.
     """
     problem = scene if isinstance(scene, Problem) else assemble(scene)
-    options = Options(max_solutions=max_solutions, modes=_check_modes(modes, problem), time_limit=time_limit)
-    names = _choose(method, problem, options.modes is not None, all_solutions)
+    checked = _check_modes(modes, problem)
+    options = _options(max_solutions, time_limit) if checked is None else Options(max_solutions, checked, time_limit)
+    names = _choose(method, problem, checked is not None, all_solutions)
     fallback: dict[str, str] = {}
     for name in names:
         backend = get_backend(name)
-        if backend.frictionless_only and not problem.is_frictionless:
+        if backend.frictionless_only and not _is_frictionless(problem):
             raise QuasistaticError(
                 f"method {name!r} is frictionless but contacts {_frictional(problem)} have mu > 0; "
                 "use method 'auto', or set 'friction: none' to drop friction on purpose"
             )
-        solution = _audited(problem, backend.load()(problem, options), name, tolerance)
+        solution = _audited(problem, _load(backend)(problem, options), name, tolerance)
         if fallback:
             solution = dataclasses.replace(solution, details={**solution.details, "fallback": fallback})
         if solution.ok or name == names[-1]:
@@ -87,11 +91,34 @@ def _choose(method: str, problem: Problem, modes_given: bool, all_solutions: boo
         if all_solutions and method in ("fast", "paper"):
             raise ValueError(f"all_solutions: method {method!r} finds one motion; use method 'auto' or 'scip'")
         return (method,)
-    if problem.is_frictionless and not modes_given:
+    if _is_frictionless(problem) and not modes_given:
         return ("lp",)
     if modes_given or all_solutions or "fast" not in BACKENDS:
         return ("scip",)
     return ("fast", "scip")
+
+
+@functools.lru_cache(maxsize=64)
+def _options(max_solutions: int, time_limit: float) -> Options:
+    """Options without prescribed modes (frozen, so one object serves every solve that uses them)."""
+    return Options(max_solutions=max_solutions, time_limit=time_limit)
+
+
+def _load(backend: Backend) -> Solver:
+    """``backend.load()``, whose import (and availability check) runs once per registry entry."""
+    module = _MODULES.get(backend)
+    if module is None:
+        # load() raises BackendUnavailableError with the install hint when the backend is missing.
+        module = _MODULES[backend] = sys.modules[getattr(backend.load(), "__module__", "")]
+    solver: Solver = getattr(module, backend.function)
+    return solver
+
+
+_MODULES: dict[Backend, ModuleType] = {}
+
+
+def _is_frictionless(problem: Problem) -> bool:
+    return derived(problem, "frictionless", lambda p: p.is_frictionless)
 
 
 def _frictional(problem: Problem) -> list[int]:

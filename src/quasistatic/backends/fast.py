@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..evaluate import MODE_TOLERANCE, RawMotion
+from ..evaluate import MODE_TOLERANCE, RawMotion, derived
 from ..jit import njit
 from ..problem import Problem
 from .base import BackendResult, Options
@@ -80,20 +80,15 @@ def solve_fast(problem: Problem, options: Options) -> BackendResult:
     """
     if options.modes is not None:
         return BackendResult("failed", "failed: the fast path (Lemke's method) cannot prescribe contact modes")
-    exact = problem.dimension == 3 and not problem.friction.is_polyhedral(3)
-    if problem.dimension == 2:
-        base = _PLANAR_EDGES
-    else:
-        count = EDGES if exact else problem.friction.edges
-        base = 2.0 * np.pi * np.arange(count) / count
+    data = derived(problem, "fast", _Inputs)
     status, stage, q, c, pivots, realignments = _solve(
-        problem.J,
-        problem.b,
-        problem.mu,
-        problem.g,
-        np.flatnonzero(problem.mu > 0.0),
-        base,
-        exact,
+        data.J,
+        data.b,
+        data.mu,
+        data.g,
+        data.frictional,
+        data.base,
+        data.exact,
         REALIGNMENTS,
         DISSIPATION_TOL,
         MODE_TOLERANCE,
@@ -104,9 +99,31 @@ def solve_fast(problem: Problem, options: Options) -> BackendResult:
     if status != SOLUTION:
         return _failed(int(status), int(stage), int(pivots))
     details = {"uniqueness": "not checked", "method": "lemke", "pivots": int(pivots), "realignments": int(realignments)}
-    if exact:
+    if data.exact:
         details["exact_cone"] = _EXACT_STAGES[int(stage)]
     return BackendResult("solved", _SOLVED, (RawMotion(q, c),), details=details)
+
+
+class _Inputs:
+    """The kernel's inputs derived from a problem (kept with it by :func:`derived`).
+
+    Attributes
+    ----------
+    J, b, mu, g : contiguous float copies of the problem's
+    frictional : (f,) indices of the contacts with mu > 0
+    base : (K,) edge signs (2-D) or unrotated edge angles (3-D)
+    exact : exact 3-D cones (edges re-aligned with the slips)
+    """
+
+    def __init__(self, problem: Problem) -> None:
+        self.exact = problem.dimension == 3 and not problem.friction.is_polyhedral(3)
+        if problem.dimension == 2:
+            self.base = _PLANAR_EDGES
+        else:
+            count = EDGES if self.exact else problem.friction.edges
+            self.base = 2.0 * np.pi * np.arange(count) / count
+        self.J, self.b, self.mu, self.g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.mu, problem.g))
+        self.frictional = np.flatnonzero(self.mu > 0.0)
 
 
 def _failed(status: int, stage: int, pivots: int) -> BackendResult:

@@ -43,7 +43,7 @@ BACKENDS: dict[str, Backend] = {
             "lp",
             ".lp",
             "solve_frictionless",
-            "frictionless LP (HiGHS), the paper's velocity/force formulation",
+            "frictionless LP, the paper's velocity/force formulation (Lemke's method on small problems, HiGHS otherwise)",
             frictionless_only=True,
         ),
         Backend(

@@ -423,11 +423,14 @@ def effective_cores(workers: int = 2, n: int = 3_000_000) -> float:
     ``n_jobs`` speed-up can go at the moment.
     """
     import joblib
+    from joblib.externals.loky import get_reusable_executor
 
     parallel = joblib.Parallel(n_jobs=workers, backend="loky")
     parallel(joblib.delayed(_busy_loop)(1000) for _ in range(workers))  # start the workers
     alone = min(parallel(joblib.delayed(_busy_loop)(n) for _ in range(1)))
     together = parallel(joblib.delayed(_busy_loop)(n) for _ in range(workers))
+    # Stop loky's workers and its threads: solve_many forks its workers only from a single-threaded process.
+    get_reusable_executor().shutdown(wait=True)
     return round(workers * alone / max(together), 2)
 
 
