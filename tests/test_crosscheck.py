@@ -20,33 +20,22 @@ The default run takes 100 2-D and 30 3-D scenes; ``pytest -m slow`` sweeps
 (normal forces as free variables) drops friction, which is why ``paper.py``
 adds the dual's equilibrium.
 
-Disagreements found (each an explicit strict xfail below, with its reason;
-all in 3-D, all traced to the certified path's exact-cone step in
-``backends/exact3d.py``, which searches an 8-edge pyramid and then refines
-each pyramid motion with its contact modes fixed). ``paper``'s motion passes
-the audit in every case (largest residual 1e-7), and the certified search of
-the same scene under ``pyramid:32`` finds a motion with the same contact
-modes and the same twist (to 1e-15 in A, where the slip runs along a pyramid
-edge, and to the pyramid's approximation, 7e-3 to 4e-2, in B and C):
+Disagreements found and fixed (all in 3-D, all in the certified path's
+exact-cone step, ``backends/exact3d.py``, which searches an 8-edge pyramid and
+then refines each pyramid motion to the exact cone); each seed below now
+passes and guards its fix:
 
-A. ``scip`` fails, refinement rejects a correct motion (seeds 3, 31, 75, 81,
-   130, 136, 139). The least-squares refinement converges (residual ~1e-15,
-   modes kept, twist = ``paper``'s), but two rolling table contacts form a
-   statically indeterminate pair and the least-squares picks tangential forces
-   with a large internal squeeze (e.g. +-5.9 against a cone radius of 0.3), so
-   the "inside the cone" check rejects the motion. Recovering the forces at
-   the converged twist from the convex set of admissible forces (as
-   ``paper.py``'s ``_forces_at`` does) would accept it.
-B. ``scip`` fails, the exact modes differ from the pyramid's (seeds 28, 70,
-   92, 99): a contact that slides under the 8-edge pyramid separates or rolls
-   under the circle, and the mode-fixed refinement cannot leave the pyramid's
-   modes (it stalls at residual ~1e-3).
-C. ``scip`` says ``jammed`` where the exact cone has a motion (seed 69): the
-   8-edge pyramid admits no motion, so ``diagnose`` calls the scene wedged,
-   but ``paper`` finds an all-sliding motion that passes the audit and
-   ``pyramid:16`` and ``pyramid:32`` find it too. The certified path's
-   ``jammed`` in 3-D with exact cones is proven for the pyramid only; this is
-   a wrong verdict, not just a missed refinement.
+A. Refinement rejected a correct motion (seeds 3, 31, 75, 81, 130, 136, 139):
+   two rolling table contacts form a statically indeterminate pair and the
+   least-squares forces carry a large internal squeeze outside the cones. The
+   forces are now recovered at the refined twist by an LP.
+B. The exact modes differ from the pyramid's (seeds 28, 70, 92, 99): a
+   contact that slides under the 8-edge pyramid separates or rolls under the
+   circle. Refinement now also tries the pyramid's modes with one or two
+   sliding contacts rolling or separating, then a 32-edge search.
+C. A wedged ``jammed`` proven for the pyramid only (seed 69): a wedge found
+   with 8 and 32 edges is now confirmed by the paper's exact program before
+   it is reported.
 
 Nothing disagrees in 2-D (600 scenes): there both methods solve the exact
 laws, and twists agree to ~1e-10.
@@ -67,14 +56,8 @@ from random_scenes import random_scene
 TWIST_RTOL = 1e-6  # scene-relative twist agreement required between methods
 _ROOT = Path(__file__).resolve().parents[1]
 
-# (dimension, seed): why the methods disagree there (see the module docstring).
-_REFINE_FORCES = "scip: exact3d refinement picks out-of-cone internal forces at a correct twist and rejects it (A)"
-_REFINE_MODES = "scip: exact motion's modes differ from the 8-edge pyramid's; mode-fixed refinement stalls (B)"
-KNOWN: dict[tuple[int, int], str] = {
-    **{(3, seed): _REFINE_FORCES for seed in (3, 31, 75, 81, 130, 136, 139)},
-    **{(3, seed): _REFINE_MODES for seed in (28, 70, 92, 99)},
-    (3, 69): "scip: 'jammed' proven for the 8-edge pyramid only; the exact cone has a motion (paper, pyramid:32) (C)",
-}
+# (dimension, seed): why the methods disagree there, as a strict xfail (none known now).
+KNOWN: dict[tuple[int, int], str] = {}
 
 
 def _cases(dimension: int, seeds: range, slow: bool = False) -> list[object]:

@@ -298,3 +298,75 @@ def test_one_motion_from_an_incomplete_search_is_not_solved() -> None:
     assert summarise(form, motions, complete, Options()).status == "solved"
     partial = summarise(form, motions, False, Options())
     assert partial.status == "failed" and "unique" in partial.message and len(partial.motions) == 1
+
+
+def wedge(mu_floor: float, mu_finger: float, dimension: int = 3) -> qs.Scene:
+    """A 1 kg box (0.1 m) on a floor, pushed low on its rear face by a finger moving forward and down
+    at (0.01, -0.01) m/s. The finger must slide down the face, so its friction mu_f N pushes the box
+    down; the floor's friction mu (m g + mu_f N) must not exceed N: the box slides iff mu mu_f < 1,
+    else friction wedges it (jammed). In 3-D the planar scene is extruded, contacts at z = +-0.05."""
+    from quasistatic.validation import extrude
+
+    data = {
+        "quasistatic": 1,
+        "dimension": 2,
+        "bodies": {"box": {"mass": 1.0, "com": [0.0, 0.05]}},
+        "movers": {"floor": {}, "finger": {"twist": [0.01, -0.01, 0.0]}},
+        "contacts": [
+            contact("box", "floor", [-0.05, 0.0], [0.0, 1.0], mu_floor),
+            contact("box", "floor", [0.05, 0.0], [0.0, 1.0], mu_floor),
+            contact("box", "finger", [-0.05, 0.02], [1.0, 0.0], mu_finger),
+        ],
+    }
+    return qs.load_scene(extrude(data, 0.1) if dimension == 3 else data)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_friction_wedge_is_jammed_and_proven_for_exact_cones(dimension: int) -> None:
+    """mu mu_f = 1.2 > 1: wedged. In 3-D the pyramid's jam proves nothing for the circle: the verdict
+    must come with the sector relaxation's certificate."""
+    sol = qs.solve(wedge(1.2, 1.0, dimension), method="scip")
+    assert sol.status == "jammed", sol.message
+    if dimension == 3:
+        assert "slip sectors" in sol.details["certificate"]
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_friction_below_the_wedge_slides(dimension: int) -> None:
+    """mu mu_f = 0.9 < 1: the box slides forward at the finger's 0.01 m/s, the finger slides down its
+    face, the pusher force N = mu m g / (1 - mu mu_f) = 88.29 N."""
+    sol = qs.solve(wedge(0.9, 1.0, dimension), method="scip")
+    assert sol.status == "solved", sol.message
+    assert sol.twists["box"][0] == approx(0.01, abs=1e-9)
+    finger = [c for c in sol.contacts if c.other == "finger"]
+    assert sum(c.normal_force for c in finger) == approx(0.9 * G / (1 - 0.9), rel=1e-6)
+    assert {c.mode for c in finger} == {"sliding"}
+
+
+def test_sector_relaxation_never_excludes_an_exact_motion() -> None:
+    """The wedge proof is sound only if every exact motion satisfies the relaxation: for scenes with
+    an audited exact motion, the relaxation (with that motion's modes prescribed) is never infeasible."""
+    from quasistatic.backends.base import Options
+    from quasistatic.backends.wedge import exact_cones_jam
+
+    for built in (wedge(0.9, 1.0), puck("exact")):
+        problem = qs.assemble(built)
+        sol = qs.solve(problem, method="scip")
+        assert sol.status == "solved"
+        for sectors in (8, 16):
+            assert not exact_cones_jam(problem, Options().start_clock(), sectors)
+            assert not exact_cones_jam(problem, Options().start_clock(), sectors, sol.modes)
+
+
+def test_exact_cone_mode_specified_solve() -> None:
+    """Prescribed modes with exact 3-D cones: the motion with those modes (even where the 8-edge
+    pyramid bends the slip off them), or a proven jammed."""
+    exact = puck("exact")
+    sliding = qs.solve(exact, modes=["sliding"] * 4 + ["rolling"])
+    assert sliding.status == "solved", sliding.message
+    d = np.array([math.cos(math.radians(30)), math.sin(math.radians(30)), 0.0])
+    check_motion(sliding, [*(0.01 * d), 0, 0, 0], ["sliding"] * 4 + ["rolling"])
+    for modes in ([None] * 4 + ["separating"], ["rolling"] * 4 + [None]):  # the finger pushes in; supports cannot hold
+        held = qs.solve(exact, modes=modes)
+        assert held.status == "jammed", (modes, held.message)
+        assert "slip sectors" in held.details["certificate"]

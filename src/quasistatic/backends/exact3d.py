@@ -4,19 +4,28 @@ An inscribed pyramid is exact for rolling contacts (its forces lie inside the
 cone) and for a sliding contact whose slip is exactly opposite one of its
 edges (the force then lies on the cone, opposite the slip). So: find every
 motion with an 8-edge pyramid by the certified search, then refine each one by
-solving the exact laws with its contact modes fixed (smooth equations, by a bounded
-trust-region least-squares solve from the pyramid motion).
+solving the exact laws with its contact modes fixed (smooth equations, by a
+bounded trust-region least-squares solve from the pyramid motion); where the
+least-squares forces of a statically indeterminate set leave the cones, the
+forces are recovered at the refined twist by an LP. Where 8 edges leave the
+answer undecided (a motion that does not refine, a wedge, no motion with
+prescribed modes, equilibrium too close to call), the search runs again with
+32 edges.
 
 What is proven: ``unstable`` (no equilibrium even in a pyramid circumscribing
-the exact cone) and kinematic ``jammed`` (a Farkas certificate). The list of
-motions is complete for the pyramid; each reported motion satisfies the exact
-laws (the audit checks it), but motions of the exact cone that the pyramid
-misses are not excluded by proof, and the details say so.
+the exact cone), kinematic ``jammed`` (a Farkas certificate) and wedged
+``jammed`` (the pyramids jam and the paper's exact program, solved globally,
+confirms it). The list of motions is complete for the pyramid; each reported
+motion satisfies the exact laws (the audit checks it), but motions of the
+exact cone that the pyramid misses are not excluded by proof, and the details
+say so.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import itertools
+from collections.abc import Iterator
 
 import numpy as np
 import scipy.optimize
@@ -24,68 +33,164 @@ import scipy.optimize
 from ..evaluate import MODE_TOLERANCE, RawMotion
 from ..problem import Problem
 from .base import BackendResult, Options, contact_modes
-from .diagnose import UNSTABLE, diagnose, equilibrium_exists
+from .diagnose import JAMMED_WEDGED, UNSTABLE, diagnose, equilibrium_exists
+from .highs import solve_lp
 from .polyhedral import aligned_edges, polyhedral_form
 from .scip import enumerate_motions, summarise
+from .wedge import exact_cones_jam
 
 __all__ = ["solve_exact_3d"]
 
 EDGES = 8
-FINER_EDGES = (32, 256)  # polygons tried when 8 edges cannot decide between unstable and at rest
+WEDGE_SECTORS = (8, 16)  # sector relaxations tried to prove a wedge (finer is tighter and slower)
+VERDICT_EDGES = 256  # polygons tried when the searched ones cannot decide between unstable and at rest
 SEARCH_EDGES = 32  # the most edges the mixed-integer search is run with (its size grows with them)
 RANGE_EDGES = 64  # polygon used for force ranges at rolling contacts (inner, within 0.12 %)
 DISSIPATION_TOL = 1e-8  # scene-relative force misalignment accepted as exact
 
 
 def solve_exact_3d(problem: Problem, options: Options) -> BackendResult:
-    """Certified pyramid search, then exact-cone refinement of every motion found."""
-    result = _search(problem, options, EDGES)
-    for count in FINER_EDGES:
+    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided."""
+    options = options.start_clock()
+    undecided, relaxed = "", False
+    for count in (EDGES, SEARCH_EDGES):
+        result, undecided = _search(problem, options, count)
         if result is not None:
             return result
-        result = _finer(problem, options, count)
-    return result or BackendResult(
-        "failed",
-        f"failed: no motion was found, and whether the exact cones admit an equilibrium is too close to call "
-        f"(undecided with {FINER_EDGES[-1]}-edge polygons inside and outside the circle, searched with {SEARCH_EDGES})",
-    )
+        if undecided in ("wedged", "modes") and not relaxed:  # the pyramid has no motion: try to prove it for the circle
+            relaxed = True
+            if proof := _wedge_proof(problem, options):
+                return _no_motion(problem, options, proof)
+    if undecided == "wedged":
+        return _confirm_wedged(problem, options)
+    if undecided == "modes":
+        return _free_motions_with_modes(problem, options)
+    if undecided == "equilibrium":
+        return _equilibrium_verdict(problem, VERDICT_EDGES)
+    return BackendResult("failed", f"failed: a motion of the {SEARCH_EDGES}-edge pyramid model did not converge to one of the exact cone")
 
 
-def _search(problem: Problem, options: Options, count: int) -> BackendResult | None:
-    """Motions of a ``count``-edge pyramid refined to the exact cone; None when undecided."""
+def _no_motion(problem: Problem, options: Options, proof: str) -> BackendResult:
+    """The certified ``jammed`` once the exact cones are proven to have no motion (with the prescribed modes, if any)."""
+    if options.modes is None:
+        return BackendResult("jammed", JAMMED_WEDGED, details={"certificate": proof})
+    message = "jammed: no motion exists with the prescribed contact modes"
+    return BackendResult("jammed", message, details={"modes": list(options.modes), "certificate": proof})
+
+
+def _wedge_proof(problem: Problem, options: Options) -> str:
+    """A certificate that the exact cones admit no motion (a sector relaxation of the exact laws is infeasible), or ''."""
+    for sectors in WEDGE_SECTORS:
+        if exact_cones_jam(problem, options, sectors, options.modes):
+            return f"no solution of the exact laws relaxed to {sectors} slip sectors per contact (SCIP, complete search)"
+    return ""
+
+
+def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResult | None, str]:
+    """Motions of a ``count``-edge pyramid refined to the exact cone, or None and why the pyramid cannot decide.
+
+    Undecided: ``refinement`` (a pyramid motion has no exact motion next to
+    it), ``wedged`` (the pyramid jams but the wider exact cone may not),
+    ``modes`` (no pyramid motion with the prescribed modes) or ``equilibrium``
+    (equilibrium exists in the circumscribed pyramid but not the inscribed one).
+    """
     edges = aligned_edges(problem, count)
     motions, complete = enumerate_motions(polyhedral_form(problem, edges), options)
-    if not motions:
-        if not complete:
-            return BackendResult("failed", "failed: the certified search hit its time limit before finding a motion")
-        verdict = diagnose(problem, edges, edges / np.cos(np.pi / count))
-        return None if verdict.status == "failed" else verdict
-    return _refined_result(problem, motions, complete, options, count)
+    if motions:
+        result = _refined_result(problem, motions, complete, options, count)
+        return result, "" if result is not None else "refinement"
+    if not complete:
+        return BackendResult("failed", "failed: the certified search hit its time limit before finding a motion"), ""
+    if options.modes is not None:
+        return None, "modes"
+    verdict = diagnose(problem, edges, edges / np.cos(np.pi / count))
+    if verdict.status == "failed":
+        return None, "equilibrium"
+    if verdict.status == "jammed" and verdict.message == JAMMED_WEDGED:
+        return None, "wedged"
+    return verdict, ""
 
 
-def _finer(problem: Problem, options: Options, count: int) -> BackendResult | None:
-    """Decide with ``count``-edge polygons: no equilibrium outside proves unstable; one inside calls for a finer search."""
+def _equilibrium_verdict(problem: Problem, count: int) -> BackendResult:
+    """No motion found: ``unstable`` if ``count``-edge polygons around the circles admit no equilibrium."""
     edges = aligned_edges(problem, count)
     if not equilibrium_exists(problem, edges / np.cos(np.pi / count)):
         certificate = f"no equilibrium in {count}-edge pyramids around the exact cones"
         return BackendResult("unstable", UNSTABLE, details={"certificate": certificate})
-    if equilibrium_exists(problem, edges) and count <= SEARCH_EDGES:
-        return _search(problem, options, count)
-    return None
+    return BackendResult(
+        "failed",
+        f"failed: no motion was found, and whether the exact cones admit an equilibrium is too close to call "
+        f"(undecided with {count}-edge polygons inside and outside the circle, searched with {SEARCH_EDGES})",
+    )
 
 
-def _refined_result(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, count: int) -> BackendResult:
+def _confirm_wedged(problem: Problem, options: Options) -> BackendResult:
+    """The pyramids jam and the sector relaxation cannot tell: the paper's exact program decides, on the same clock.
+
+    Its wedged ``jammed`` is proven for the exact cones (no motion within
+    1000 times the scene's scales); a motion it finds is audited and
+    attached, but the list is not known to be complete, so that is ``failed``.
+    """
+    from .paper import solve_paper
+
+    exact = solve_paper(problem, options)
+    if exact.status == "jammed":
+        proof = f"no motion in {EDGES}- and {SEARCH_EDGES}-edge pyramids; the paper's exact program proves none (within its bounds)"
+        return BackendResult("jammed", JAMMED_WEDGED, details={"certificate": proof})
+    if exact.status == "solved":
+        message = (
+            f"failed: the {SEARCH_EDGES}-edge pyramid jams, but the exact cones admit a motion (the paper's program found it; "
+            "attached, audited); whether it is the only one is not known"
+        )
+        return BackendResult("failed", message, exact.motions, details={"paper": exact.message})
+    return BackendResult(
+        "failed",
+        f"failed: {EDGES}- and {SEARCH_EDGES}-edge pyramids jam, but that is not proven for the exact cones "
+        f"(sector relaxations inconclusive; the paper's program: {exact.message}); "
+        "friction 'pyramid:K' gives a certified answer for the pyramid, or raise time_limit",
+    )
+
+
+def _refined_result(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, count: int) -> BackendResult | None:
+    """Every pyramid motion refined to the exact cone (None if one cannot be), summarised."""
     refined = [_refine(problem, motion) for motion in motions]
     if any(r is None for r in refined):
-        return BackendResult("failed", "failed: a motion of the pyramid model did not converge to one of the exact cone")
+        return None
     unique: list[RawMotion] = []
     for motion in refined:
-        if motion is not None and not any(_same_exact(problem, motion, other) for other in unique):
+        if motion is not None and _keeps_prescribed(problem, motion, options) and not any(_same_exact(problem, motion, o) for o in unique):
             unique.append(motion)
-    range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, _slips(problem, unique[0].q)))
-    result = summarise(range_form, unique, complete, options)
-    details = {**result.details, "exact_cone": f"motions refined from a {count}-edge pyramid; completeness proven for the pyramid"}
-    return dataclasses.replace(result, details=details)
+    if not unique:
+        return None
+    return _summary(problem, unique, complete, options, f"motions refined from a {count}-edge pyramid; completeness proven for the pyramid")
+
+
+def _summary(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, note: str) -> BackendResult:
+    range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, _slips(problem, motions[0].q)))
+    result = summarise(range_form, motions, complete, options)
+    return dataclasses.replace(result, details={**result.details, "exact_cone": note})
+
+
+def _free_motions_with_modes(problem: Problem, options: Options) -> BackendResult:
+    """No pyramid motion has the prescribed modes, yet an exact one may (a pyramid bends slips towards its edges):
+    the motions of the free solve that have them, else ``failed``."""
+    free = solve_exact_3d(problem, dataclasses.replace(options, modes=None))
+    matching = [motion for motion in free.motions if _keeps_prescribed(problem, motion, options)]
+    if matching and free.status in ("solved", "ambiguous"):
+        note = "the motions with the prescribed modes among every motion of the free search (its exact refinement)"
+        return _summary(problem, matching, free.details.get("search") == "complete", options, note)
+    return BackendResult(
+        "failed",
+        f"failed: no motion with the prescribed contact modes exists for {EDGES}- and {SEARCH_EDGES}-edge pyramids inscribed "
+        "in the exact cones, but with exact cones that is not proven; use friction 'pyramid:K' for a certified answer",
+    )
+
+
+def _keeps_prescribed(problem: Problem, motion: RawMotion, options: Options) -> bool:
+    """A refined motion still has the prescribed modes (refinement may bring a sliding contact to rest)."""
+    if options.modes is None:
+        return True
+    return all(want is None or want == got for want, got in zip(options.modes, contact_modes(problem, motion.q), strict=True))
 
 
 def _same_exact(problem: Problem, a: RawMotion, b: RawMotion) -> bool:
@@ -101,12 +206,44 @@ def _slips(problem: Problem, q: np.ndarray) -> np.ndarray:
 
 
 def _refine(problem: Problem, motion: RawMotion) -> RawMotion | None:
-    """Bounded Gauss-Newton (trust region, normal forces >= 0) on the exact laws with the pyramid motion's contact modes.
+    """The exact motion next to a pyramid motion: with the pyramid's modes, else with one or two of them changed.
+
+    A pyramid's sliding contact may separate or roll under the circle (its
+    slip runs between two edges, where the pyramid's friction is weaker), so
+    those changes are tried, nearest first, before giving up.
+    """
+    if not motion.continuum and _max_dissipation_error(problem, motion) <= DISSIPATION_TOL:
+        return motion
+    modes = np.array(contact_modes(problem, motion.q), dtype=object)
+    for attempt, changed in enumerate(_mode_changes(modes)):
+        # Newton converges in a few dozen steps from a nearby start; a changed pattern that has not by then is wrong.
+        refined = _refine_with_modes(problem, motion, changed, evaluations=200 if attempt == 0 else 20)
+        if refined is not None:
+            return refined
+    return None
+
+
+def _mode_changes(modes: np.ndarray) -> Iterator[np.ndarray]:
+    """``modes`` itself, then each sliding contact rolling or separating, then each pair of such changes."""
+    yield modes
+    singles = [(i, new) for i in np.flatnonzero(modes == "sliding") for new in ("rolling", "separating")]
+    for size in (1, 2):
+        for combination in itertools.combinations(singles, size):
+            if len({i for i, _ in combination}) == size:
+                changed = modes.copy()
+                for i, new in combination:
+                    changed[i] = new
+                yield changed
+
+
+def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, evaluations: int) -> RawMotion | None:
+    """Bounded Gauss-Newton (trust region, normal forces >= 0) on the exact laws with the given contact modes.
 
     With the modes fixed, the exact laws are smooth equations: equilibrium,
     closed contacts do not open, rolling ones do not slip, and a sliding one's
     friction is ``-mu cn slip/|slip|``. Returns None when they have no
-    solution near the pyramid motion that keeps every mode and inequality.
+    solution near the pyramid motion that keeps every mode and inequality
+    (within ``evaluations`` residual evaluations per unknown).
 
     A pyramid continuum is refined from its interior point: the pyramid lets a
     slip turn within a face's fan at no change of force, the circle does not,
@@ -114,9 +251,6 @@ def _refine(problem: Problem, motion: RawMotion) -> RawMotion | None:
     pyramid's extremes) only where the exact equations leave a twist direction
     free at the solution (a null vector of their Jacobian with a twist part).
     """
-    if not motion.continuum and _max_dissipation_error(problem, motion) <= DISSIPATION_TOL:
-        return motion
-    modes = np.array(contact_modes(problem, motion.q))
     # A frictionless contact carries only a normal force and may slip freely: no slip equation for it.
     frictional = problem.mu > 0
     closed, rolling, sliding = modes != "separating", (modes == "rolling") & frictional, (modes == "sliding") & frictional
@@ -142,23 +276,65 @@ def _refine(problem: Problem, motion: RawMotion) -> RawMotion | None:
     lower = np.r_[np.full(n, -np.inf), np.zeros(n_closed), np.full(2 * n_rolling, -np.inf)]
     x0[n : n + n_closed] = np.maximum(x0[n : n + n_closed], 0.0)
     fit = scipy.optimize.least_squares(
-        residual, x0, bounds=(lower, np.inf), method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200 * x0.size
+        residual, x0, bounds=(lower, np.inf), method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=evaluations * x0.size
     )
     q, u, c = unpack(fit.x)
-    refined = RawMotion(q, c)
     # A sliding contact may come to rest (its force then sits on the cone): still a solution.
     new_modes = np.array(contact_modes(problem, q))
     same = np.where(frictional, new_modes == modes, (new_modes == "separating") == (modes == "separating"))
     keeps_modes = bool(np.all(same | (sliding & (new_modes == "rolling"))))
-    inside = np.all(c[:, 2] >= -1e-12) and np.all(
-        np.linalg.norm(c[rolling, :2], axis=1) <= problem.mu[rolling] * c[rolling, 2] + 1e-12
-    )
     converged = float(np.max(np.abs(residual(fit.x)), initial=0.0)) <= 1e-10
-    if not (converged and keeps_modes and inside):
+    if not (converged and keeps_modes):
         return None
+    if not _inside_cones(problem, c, rolling):
+        # The twist is right but the least-squares forces of a statically indeterminate
+        # set may carry a squeeze outside the cones: pick admissible ones at this twist.
+        c = _forces_at(problem, q, closed, rolling, sliding)
+        if c is None:
+            return None
+    refined = RawMotion(q, c)
     if motion.continuum and _twist_is_free(fit.jac, n):
         return RawMotion(q, c, motion.extremes, motion.unbounded)
     return refined
+
+
+def _inside_cones(problem: Problem, c: np.ndarray, rolling: np.ndarray) -> bool:
+    return bool(np.all(c[:, 2] >= -1e-12) and np.all(np.linalg.norm(c[rolling, :2], axis=1) <= problem.mu[rolling] * c[rolling, 2] + 1e-12))
+
+
+def _forces_at(problem: Problem, q: np.ndarray, closed: np.ndarray, rolling: np.ndarray, sliding: np.ndarray) -> np.ndarray | None:
+    """Least total normal force (m, 3) that balances the load at twist ``q`` with the given modes; None if none does.
+
+    Linear in the unknowns: a sliding contact's friction is ``-mu cn slip/|slip|``
+    (the slip is known), a rolling one's lies in a ``RANGE_EDGES``-gon inscribed
+    in its cone (so inside the exact cone), an open contact carries nothing.
+    """
+    m, n = problem.n_contacts, problem.n_dof
+    edges = aligned_edges(problem, RANGE_EDGES)
+    slip = _slips(problem, q)
+    direction = np.zeros((m, 2))
+    speed = np.linalg.norm(slip[sliding], axis=1, keepdims=True)
+    direction[sliding] = -problem.mu[sliding, None] * slip[sliding] / np.maximum(speed, 1e-300)
+    rows = np.flatnonzero(rolling)
+    # Columns: cn (m), then beta (len(rows) x K) for the rolling contacts.
+    K = RANGE_EDGES
+    normal_push = problem.Jn.T + np.einsum("mt,mtn->nm", direction, problem.Jt)
+    edge_push = np.einsum("rkt,rtn->nrk", edges[rows], problem.Jt[rows]).reshape(n, len(rows) * K)
+    bound = np.hstack([np.diag(problem.mu)[rows], -np.repeat(np.eye(len(rows)), K, axis=1)])  # mu cn - sum beta >= 0
+    A = np.vstack([np.hstack([normal_push, edge_push]), bound])
+    lower = np.r_[-problem.g, np.zeros(len(rows))]
+    upper = np.r_[-problem.g, np.full(len(rows), np.inf)]
+    col_upper = np.r_[np.where(closed, np.inf, 0.0), np.full(len(rows) * K, np.inf)]
+    cost = np.r_[np.ones(m), np.zeros(len(rows) * K)]
+    lp = solve_lp(cost, A, lower, upper, np.zeros(cost.size), col_upper)
+    if lp.status != "optimal":
+        return None
+    cn, beta = lp.x[:m], lp.x[m:].reshape(len(rows), K)
+    c = np.zeros((m, 3))
+    c[:, 2] = cn
+    c[:, :2] = direction * cn[:, None]
+    c[rows, :2] = np.einsum("rk,rkt->rt", beta, edges[rows])
+    return c
 
 
 def _twist_is_free(jacobian: np.ndarray, n_twist: int) -> bool:
