@@ -42,7 +42,6 @@ from .wedge import exact_cones_jam
 __all__ = ["solve_exact_3d"]
 
 EDGES = 8
-WEDGE_SECTORS = (8, 16)  # sector relaxations tried to prove a wedge (finer is tighter and slower)
 VERDICT_EDGES = 256  # polygons tried when the searched ones cannot decide between unstable and at rest
 SEARCH_EDGES = 32  # the most edges the mixed-integer search is run with (its size grows with them)
 RANGE_EDGES = 64  # polygon used for force ranges at rolling contacts (inner, within 0.12 %)
@@ -80,10 +79,21 @@ def _no_motion(problem: Problem, options: Options, proof: str) -> BackendResult:
 
 def _wedge_proof(problem: Problem, options: Options) -> str:
     """A certificate that the exact cones admit no motion (a sector relaxation of the exact laws is infeasible), or ''."""
-    for sectors in WEDGE_SECTORS:
-        if exact_cones_jam(problem, options, sectors, options.modes):
-            return f"no solution of the exact laws relaxed to {sectors} slip sectors per contact (SCIP, complete search)"
-    return ""
+    proven, sectors = exact_cones_jam(problem, options, options.modes, lambda q: _is_exact_motion(problem, q))
+    if not proven:
+        return ""
+    return f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; SCIP, complete search)"
+
+
+def _is_exact_motion(problem: Problem, q: np.ndarray) -> bool:
+    """Whether forces satisfying the exact laws exist at twist ``q`` (with the modes it gives each contact)."""
+    u = np.einsum("mdn,n->md", problem.J, q) - problem.b
+    if np.min(u[:, -1], initial=0.0) < -MODE_TOLERANCE:
+        return False
+    modes = np.array(contact_modes(problem, q), dtype=object)
+    frictional = problem.mu > 0
+    closed, rolling, sliding = modes != "separating", (modes == "rolling") & frictional, (modes == "sliding") & frictional
+    return _forces_at(problem, q, closed, rolling, sliding) is not None
 
 
 def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResult | None, str]:

@@ -12,7 +12,7 @@ import scipy.sparse as sp
 
 from ..errors import SolverError
 
-__all__ = ["LPResult", "solve_lp", "optimise_each", "INF"]
+__all__ = ["LPResult", "solve_lp", "optimise_each", "WarmLP", "INF"]
 
 INF = float("inf")
 LPStatus = Literal["optimal", "infeasible", "unbounded", "unbounded_or_infeasible", "error"]
@@ -75,22 +75,37 @@ def optimise_each(
     col_lower: np.ndarray | None = None,
     col_upper: np.ndarray | None = None,
 ) -> list[LPResult]:
-    """Solve one feasible set for each ``(cost, maximize)`` in turn, as :func:`solve_lp` would.
-
-    The model is passed to HiGHS once; each later objective starts from the
-    previous optimal basis (a range needs two LPs per unknown: warm starts make
-    the second and later ones a few pivots each).
-    """
+    """Solve one feasible set for each ``(cost, maximize)`` in turn, as :func:`solve_lp` would (see :class:`WarmLP`)."""
     if not objectives:
         return []
-    cost, maximize = objectives[0]
-    solver = _load(cost, A, row_lower, row_upper, col_lower, col_upper, maximize)
-    results = [_run(solver, cost, maximize)]
-    columns = np.arange(cost.size, dtype=np.int32)
-    for cost, maximize in objectives[1:]:
-        solver.changeColsCost(cost.size, columns, -cost if maximize else cost)  # always minimised, as in _load
-        results.append(_run(solver, cost, maximize))
-    return results
+    model = WarmLP(A, row_lower, row_upper, col_lower, col_upper)
+    return [model.optimise(cost, maximize) for cost, maximize in objectives]
+
+
+class WarmLP:
+    """One feasible set passed to HiGHS once, optimised for one objective after another.
+
+    Each objective starts from the previous optimal basis (a range needs two
+    LPs per unknown: warm starts make the second and later ones a few pivots
+    each). Uses the thread's HiGHS instance: finish with one before solving
+    any other LP on the same thread.
+    """
+
+    def __init__(
+        self,
+        A: np.ndarray | sp.spmatrix,
+        row_lower: np.ndarray,
+        row_upper: np.ndarray,
+        col_lower: np.ndarray | None = None,
+        col_upper: np.ndarray | None = None,
+    ) -> None:
+        self.n = A.shape[1]
+        self._solver = _load(np.zeros(self.n), A, row_lower, row_upper, col_lower, col_upper, False)
+        self._columns = np.arange(self.n, dtype=np.int32)
+
+    def optimise(self, cost: np.ndarray, maximize: bool = False) -> LPResult:
+        self._solver.changeColsCost(self.n, self._columns, -cost if maximize else cost)  # always minimised, as in _load
+        return _run(self._solver, cost, maximize)
 
 
 def _load(

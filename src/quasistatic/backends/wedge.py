@@ -1,30 +1,34 @@
-"""A proof that exact 3-D friction cones wedge: infeasibility of a sector relaxation of the exact laws.
+"""A proof that exact 3-D friction cones admit no motion: infeasibility of a sector relaxation of the exact laws.
 
 A pyramid that jams proves nothing about the circle: its maximum-dissipation
 force for a slip between two edges is not opposite the slip. This module
-checks a relaxation that every exact solution satisfies. Split the tangent
-plane into ``SECTORS`` equal sectors. An exact solution's contact either
-rolls (no slip, force inside the cone) or its slip ``u`` lies in some sector
-and then its friction force ``-p = -mu cn u/|u|`` lies on the cone's circle
-opposite it: ``p`` inside the sector too, with ``mu cn cos(pi/SECTORS) <=
-p.mid <= mu cn`` (``mid`` the sector's bisector). A separating contact
-carries no force, which every sector allows. Non-penetration, equilibrium and
-``cn _|_ un`` are kept exactly.
+checks a relaxation that every exact solution satisfies. Split each
+contact's tangent plane into sectors (each narrower than a half-turn). An
+exact solution's contact either rolls (no slip, force inside the cone) or
+its slip ``u`` lies in some sector, and then its friction force ``-p = -mu cn
+u/|u|`` lies on the cone's circle opposite it: ``p`` inside the same sector,
+beyond the chord of the sector's arc (``p.mid >= mu cn cos(width/2)``) and
+inside the circle's tangents at the arc's ends and middle. A separating
+contact carries no force, which every sector allows. Non-penetration,
+equilibrium and ``cn _|_ un`` are kept exactly.
 
-Each of these pieces is a polyhedral cone in ``(u, p, cn)``, so "one of them"
-is written as their convex hull (the contact's ``(u, p, cn)`` is a sum of one
+Each piece is a polyhedral cone in ``(u, p, cn)``, so "one of them" is
+written as their convex hull (the contact's ``(u, p, cn)`` is a sum of one
 part per cone) with an SOS1 constraint: at most one part is nonzero. The LP
-relaxation is then the hull itself (tight), and no bound on a twist or a
-force is assumed (no big-M).
+relaxation is then the hull itself, and no bound on a twist or a force is
+assumed (no big-M).
 
 If SCIP proves the relaxation infeasible, the exact laws have no solution
-for the commanded motion with any finite forces: a certified wedge. If it
-finds a point, nothing is decided (the relaxation is wider than the laws).
+(with the prescribed modes, if any) for the commanded motion, with any finite
+forces: a certificate. If it finds a point, the sectors its sliding contacts
+use are halved and it tries again (the relaxation tightens only where a
+point escaped), until a sector would be narrower than ``FINEST`` or the time
+runs out: then nothing is decided.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -34,29 +38,65 @@ from ..problem import Problem
 from ..solution import Mode
 from .base import Options
 
-__all__ = ["exact_cones_jam", "SECTORS"]
+__all__ = ["exact_cones_jam", "SECTORS", "FINEST"]
 
-SECTORS = 16  # default number of slip sectors per contact
+SECTORS = 8  # initial slip sectors per contact
+FINEST = 2.0 * np.pi / 256  # narrowest sector [rad] the refinement makes
+_ROLLING_POLYGON = 16  # tangents of the circle bounding a rolling contact's force
+_ACTIVE = 1e-9  # scene-relative size above which a part of the hull is the one in use
 
 
-def exact_cones_jam(problem: Problem, options: Options, sectors: int = SECTORS, modes: Sequence[Mode | None] | None = None) -> bool:
-    """True when the sector relaxation is proven infeasible (within the time left), so the exact cones jam.
+def exact_cones_jam(
+    problem: Problem,
+    options: Options,
+    modes: Sequence[Mode | None] | None = None,
+    is_motion: Callable[[np.ndarray], bool] | None = None,
+) -> tuple[bool, int]:
+    """Whether the sector relaxation was proven infeasible (the exact cones admit no motion), and the most sectors used.
 
-    With ``modes`` (prescribed per contact, None free) the relaxation keeps them:
-    True then proves that no exact motion has those modes.
+    With ``modes`` (prescribed per contact, None free) the relaxation keeps
+    them: True then proves that no exact motion has those modes. ``is_motion``
+    (optional) says whether a relaxed point's twist is an exact motion: then
+    the refinement stops early, since nothing is left to prove.
     """
+    sectors = [2.0 * np.pi * np.arange(SECTORS + 1) / SECTORS for _ in range(problem.n_contacts)]
+    while options.remaining() > 0.0:
+        status, active, q = _relaxation(problem, options, sectors, modes)
+        if status == "infeasible":
+            return True, max(len(s) - 1 for s in sectors)
+        if status != "feasible" or (is_motion is not None and is_motion(q)) or not _split(sectors, active):
+            break  # out of time, or the point already satisfies the exact laws' friction: a motion is likely
+    return False, max(len(s) - 1 for s in sectors)
+
+
+def _split(sectors: list[np.ndarray], active: list[int]) -> bool:
+    """Halve each sector where the relaxed point's friction is not exact; False when there is none to halve."""
+    changed = False
+    for i, k in enumerate(active):
+        if k < 0:
+            continue
+        lo, hi = sectors[i][k], sectors[i][k + 1]
+        if hi - lo > 2.0 * FINEST:
+            sectors[i] = np.insert(sectors[i], k + 1, 0.5 * (lo + hi))
+            changed = True
+    return changed
+
+
+def _relaxation(
+    problem: Problem, options: Options, sectors: list[np.ndarray], modes: Sequence[Mode | None] | None
+) -> tuple[str, list[int], np.ndarray]:
+    """Solve the relaxation: its status, per contact the sector its point slides in (-1: none or exact), its twist."""
     import pyscipopt
 
-    if options.remaining() <= 0.0:
-        return False
     scip = pyscipopt.Model()
     scip.hideOutput()
     scip.setParam("display/verblevel", 0)
     scip.setParam("numerics/feastol", 1e-7)
-    scip.setParam("limits/time", options.remaining())
+    scip.setParam("limits/time", max(options.remaining(), 1e-3))
     n = problem.n_dof
     q = [scip.addVar(lb=None, ub=None, name=f"q{j}") for j in range(n)]
-    push: list[object] = [float(problem.g[j]) for j in range(n)]  # sum_i J_i^T c_i + g
+    push: list[Any] = [float(problem.g[j]) for j in range(n)]  # sum_i J_i^T c_i + g
+    parts = []  # per contact, per sector: (size, [cn], u, p) variables
     for i in range(problem.n_contacts):
         cn = scip.addVar(lb=0.0, ub=None, name=f"cn{i}")
         mode = None if modes is None else modes[i]
@@ -65,63 +105,87 @@ def exact_cones_jam(problem: Problem, options: Options, sectors: int = SECTORS, 
         scip.addCons(_dot(problem.Jn[i], q) - opening == float(problem.bn[i]))
         scip.addConsSOS1([cn, opening])
         slip = [_dot(problem.Jt[i, t], q) - float(problem.bt[i, t]) for t in range(2)]
-        p = _friction(scip, float(problem.mu[i]), cn, slip, str(i), sectors, mode)
+        p, contact_parts = _friction(scip, float(problem.mu[i]), cn, slip, str(i), sectors[i], mode)
+        parts.append(contact_parts)
         for j in range(n):
             push[j] = push[j] + float(problem.Jn[i, j]) * cn - float(problem.Jt[i, 0, j]) * p[0] - float(problem.Jt[i, 1, j]) * p[1]
     for j in range(n):
         scip.addCons(push[j] == 0.0)
     scip.optimize()
-    return bool(scip.getStatus() == "infeasible")
+    status = scip.getStatus()
+    if status == "infeasible":
+        return "infeasible", [], np.zeros(n)
+    if scip.getNSols() == 0:
+        return "unknown", [], np.zeros(n)
+    best = scip.getBestSol()
+    active = []
+    for mu, contact_parts in zip(problem.mu, parts, strict=True):
+        values = np.array([scip.getSolVal(best, part[0]) for part in contact_parts])
+        k = int(np.argmax(values)) if values.size and values.max() > _ACTIVE else -1
+        if k >= 0:
+            cn, u, p = (np.array([scip.getSolVal(best, v) for v in group]) for group in contact_parts[k][1:])
+            if _exact_friction(float(mu), float(cn[0]), u, p):
+                k = -1
+        active.append(k)
+    return "feasible", active, np.array([scip.getSolVal(best, v) for v in q])
 
 
-def _friction(scip: Any, mu: float, cn: Any, slip: list[Any], name: str, sectors: int, mode: Mode | None) -> list[Any]:
-    """``p = -c_t`` of contact ``name``: rolling, or sliding in one of ``sectors`` sectors (hull of the cones with SOS1)."""
+def _exact_friction(mu: float, cn: float, u: np.ndarray, p: np.ndarray) -> bool:
+    """The relaxed point's friction is already the exact law's: ``p`` along the slip, on the circle (to 1e-6)."""
+    speed, force = float(np.linalg.norm(u)), float(np.linalg.norm(p))
+    if speed <= _ACTIVE:
+        return force <= mu * cn * (1.0 + 1e-6)
+    return bool(np.linalg.norm(p - mu * cn * u / speed) <= 1e-6 * max(mu * cn, _ACTIVE))
+
+
+def _friction(
+    scip: Any, mu: float, cn: Any, slip: list[Any], name: str, bounds: np.ndarray, mode: Mode | None
+) -> tuple[list[Any], list[tuple[Any, ...]]]:
+    """``p = -c_t`` of contact ``name``: rolling, or sliding in one sector (hull of the cones with SOS1); and the sliding parts."""
     import pyscipopt
 
     if mode == "rolling":
         for t in range(2):
             scip.addCons(slip[t] == 0.0)
     if mu <= 0.0:
-        return [0.0, 0.0]
-    bounds = 2.0 * np.pi * np.arange(sectors + 1) / sectors
-    mids = bounds[:-1] + np.pi / sectors
-    # The rolling part: no slip, p in the sectors-gon around the circle.
-    cn_parts = [scip.addVar(lb=0.0, ub=0.0 if mode == "sliding" else None, name=f"cn_roll{name}")]
-    p_parts = [[scip.addVar(lb=None, ub=None, name=f"p_roll{name}_{t}") for t in range(2)]]
-    u_parts: list[list[Any]] = []
-    for mid in mids:
-        scip.addCons(np.cos(mid) * p_parts[0][0] + np.sin(mid) * p_parts[0][1] <= mu * cn_parts[0])
-    sizes = [cn_parts[0]]
-    for k in range(sectors if mode != "rolling" else 0):
-        lo, hi, mid = bounds[k], bounds[k + 1], mids[k]
+        return [0.0, 0.0], []
+    # The rolling part: no slip, p inside the circle's tangents.
+    cn_roll = scip.addVar(lb=0.0, ub=0.0 if mode == "sliding" else None, name=f"cn_roll{name}")
+    p_roll = [scip.addVar(lb=None, ub=None, name=f"p_roll{name}_{t}") for t in range(2)]
+    for angle in 2.0 * np.pi * np.arange(_ROLLING_POLYGON) / _ROLLING_POLYGON:
+        scip.addCons(np.cos(angle) * p_roll[0] + np.sin(angle) * p_roll[1] <= mu * cn_roll)
+    cn_parts, p_parts, u_parts, sizes, parts = [cn_roll], [p_roll], [], [], []
+    for k in range(len(bounds) - 1 if mode != "rolling" else 0):
+        lo, hi = bounds[k], bounds[k + 1]
+        mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
         cn_k = scip.addVar(lb=0.0, ub=None, name=f"cn{name}_{k}")
         u_k = [scip.addVar(lb=None, ub=None, name=f"u{name}_{k}_{t}") for t in range(2)]
         p_k = [scip.addVar(lb=None, ub=None, name=f"p{name}_{k}_{t}") for t in range(2)]
         for v in (u_k, p_k):  # inside the sector: cross(a_lo, v) >= 0, cross(v, a_hi) >= 0
             scip.addCons(np.cos(lo) * v[1] - np.sin(lo) * v[0] >= 0.0)
             scip.addCons(v[0] * np.sin(hi) - v[1] * np.cos(hi) >= 0.0)
-        along = np.cos(mid) * p_k[0] + np.sin(mid) * p_k[1]
-        scip.addCons(along >= mu * np.cos(np.pi / sectors) * cn_k)  # beyond the arc's chord
-        scip.addCons(along <= mu * cn_k)  # inside the circumscribed polygon
+        scip.addCons(np.cos(mid) * p_k[0] + np.sin(mid) * p_k[1] >= mu * np.cos(half) * cn_k)  # beyond the arc's chord
+        for angle in (lo, mid, hi):  # inside the circle's tangents at the arc's ends and middle
+            scip.addCons(np.cos(angle) * p_k[0] + np.sin(angle) * p_k[1] <= mu * cn_k)
         size = scip.addVar(lb=0.0, ub=None, name=f"size{name}_{k}")  # zero only when the part is
         scip.addCons(size == cn_k + np.cos(mid) * u_k[0] + np.sin(mid) * u_k[1])
         cn_parts.append(cn_k)
         p_parts.append(p_k)
         u_parts.append(u_k)
         sizes.append(size)
-    scip.addConsSOS1(sizes)
-    if mode == "sliding":  # |slip| > MODE_TOLERANCE, so its component along its sector's bisector exceeds that times cos
-        scip.addCons(
-            pyscipopt.quicksum(np.cos(m) * u[0] + np.sin(m) * u[1] for m, u in zip(mids, u_parts, strict=True))
-            >= MODE_TOLERANCE * np.cos(np.pi / sectors)
-        )
+        parts.append((size, [cn_k], u_k, p_k))
+    scip.addConsSOS1([cn_roll, *sizes])
+    if mode == "sliding":  # |slip| > MODE_TOLERANCE: its part along its sector's bisector exceeds that times cos(half)
+        mids = 0.5 * (bounds[:-1] + bounds[1:])
+        along = [np.cos(mid) * u[0] + np.sin(mid) * u[1] for mid, u in zip(mids, u_parts, strict=True)]
+        scip.addCons(pyscipopt.quicksum(along) >= MODE_TOLERANCE * np.cos(0.5 * np.max(np.diff(bounds))))
     scip.addCons(pyscipopt.quicksum(cn_parts) == cn)
     for t in range(2 if u_parts else 0):
         scip.addCons(pyscipopt.quicksum(u[t] for u in u_parts) == slip[t])
-    return [pyscipopt.quicksum(p[t] for p in p_parts) for t in range(2)]
+    return [pyscipopt.quicksum(p[t] for p in p_parts) for t in range(2)], parts
 
 
-def _dot(row: np.ndarray, x: list) -> object:
+def _dot(row: np.ndarray, x: list) -> Any:
     import pyscipopt
 
     return pyscipopt.quicksum(float(a) * v for a, v in zip(row, x, strict=True) if a != 0.0) + 0.0
