@@ -97,3 +97,24 @@ def test_bad_config() -> None:
         BenchConfig(families=("nope",))
     with pytest.raises(ValueError, match="repeat"):
         BenchConfig(repeat=0)
+
+
+def test_contradictions_are_claims_against_the_certified_answer() -> None:
+    """`bench --check` fails CI on a contradiction: a status or twist other than the certified one.
+    A `failed` answer claims nothing, and one motion of an `ambiguous` set is not a contradiction."""
+    root = Path(__file__).resolve().parents[1] / "validation" / "scenes"
+    rest = qs.assemble(qs.load_scene(root / "slope_block_20.yaml"))
+    certified = qs.solve(rest, method="scip")
+    assert certified.status == "solved"
+    stopped = qs.solve(rest, method="scip", time_limit=1e-6)
+    unstable = qs.solve(qs.load_scene(root / "slope_block_30.yaml"), method="scip")
+    assert stopped.status == "failed" and unstable.status == "unstable"
+    assert not runner._contradicts(rest, certified, certified)
+    assert not runner._contradicts(rest, stopped, certified)
+    assert runner._contradicts(rest, unstable, certified)
+    lift = qs.load_scene(root / "grasp_level.yaml")
+    every = qs.solve(lift, method="scip")
+    assert every.status == "ambiguous"
+    one = qs.solve(lift, method="paper")
+    assert one.status == "solved" and not runner._contradicts(qs.assemble(lift), one, every)
+    assert runner._contradicts(qs.assemble(lift), every, qs.solve(lift, method="scip", modes=["rolling", "rolling"]))

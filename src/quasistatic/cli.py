@@ -153,6 +153,7 @@ def bench(
     budget: Annotated[float | None, typer.Option(min=0.001, help="Seconds of timed solves aimed at per row.")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write the log-log time-vs-contacts plot here (needs matplotlib).")] = None,
     batch: Annotated[bool, typer.Option("--batch/--no-batch", help="Measure solve_many throughput.")] = True,
+    check: Annotated[bool, typer.Option("--check", help="Exit 1 if a method contradicts the certified answer (CI).")] = False,
 ) -> None:
     """Benchmark every method on generated problem families against baselines measured in the same run."""
     import sys
@@ -180,3 +181,8 @@ def bench(
     for target in [p for p in (plot, out / "scaling.png" if out is not None else None) if p is not None]:
         written = write_scaling_plot(result, target)
         console.print(f"wrote {written}" if written else f"no plot written to {target} (matplotlib missing or no scaling rows)")
+    contradicting = [row for row in result.rows if row.contradictions]
+    for row in contradicting:
+        console.print(f"[red]{row.family} {row.size_label} {row.method}: {row.contradictions} answer(s) contradict the certified one[/red]")
+    if check and contradicting:
+        raise typer.Exit(1)

@@ -285,9 +285,12 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     x0 = np.concatenate([motion.q, motion.c[closed, 2], motion.c[rolling, :2].ravel()])
     lower = np.r_[np.full(n, -np.inf), np.zeros(n_closed), np.full(2 * n_rolling, -np.inf)]
     x0[n : n + n_closed] = np.maximum(x0[n : n + n_closed], 0.0)
-    fit = scipy.optimize.least_squares(
-        residual, x0, bounds=(lower, np.inf), method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=evaluations * x0.size
-    )
+    tolerances = {"xtol": 1e-15, "ftol": 1e-15, "gtol": 1e-15, "max_nfev": evaluations * x0.size}
+    fit = scipy.optimize.least_squares(residual, x0, bounds=(lower, np.inf), method="trf", **tolerances)
+    if np.max(np.abs(fit.fun), initial=0.0) > 1e-10:
+        # The bounded trust region can stall where unbounded Levenberg-Marquardt converges (a random
+        # 6-contact grasp); a negative normal force is then caught below, where forces are recovered by LP.
+        fit = scipy.optimize.least_squares(residual, x0, method="lm", **tolerances)
     q, u, c = unpack(fit.x)
     # A sliding contact may come to rest (its force then sits on the cone): still a solution.
     new_modes = np.array(contact_modes(problem, q))

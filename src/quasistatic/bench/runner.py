@@ -117,6 +117,7 @@ class Row:
     worst_residual: float | None = None
     agree: int = 0
     compared: int = 0
+    contradictions: int = 0
     note: str = ""
 
     def to_dict(self) -> dict[str, Any]:
@@ -359,13 +360,14 @@ def _row(
     statuses: dict[str, int] = dict(Counter(str(s.status) for s in outcome.solutions))
     residuals = [_worst_residual(s) for s in outcome.solutions]
     worst = max((r for r in residuals if r is not None), default=None)
-    agree = compared = 0
+    agree = compared = contradictions = 0
     if reference is not None:
         for problem, mine, ref in zip(problems, outcome.solutions, reference, strict=False):
             if not _certified(ref):
                 continue
             compared += 1
             agree += _same_answer(problem, mine, ref)
+            contradictions += _contradicts(problem, mine, ref)
     return Row(
         method=method,
         instances=len(outcome.solutions),
@@ -378,6 +380,7 @@ def _row(
         worst_residual=worst,
         agree=agree,
         compared=compared,
+        contradictions=contradictions,
         note=outcome.note,
         **head,
     )
@@ -393,6 +396,13 @@ def _worst_residual(solution: Solution) -> float | None:
     motions = [solution.motion, *solution.solutions] if solution.motion is not None else list(solution.solutions)
     values = [v for m in motions if m is not None for v in m.audit.residuals().values()]
     return max(values) if values else None
+
+
+def _contradicts(problem: Problem, mine: Solution, ref: Solution) -> bool:
+    """A claim against the certified reference: not a ``failed`` (which claims nothing), nor one motion of an ``ambiguous`` set."""
+    if mine.status == "failed" or (mine.status == "solved" and ref.status == "ambiguous"):
+        return False
+    return not _same_answer(problem, mine, ref)
 
 
 def _same_answer(problem: Problem, a: Solution, b: Solution) -> bool:
