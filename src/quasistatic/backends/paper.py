@@ -86,6 +86,7 @@ GAP_TOL = 1e-8  # scene-relative power gap below which P_zc = P_c (eq. 19 holds 
 TWIST_BOUND = 1e3  # |q_j| <= this (scene-relative: 1000 times the fastest mover)
 FORCE_BOUND = 1e3  # c_n <= this (scene-relative: 1000 times the largest load)
 _ACTIVE = 0.999  # a value beyond this fraction of its bound counts as at the bound
+POLISH_MAX = 500  # most unknowns polished by Newton's method (finite-difference Jacobian)
 RECOVERY_TOL = 1e-7  # scene-relative power gap accepted when the forces are recovered at a fixed twist
 _FORMULATION = "Trinkle & Hunter eq. 6, 7, 10, 23, 24 with the dual's equilibrium (13), (17); minimises P_zc - P_c of eq. 19"
 
@@ -167,7 +168,10 @@ def _refine(problem: Problem, q: np.ndarray, c: np.ndarray) -> np.ndarray | None
     the twist much more. With the modes fixed the laws are smooth equations:
     equilibrium, closed contacts stay closed, rolling ones do not slip, and
     sliding friction is ``-mu c_n u_t/||u_t||``. Returns None unless they are
-    met to 1e-12; the caller then checks the refined twist against the laws.
+    met to 1e-12, or when there are more than ``POLISH_MAX`` unknowns (each
+    step's finite-difference Jacobian costs one residual evaluation per
+    unknown: a 1000-box pile took 12 minutes); the caller then checks SCIP's
+    own twist against the laws.
     """
     n, (m, d) = problem.n_dof, c.shape
     u = np.einsum("mdn,n->md", problem.J, q) - problem.b
@@ -191,6 +195,8 @@ def _refine(problem: Problem, q: np.ndarray, c: np.ndarray) -> np.ndarray | None
         return np.concatenate([balance, u[closed, -1], u[rolling, :-1].ravel()])
 
     x0 = np.concatenate([q, c[closed, -1], c[rolling, :-1].ravel()])
+    if x0.size > POLISH_MAX:
+        return None
     fit = scipy.optimize.least_squares(residual, x0, xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=100 * x0.size)
     return fit.x[:n] if np.max(np.abs(residual(fit.x)), initial=0.0) <= 1e-12 else None
 
