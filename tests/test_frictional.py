@@ -371,3 +371,15 @@ def test_exact_cone_mode_specified_solve() -> None:
         held = qs.solve(exact, modes=modes)
         assert held.status == "jammed", (modes, held.message)
         assert "slip sectors" in held.details["certificate"]
+
+
+@pytest.mark.slow
+def test_exact_motions_prove_ambiguity_when_another_does_not_refine() -> None:
+    """A random 6-contact 3-D grasp (benchmark family) whose 8-edge pyramid has many motions, one of which has
+    no exact motion next to it: the exact ones that do refine still prove ``ambiguous`` (list incomplete)."""
+    from quasistatic.bench.families import grasp_3d
+
+    sol = qs.solve(grasp_3d(6, 1), method="scip", time_limit=30.0)
+    assert sol.status == "ambiguous", sol.message
+    assert len(sol.solutions) >= 2 and all(m.audit.passed for m in sol.solutions)
+    assert "incomplete" in sol.message or "incomplete" in sol.details.get("exact_cone", "")

@@ -162,17 +162,26 @@ def _confirm_wedged(problem: Problem, options: Options) -> BackendResult:
 
 
 def _refined_result(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, count: int) -> BackendResult | None:
-    """Every pyramid motion refined to the exact cone (None if one cannot be), summarised."""
+    """Every pyramid motion refined to the exact cone, summarised; None when that decides nothing.
+
+    Where some motion cannot be refined, two distinct exact motions (or a
+    continuum) still prove ``ambiguous``, with a list that may be incomplete.
+    """
     refined = [_refine(problem, motion) for motion in motions]
-    if any(r is None for r in refined):
-        return None
     unique: list[RawMotion] = []
     for motion in refined:
         if motion is not None and _keeps_prescribed(problem, motion, options) and not any(_same_exact(problem, motion, o) for o in unique):
             unique.append(motion)
+    unrefined = sum(r is None for r in refined)
     if not unique:
         return None
-    return _summary(problem, unique, complete, options, f"motions refined from a {count}-edge pyramid; completeness proven for the pyramid")
+    if not unrefined:
+        note = f"motions refined from a {count}-edge pyramid; completeness proven for the pyramid"
+        return _summary(problem, unique, complete, options, note)
+    if len(unique) >= 2 or any(motion.continuum for motion in unique):
+        note = f"{unrefined} motion(s) of the {count}-edge pyramid did not converge to one of the exact cone: the list is incomplete"
+        return _summary(problem, unique, False, options, note)
+    return None
 
 
 def _summary(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, note: str) -> BackendResult:
