@@ -44,6 +44,7 @@ UNSTABLE_MESSAGE = (
 
 LEMKE_MAX_ROWS = 200  # largest LCP (2 twist entries per dof + contacts) solved by Lemke's method first
 PAIR_TOL = 1e-10  # scene-relative violation of the optimality conditions a Lemke pair may have
+JACOBI_MAX = 24  # largest min(rows, cols) whose rank is found by Jacobi rotations (LAPACK beyond)
 
 
 def solve_frictionless(problem: Problem, options: Options) -> BackendResult:
@@ -169,6 +170,8 @@ def _rank(A: np.ndarray, tol: float) -> int:
     """Number of singular values of ``A`` above ``tol`` (absolute: the data are scene-relative)."""
     if A.shape[0] == 0 or A.shape[1] == 0:
         return 0
+    if min(A.shape) > JACOBI_MAX:  # Jacobi sweeps cost O(k^3) each: LAPACK wins on large matrices
+        return int(np.sum(np.linalg.svd(np.ascontiguousarray(A))[1] > tol))
     return int(np.sum(_singular_values(A) > tol))
 
 
