@@ -4,21 +4,24 @@ An inscribed pyramid is exact for rolling contacts (its forces lie inside the
 cone) and for a sliding contact whose slip is exactly opposite one of its
 edges (the force then lies on the cone, opposite the slip). So: find every
 motion with an 8-edge pyramid by the certified search, then refine each one by
-solving the exact laws with its contact modes fixed (smooth equations, by a
-bounded trust-region least-squares solve from the pyramid motion); where the
-least-squares forces of a statically indeterminate set leave the cones, the
-forces are recovered at the refined twist by an LP. Where 8 edges leave the
-answer undecided (a motion that does not refine, a wedge, no motion with
+solving the exact laws with its contact modes fixed (smooth equations, by
+least squares from the pyramid motion: a bounded trust region, then
+Levenberg-Marquardt if that stalls). A sliding contact of the pyramid may
+roll or separate under the circle, so those mode changes are tried too; where
+the least-squares forces of a statically indeterminate set leave the cones,
+the forces are recovered at the refined twist by an LP. Where 8 edges leave
+the answer undecided (a motion that does not refine, a wedge, no motion with
 prescribed modes, equilibrium too close to call), the search runs again with
 32 edges.
 
 What is proven: ``unstable`` (no equilibrium even in a pyramid circumscribing
-the exact cone), kinematic ``jammed`` (a Farkas certificate) and wedged
-``jammed`` (the pyramids jam and the paper's exact program, solved globally,
-confirms it). The list of motions is complete for the pyramid; each reported
-motion satisfies the exact laws (the audit checks it), but motions of the
-exact cone that the pyramid misses are not excluded by proof, and the details
-say so.
+the exact cone), kinematic ``jammed`` (a Farkas certificate), wedged
+``jammed`` and "no motion with these modes" (a sector relaxation of the exact
+laws is infeasible, :mod:`.wedge`; failing that, the paper's exact program
+solved globally), and ``ambiguous`` (two distinct audited exact motions).
+The list of motions is complete for the pyramid; each reported motion
+satisfies the exact laws (the audit checks it), but motions of the exact cone
+that the pyramid misses are not excluded by proof, and the details say so.
 """
 
 from __future__ import annotations
