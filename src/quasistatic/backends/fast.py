@@ -11,7 +11,7 @@ makes it a standard LCP (both rows non-negative is equilibrium) whose
 twist-force coupling is skew-symmetric, so ``z^T M z = sum mu cn lam >= 0``
 (the matrix is copositive). Only contacts with ``mu > 0`` get edges.
 
-Exact 3-D cones: solve with an inscribed 8-edge pyramid, then turn each
+Exact 3-D cones: solve with an inscribed 6-edge pyramid, then turn each
 sliding contact's pyramid so one edge lies exactly opposite its slip and
 solve again (first from the previous complementary basis, which usually
 still holds), until every sliding contact's friction is
@@ -45,7 +45,7 @@ from .lemke import PIVOT_LIMIT, RAY, SOLUTION, lemke
 
 __all__ = ["solve_fast"]
 
-EDGES = 8  # pyramid edges for exact 3-D cones
+EDGES = 6  # pyramid edges for exact 3-D cones (Newton then solves the circle; 6 was 2-3x faster than 8 on 3-D grasps, same successes)
 REALIGNMENTS = 20  # most edge re-alignments for exact 3-D cones
 DISSIPATION_TOL = 1e-9  # scene-relative misalignment of a sliding contact's friction accepted as exact
 PIVOT_TOL = 1e-11  # scene-relative pivot and tie tolerance of Lemke's method
