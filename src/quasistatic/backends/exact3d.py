@@ -93,10 +93,13 @@ def _is_exact_motion(problem: Problem, q: np.ndarray) -> bool:
     u = np.einsum("mdn,n->md", problem.J, q) - problem.b
     if np.min(u[:, -1], initial=0.0) < -MODE_TOLERANCE:
         return False
-    modes = np.array(contact_modes(problem, q), dtype=object)
+    return _forces_at(problem, q, *_mode_masks(problem, np.array(contact_modes(problem, q), dtype=object))) is not None
+
+
+def _mode_masks(problem: Problem, modes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Closed, rolling and sliding contacts; a frictionless one carries only a normal force and may slip freely."""
     frictional = problem.mu > 0
-    closed, rolling, sliding = modes != "separating", (modes == "rolling") & frictional, (modes == "sliding") & frictional
-    return _forces_at(problem, q, closed, rolling, sliding) is not None
+    return modes != "separating", (modes == "rolling") & frictional, (modes == "sliding") & frictional
 
 
 def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResult | None, str]:
@@ -273,9 +276,8 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     pyramid's extremes) only where the exact equations leave a twist direction
     free at the solution (a null vector of their Jacobian with a twist part).
     """
-    # A frictionless contact carries only a normal force and may slip freely: no slip equation for it.
+    closed, rolling, sliding = _mode_masks(problem, modes)  # a frictionless contact gets no slip equation
     frictional = problem.mu > 0
-    closed, rolling, sliding = modes != "separating", (modes == "rolling") & frictional, (modes == "sliding") & frictional
     n, m = problem.n_dof, problem.n_contacts
     n_closed, n_rolling = int(closed.sum()), int(rolling.sum())
 
