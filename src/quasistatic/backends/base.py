@@ -158,7 +158,7 @@ def value_ranges(
     """
     model = WarmLP(A_eq, b_eq, b_eq, col_lower)
     constant = _in_row_space(A_eq, targets)
-    coordinate = [int(np.flatnonzero(t)[0]) if np.count_nonzero(t) == 1 and t[np.flatnonzero(t)[0]] == 1.0 else -1 for t in targets]
+    coordinate = [_unit_index(t) for t in targets]
     at_bound = np.zeros(A_eq.shape[1], dtype=bool)  # coordinates seen at their lower bound
     ranges: list[tuple[float, float | None]] = []
     for target, fixed, j in zip(targets, constant, coordinate, strict=True):
@@ -177,6 +177,12 @@ def value_ranges(
             at_bound |= result.x <= col_lower + ZERO * 1e-3
         ranges.append((max(low or 0.0, 0.0), result.objective if result.status == "optimal" else None))
     return ranges
+
+
+def _unit_index(target: np.ndarray) -> int:
+    """``j`` when ``target`` is the unit vector e_j (the target is one coordinate), else -1."""
+    nonzero = np.flatnonzero(target)
+    return int(nonzero[0]) if nonzero.size == 1 and target[nonzero[0]] == 1.0 else -1
 
 
 def _in_row_space(A: np.ndarray, targets: np.ndarray) -> np.ndarray:

@@ -37,6 +37,7 @@ from ..evaluate import MODE_TOLERANCE
 from ..problem import Problem
 from ..solution import Mode
 from .base import Options
+from .scip import _dot
 
 __all__ = ["exact_cones_jam", "SECTORS", "FINEST"]
 
@@ -183,9 +184,3 @@ def _friction(
     for t in range(2 if u_parts else 0):
         scip.addCons(pyscipopt.quicksum(u[t] for u in u_parts) == slip[t])
     return [pyscipopt.quicksum(p[t] for p in p_parts) for t in range(2)], parts
-
-
-def _dot(row: np.ndarray, x: list) -> Any:
-    import pyscipopt
-
-    return pyscipopt.quicksum(float(a) * v for a, v in zip(row, x, strict=True) if a != 0.0) + 0.0
