@@ -53,9 +53,7 @@ def random_scene(dimension: int, seed: int, friction: str = "exact") -> qs.Scene
         movers.append(qs.Mover("table"))
     gravity = _tilted_gravity(rng, d)
     body = qs.Body("box", mass=float(rng.uniform(0.2, 2.0)), com=com)
-    return qs.Scene(
-        bodies=(body,), movers=tuple(movers), contacts=tuple(contacts), dimension=d, gravity=gravity, friction=friction
-    )
+    return qs.Scene(bodies=(body,), movers=tuple(movers), contacts=tuple(contacts), dimension=d, gravity=gravity, friction=friction)
 
 
 def _placements(rng: np.random.Generator, half: np.ndarray, centre: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray]]:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import quasistatic as qs
-from quasistatic.bench.families import grasp_2d, grasp_3d
+from quasistatic.tools.bench.families import grasp_2d, grasp_3d
 
 
 def _same(a: qs.Solution, b: qs.Solution) -> None:
@@ -99,7 +99,7 @@ def test_forked_and_joblib_workers_give_the_same_answers(problems: list[qs.Probl
     for a, b, c in zip(serial, forked, shipped, strict=True):
         _same(b, a)
         _same(c, a)
-    assert not batch._INHERITED  # the inherited items are let go
+    assert not batch._WORKER_ITEMS  # the parent never holds the workers' copy
 
 
 def test_failing_item_is_named_by_a_worker() -> None:

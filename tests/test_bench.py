@@ -12,7 +12,7 @@ import pytest
 from rich.console import Console
 
 import quasistatic as qs
-from quasistatic.bench import (
+from quasistatic.tools.bench import (
     FAMILIES,
     BenchConfig,
     Row,

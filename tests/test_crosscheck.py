@@ -49,8 +49,8 @@ import numpy as np
 import pytest
 
 import quasistatic as qs
-from quasistatic.backends.registry import BACKENDS
 from quasistatic.solution import Motion, Solution
+from quasistatic.solvers import BACKENDS
 from random_scenes import random_scene
 
 TWIST_RTOL = 1e-6  # scene-relative twist agreement required between methods
@@ -135,8 +135,8 @@ def test_scenes_are_reproducible(dimension: int) -> None:
 
 
 def test_paper_refuses_prescribed_modes() -> None:
-    from quasistatic.backends.base import Options
-    from quasistatic.backends.paper import solve_paper
+    from quasistatic.solvers import Options
+    from quasistatic.solvers.paper import solve_paper
 
     problem = qs.assemble(random_scene(2, 0))
     result = solve_paper(problem, Options(modes=(None,) * problem.n_contacts))

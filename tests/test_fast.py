@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 
 import quasistatic as qs
-from quasistatic.backends.base import Options
-from quasistatic.backends.fast import solve_fast
-from quasistatic.backends.lemke import PIVOT_LIMIT, RAY, SOLUTION, lemke
-from quasistatic.validation import load_cases, scene_data
+from quasistatic.solvers import Options
+from quasistatic.solvers.fast import solve_fast
+from quasistatic.solvers.numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION, lemke
+from quasistatic.tools.validation import load_cases, scene_data
 
 ROOT = Path(__file__).resolve().parents[1]
 G = 9.81
@@ -319,7 +319,7 @@ def test_runs_without_numba() -> None:
 
 def _lp_without_lemke(problem: qs.Problem, monkeypatch: pytest.MonkeyPatch) -> qs.Solution:
     """The ``lp`` answer with Lemke's method switched off (HiGHS only), on a fresh copy of the problem."""
-    from quasistatic.backends import lp
+    from quasistatic.solvers import lp
 
     monkeypatch.setattr(lp, "LEMKE_MAX_ROWS", -1)
     try:
@@ -354,7 +354,7 @@ def test_lp_with_lemke_gives_the_highs_answer(seed: int, monkeypatch: pytest.Mon
 
 def test_lp_with_lemke_on_the_benchmark_grasps(monkeypatch: pytest.MonkeyPatch) -> None:
     """Frictionless 3-D grasps (8 contacts: solved, one with indeterminate forces; 4: unstable)."""
-    from quasistatic.bench.families import grasp_3d
+    from quasistatic.tools.bench.families import grasp_3d
 
     for size, instance in itertools.product((4, 8), range(8)):
         problem = qs.assemble(grasp_3d(size, instance, friction="none"))
@@ -365,7 +365,7 @@ def test_lp_with_lemke_on_the_benchmark_grasps(monkeypatch: pytest.MonkeyPatch) 
 
 
 def _some_solutions() -> list[tuple[qs.Problem, qs.Solution]]:
-    from quasistatic.bench.families import grasp_2d, grasp_3d
+    from quasistatic.tools.bench.families import grasp_2d, grasp_3d
 
     problems = [qs.assemble(grasp_3d(8, i, friction="none")) for i in range(3)] + [qs.assemble(grasp_2d(3, i)) for i in range(3)]
     solved = [(p, qs.solve(p, method=m)) for p in problems for m in ("fast", "lp" if p.is_frictionless else "scip")]
@@ -409,8 +409,9 @@ def test_lazy_contacts_equal_the_eager_ones() -> None:
 _KERNEL_CASES = """
 import json, sys
 import numpy as np
-from quasistatic import audit
-from quasistatic.bench.families import grasp_2d, grasp_3d
+from quasistatic.check.audit import AuditGeometry, audit_arrays
+from quasistatic.model import scene_scales
+from quasistatic.tools.bench.families import grasp_2d, grasp_3d
 
 scenes = [grasp_2d(4, 0), grasp_3d(6, 1), grasp_3d(4, 2, friction="pyramid:6"), grasp_3d(8, 0, friction="none")]
 rng = np.random.default_rng(7)
@@ -418,7 +419,7 @@ out = []
 for scene in scenes:
     T = rng.normal(size=(len(scene.bodies), scene.twist_size))
     forces = rng.normal(size=(len(scene.contacts), scene.dimension))
-    e = audit._evaluate(audit._geometry(scene), T, forces)
+    _, _, e = audit_arrays(AuditGeometry.of(scene), T, forces, scene_scales(scene))
     out.append([a.tolist() for a in (e.sums, e.velocities, e.slips, e.normal)])
 print(json.dumps(out))
 """
@@ -440,8 +441,8 @@ def test_audit_kernel_compiled_and_plain_python_agree() -> None:
 
 def test_audit_rejects_non_finite_motions() -> None:
     """A NaN anywhere in a motion fails its audit (max() alone would let a NaN through)."""
-    from quasistatic.audit import audit_motion
-    from quasistatic.bench.families import grasp_3d
+    from quasistatic.check.audit import audit_motion
+    from quasistatic.tools.bench.families import grasp_3d
 
     problem = qs.assemble(grasp_3d(8, 0, friction="none"))
     solution = qs.solve(problem, method="fast")
@@ -458,24 +459,9 @@ def test_audit_rejects_non_finite_motions() -> None:
         assert not audit.passed, where
 
 
-def test_problem_caches_go_with_their_objects() -> None:
-    """Data derived per Problem and per Scene is dropped when the object is."""
-    import gc
-
-    from quasistatic import audit, evaluate
-    from quasistatic.bench.families import grasp_2d
-
-    gc.collect()
-    before = (len(evaluate._DERIVED), len(audit._GEOMETRY))
-    for i in range(20):
-        qs.solve(qs.assemble(grasp_2d(3, i)), method="fast")
-    gc.collect()
-    assert (len(evaluate._DERIVED), len(audit._GEOMETRY)) == before
-
-
 def test_jacobi_singular_values_match_lapack() -> None:
     """The small-matrix SVD behind the frictionless rank tests gives LAPACK's singular values and ranks."""
-    from quasistatic.backends.lp import _rank, _singular_values
+    from quasistatic.solvers.lp import _rank, _singular_values
 
     rng = np.random.default_rng(3)
     for trial in range(500):

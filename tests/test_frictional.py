@@ -17,7 +17,7 @@ import pytest
 from pytest import approx
 
 import quasistatic as qs
-from quasistatic.backends.registry import BACKENDS
+from quasistatic.solvers import BACKENDS
 
 G = 9.81
 SOLVING = ["scip", "auto", *(["fast"] if "fast" in BACKENDS else [])]
@@ -287,9 +287,9 @@ def test_time_limit_bounds_the_whole_certified_solve_and_claims_nothing() -> Non
 
 def test_one_motion_from_an_incomplete_search_is_not_solved() -> None:
     """One motion found before the time limit: reported, audited, but failed (uniqueness unproven), not ambiguous."""
-    from quasistatic.backends.base import Options
-    from quasistatic.backends.polyhedral import aligned_edges, polyhedral_form
-    from quasistatic.backends.scip import enumerate_motions, summarise
+    from quasistatic.laws.polyhedral import aligned_edges, polyhedral_form
+    from quasistatic.solvers import Options
+    from quasistatic.solvers.certify.search import enumerate_motions, summarise
 
     problem = qs.assemble(slope(20.0, push=0.01))
     form = polyhedral_form(problem, aligned_edges(problem, problem.friction.edges))
@@ -305,7 +305,7 @@ def wedge(mu_floor: float, mu_finger: float, dimension: int = 3) -> qs.Scene:
     at (0.01, -0.01) m/s. The finger must slide down the face, so its friction mu_f N pushes the box
     down; the floor's friction mu (m g + mu_f N) must not exceed N: the box slides iff mu mu_f < 1,
     else friction wedges it (jammed). In 3-D the planar scene is extruded, contacts at z = +-0.05."""
-    from quasistatic.validation import extrude
+    from quasistatic.tools.validation import extrude
 
     data = {
         "quasistatic": 1,
@@ -346,8 +346,8 @@ def test_friction_below_the_wedge_slides(dimension: int) -> None:
 def test_sector_relaxation_never_excludes_an_exact_motion() -> None:
     """The wedge proof is sound only if every exact motion satisfies the relaxation: for scenes with
     an audited exact motion, the relaxation (with that motion's modes prescribed) is never infeasible."""
-    from quasistatic.backends.base import Options
-    from quasistatic.backends.wedge import _relaxation
+    from quasistatic.solvers import Options
+    from quasistatic.solvers.certify.wedge import _relaxation
 
     for built in (wedge(0.9, 1.0), puck("exact")):
         problem = qs.assemble(built)
@@ -377,7 +377,7 @@ def test_exact_cone_mode_specified_solve() -> None:
 def test_exact_motions_prove_ambiguity_when_another_does_not_refine() -> None:
     """A random 6-contact 3-D grasp (benchmark family) whose 8-edge pyramid has many motions, one of which has
     no exact motion next to it: the exact ones that do refine still prove ``ambiguous`` (list incomplete)."""
-    from quasistatic.bench.families import grasp_3d
+    from quasistatic.tools.bench.families import grasp_3d
 
     sol = qs.solve(grasp_3d(6, 1), method="scip", time_limit=30.0)
     assert sol.status == "ambiguous", sol.message

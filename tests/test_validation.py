@@ -18,7 +18,7 @@ from rich.console import Console
 
 import quasistatic as qs
 from quasistatic import QuasistaticError, load_scene
-from quasistatic.validation import (
+from quasistatic.tools.validation import (
     Case,
     extrude,
     load_cases,
@@ -35,6 +35,7 @@ ROOT = Path(__file__).resolve().parents[1]
 FOLDER = ROOT / "validation"
 CASES = load_cases(FOLDER)
 STATUSES = {"solved", "ambiguous", "jammed", "unstable"}
+
 
 def _param(case: Case) -> object:
     marks = []

@@ -6,20 +6,23 @@ objects move, the contact forces and each contact's mode (Trinkle & Hunter).
 
 from .batch import solve_many
 from .errors import BackendUnavailableError, QuasistaticError, SceneError, SolverError
-from .friction import FrictionModel
-from .problem import Problem, assemble
-from .scene import Body, Contact, Mover, Robot, Scene, load_scene
-from .solution import Audit, ContactResult, Motion, PowerBalance, Solution
+from .laws import Problem, assemble
+from .model import Body, Contact, FrictionModel, Mover, Robot, Scene, load_scene
+from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "Attempt",
     "Audit",
     "BackendUnavailableError",
     "Body",
+    "Certificate",
+    "CertificateKind",
     "Contact",
     "ContactResult",
+    "Diagnosis",
     "FrictionModel",
     "METHODS",
     "Motion",

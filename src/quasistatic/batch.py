@@ -18,13 +18,13 @@ import threading
 from collections.abc import Iterable, Sequence
 from typing import Any
 
-from .audit import DEFAULT_TOLERANCE
-from .backends.registry import get_backend
+from .check import DEFAULT_TOLERANCE
 from .errors import QuasistaticError
-from .problem import Problem, assemble
-from .scene import Scene
+from .laws import Problem, assemble
+from .model import Scene
 from .solution import Solution
 from .solve import solve
+from .solvers import get_backend
 
 __all__ = ["solve_many"]
 
@@ -134,7 +134,7 @@ def _solve_chunk(items: Sequence[Scene | Problem], offset: int, method: str, opt
 
 # --------------------------------------------------------------------------- forked workers
 
-_INHERITED: dict[str, Any] = {}  # what forked workers read: set just before the fork, cleared after
+_WORKER_ITEMS: list[Scene | Problem] = []  # in a forked worker only: the parent's items, set once at its start
 
 
 def _can_fork() -> bool:
@@ -148,22 +148,26 @@ def _solve_forked(items: list[Scene | Problem], workers: int, chunks_per_job: in
     rest = len(items) - 1
     size = max(1, -(-rest // (workers * chunks_per_job)))
     blocks = [(start, min(start + size, len(items)), method, options) for start in range(1, len(items), size)]
-    _INHERITED["items"] = items
     # Frozen objects are left out of garbage collection: the workers do not traverse (and so do not
     # copy) the heap they inherit, and neither process re-traverses it while solutions are pickled.
     gc.freeze()
     try:
-        with multiprocessing.get_context("fork").Pool(min(workers, len(blocks))) as pool:
+        # A forked worker's initializer arguments are inherited, not pickled.
+        with multiprocessing.get_context("fork").Pool(min(workers, len(blocks)), _adopt_items, (items,)) as pool:
             results = pool.starmap(_solve_inherited, blocks, chunksize=1)
     finally:
         gc.unfreeze()
-        _INHERITED.clear()
     solutions = list(first)
     for ok, value in results:
         if not ok:
             raise value
         solutions += value
     return solutions
+
+
+def _adopt_items(items: list[Scene | Problem]) -> None:
+    """In a forked worker, at its start: keep the parent's items (inherited with the process, never pickled)."""
+    _WORKER_ITEMS[:] = items
 
 
 def _solve_inherited(start: int, stop: int, method: str, options: dict[str, Any]) -> tuple[bool, Any]:
@@ -174,7 +178,7 @@ def _solve_inherited(start: int, stop: int, method: str, options: dict[str, Any]
     replaced by a QuasistaticError that names it.
     """
     try:
-        return True, _solve_chunk(_INHERITED["items"][start:stop], start, method, options)
+        return True, _solve_chunk(_WORKER_ITEMS[start:stop], start, method, options)
     except Exception as exc:
         try:
             pickle.loads(pickle.dumps(exc))

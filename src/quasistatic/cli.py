@@ -17,11 +17,10 @@ from typing import Annotated, NoReturn, TypeVar
 import typer
 
 from .errors import QuasistaticError
+from .model import Scene, load_scene
 from .report import make_console, render_solution
-from .scene import Scene, load_scene
 from .solution import Mode, Solution
 from .solve import METHODS, solve
-from .validation import render_results, run_validation
 
 __all__ = ["app", "main"]
 
@@ -42,9 +41,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 
-JsonOption = Annotated[
-    bool, typer.Option("--json", help="Print the solution as JSON (Solution.to_dict()) and nothing else.")
-]
+JsonOption = Annotated[bool, typer.Option("--json", help="Print the solution as JSON (Solution.to_dict()) and nothing else.")]
 SceneArgument = Annotated[Path, typer.Argument(metavar="SCENE", help="Scene file (.yaml, .yml or .json).")]
 
 
@@ -78,9 +75,7 @@ def solve_command(
     scene = _guarded(lambda: load_scene(scene_file))
     prescribed = _guarded(lambda: _parse_modes(modes)) if modes is not None else None
     certify = all_solutions and method in ("auto", "scip")
-    solution = _guarded(
-        lambda: solve(scene, method=method, modes=prescribed, all_solutions=certify, max_solutions=max_solutions)
-    )
+    solution = _guarded(lambda: solve(scene, method=method, modes=prescribed, all_solutions=certify, max_solutions=max_solutions))
     _report(solution, as_json)
 
 
@@ -102,6 +97,8 @@ def validate(
 
     Exit 1 when a case fails, or when a documented disagreement no longer fails (update cases.yaml).
     """
+    from .tools.validation import render_results, run_validation
+
     results = _guarded(lambda: run_validation(folder))
     render_results(results, make_console())
     raise typer.Exit(0 if all(r.ok for r in results) else 1)
@@ -158,7 +155,7 @@ def bench(
     """Benchmark every method on generated problem families against baselines measured in the same run."""
     import sys
 
-    from .bench import BenchConfig, render_result, run_benchmarks, write_results, write_scaling_plot
+    from .tools.bench import BenchConfig, render_result, run_benchmarks, write_results, write_scaling_plot
 
     config = _guarded(
         lambda: BenchConfig(

@@ -16,6 +16,7 @@ from rich.table import Table
 from rich.text import Text
 
 from .solution import ContactResult, Motion, Solution
+from .tolerances import DISPLAY_ZERO
 
 __all__ = ["render_solution", "make_console", "format_float", "format_vector"]
 
@@ -28,7 +29,6 @@ _STATUS_STYLE = {
 }
 _MODE_STYLE = {"rolling": "green", "sliding": "yellow", "separating": "cyan"}
 _PIPE_WIDTH = 120
-_DISPLAY_ZERO = 1e-12  # relative to a vector's largest entry: shown as 0
 
 
 def format_float(value: float, scale: float = 0.0) -> str:
@@ -38,7 +38,7 @@ def format_float(value: float, scale: float = 0.0) -> str:
     column's largest entry) are shown as ``0``.
     """
     value = float(value)
-    if abs(value) <= _DISPLAY_ZERO * scale:
+    if abs(value) <= DISPLAY_ZERO * scale:
         value = 0.0
     text = f"{value:.6g}"
     if text.startswith("-") and float(text) == 0.0:
@@ -76,9 +76,8 @@ def render_solution(solution: Solution, console: Console) -> None:
     console.print(Text.assemble("status: ", status))
     console.print(Text(solution.message))
     console.print(Text(f"method: {solution.method}   friction model: {solution.friction}"))
-    certificate = solution.details.get("certificate") if solution.details else None
-    if certificate is not None:
-        console.print(Text(f"certificate: {certificate}"))
+    if solution.certificate is not None:
+        console.print(Text(f"certificate: {solution.certificate.text}"))
     motion = solution.motion
     if motion is None:
         return
@@ -137,9 +136,7 @@ def _contact_table(contacts: Iterable[ContactResult], with_ranges: bool, title: 
         table.add_column("f_n range", justify="right")
     contacts = tuple(contacts)
     force_scale = max((float(np.max(np.abs(c.force), initial=0.0)) for c in contacts), default=0.0)
-    speed_scale = max(
-        (max(float(np.max(np.abs(c.slip), initial=0.0)), abs(c.normal_velocity)) for c in contacts), default=0.0
-    )
+    speed_scale = max((max(float(np.max(np.abs(c.slip), initial=0.0)), abs(c.normal_velocity)) for c in contacts), default=0.0)
     for index, contact in enumerate(contacts):
         row: list[str | Text] = [
             str(index),

@@ -1,16 +1,94 @@
-"""What a solve returns: a status, the motion(s), forces, modes, power and audit."""
+"""What a solve returns: a status, the motion(s), forces, modes, power and audit, and how it was proven.
+
+Plain value types; this module imports nothing else of the package.
+"""
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any, Literal, Protocol
 
 import numpy as np
 
-__all__ = ["Status", "Mode", "ContactResult", "PowerBalance", "Audit", "Motion", "Solution"]
+__all__ = [
+    "Status",
+    "Mode",
+    "Diagnosis",
+    "CertificateKind",
+    "Certificate",
+    "Attempt",
+    "ContactResult",
+    "ContactSource",
+    "PowerBalance",
+    "Audit",
+    "Motion",
+    "Solution",
+]
 
 Status = Literal["solved", "ambiguous", "jammed", "unstable", "failed"]
 Mode = Literal["rolling", "sliding", "separating"]
+
+
+class Diagnosis(enum.Enum):
+    """Why no motion exists."""
+
+    KINEMATIC = "kinematic"
+    """jammed: every twist of the free bodies would let a mover penetrate them."""
+    WEDGED = "wedged"
+    """jammed: the parts could rest, but friction wedges them against the commanded motion."""
+    PRESCRIBED_MODES = "prescribed_modes"
+    """jammed: no motion has the prescribed contact modes."""
+    NO_EQUILIBRIUM = "no_equilibrium"
+    """unstable: no force in the friction cones balances the load."""
+
+
+class CertificateKind(enum.Enum):
+    """What kind of proof stands behind a verdict."""
+
+    FARKAS = "farkas"
+    """Multipliers y >= 0 with Jn^T y = 0 and bn.y > 0: no twist keeps every contact from penetrating."""
+    RAY = "ray"
+    """A twist d with Jn d >= 0 along which the load does positive work: no equilibrium."""
+    INFEASIBLE_EQUILIBRIUM = "infeasible_equilibrium"
+    """The LP of forces in (circumscribed) friction cones that balance the load is infeasible."""
+    COMPLETE_SEARCH = "complete_search"
+    """A complete mixed-integer search found no motion (within the pyramid model it searched)."""
+    SECTOR_RELAXATION = "sector_relaxation"
+    """A relaxation of the exact-cone laws (slips in sectors) is infeasible."""
+    GLOBAL_OPTIMUM = "global_optimum"
+    """The paper's minimum-power program has a positive global minimum (no power-balanced motion)."""
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """The proof behind a verdict.
+
+    Attributes
+    ----------
+    kind : CertificateKind
+    text : str
+        What was proven, in words.
+    data : tuple of float
+        The certificate's numbers where they are small enough to report
+        (Farkas multipliers per contact, a ray's twist direction); else empty.
+    """
+
+    kind: CertificateKind
+    text: str
+    data: tuple[float, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind.value, "text": self.text, "data": [float(x) for x in self.data]}
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """A method tried before the one that answered, and why its answer was not kept."""
+
+    method: str
+    message: str
 
 
 @dataclass(frozen=True)
@@ -133,12 +211,26 @@ class Audit:
         return {**{k: float(v) for k, v in self.residuals().items()}, "tolerance": self.tolerance, "passed": self.passed}
 
 
-class _ContactSource(Protocol):
-    """Per-contact results kept as arrays until a Motion's ``contacts`` are first read."""
+class ContactSource(Protocol):
+    """Where a Motion's per-contact results come from: built when first read (solves that only need
+    twists, statuses and audits, as batches do, never pay for one object per contact)."""
 
     def results(self) -> tuple[ContactResult, ...]: ...
 
     def modes(self) -> tuple[Mode, ...]: ...
+
+
+@dataclass(frozen=True)
+class ContactList:
+    """A :class:`ContactSource` that already holds its results."""
+
+    contacts: tuple[ContactResult, ...]
+
+    def results(self) -> tuple[ContactResult, ...]:
+        return self.contacts
+
+    def modes(self) -> tuple[Mode, ...]:
+        return tuple(c.mode for c in self.contacts)
 
 
 @dataclass(frozen=True)
@@ -149,8 +241,8 @@ class Motion:
     ----------
     twists : dict name -> array (3,) in 2-D or (6,) in 3-D
         Linear velocity of the com, then angular velocity, world frame.
-    contacts : tuple of ContactResult, in scene order
-        (For a motion returned by a solve, made from the audit's arrays when first read.)
+    source : ContactSource
+        The per-contact results, read through :attr:`contacts` and :attr:`modes`.
     power : PowerBalance
     audit : Audit
     continuum : bool
@@ -160,7 +252,7 @@ class Motion:
     """
 
     twists: dict[str, np.ndarray]
-    contacts: tuple[ContactResult, ...]
+    source: ContactSource = field(repr=False, compare=False)
     power: PowerBalance
     audit: Audit
     continuum: bool = False
@@ -178,12 +270,14 @@ class Motion:
         state["twists"] = {name: np.array(values, dtype=float).reshape(shape) for name, shape, values in state["twists"]}
         self.__dict__.update(state)
 
+    @cached_property
+    def contacts(self) -> tuple[ContactResult, ...]:
+        """Each contact's result, in scene order."""
+        return self.source.results()
+
     @property
     def modes(self) -> tuple[Mode, ...]:
-        source = self.__dict__.get("_contact_source")
-        if source is not None and "contacts" not in self.__dict__:
-            return source.modes()  # type: ignore[no-any-return]
-        return tuple(c.mode for c in self.contacts)
+        return self.source.modes()
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {
@@ -198,52 +292,6 @@ class Motion:
             out["unbounded"] = self.unbounded
             out["extreme_twists"] = [{n: _floats(t) for n, t in e.items()} for e in self.extreme_twists]
         return out
-
-
-class _LazyContacts:
-    """``Motion.contacts`` of a motion made by :func:`_lazy_motion`: built on first read, then kept.
-
-    A non-data descriptor: a Motion built the ordinary way holds ``contacts`` in its
-    ``__dict__``, which takes precedence, so this only runs for lazily built ones.
-    """
-
-    def __get__(self, motion: Motion | None, owner: type | None = None) -> Any:
-        if motion is None:
-            return self
-        contacts = motion.__dict__["_contact_source"].results()
-        motion.__dict__["contacts"] = contacts  # frozen: set once, as the constructor would have
-        return contacts
-
-
-Motion.contacts = _LazyContacts()  # type: ignore[assignment]  # after @dataclass, so it is no default
-
-
-def _lazy_motion(
-    twists: dict[str, np.ndarray],
-    source: _ContactSource,
-    power: PowerBalance,
-    audit: Audit,
-    continuum: bool = False,
-    extreme_twists: tuple[dict[str, np.ndarray], ...] = (),
-    unbounded: bool = False,
-) -> Motion:
-    """A Motion whose ``contacts`` are made from ``source`` when first read (equal to an eager one).
-
-    Solves that only need the twists, statuses and audits (batches, benchmarks,
-    simulation steps) then never pay for one object per contact; the source
-    (arrays) also pickles faster than the objects would.
-    """
-    motion = object.__new__(Motion)
-    motion.__dict__.update(
-        twists=twists,
-        power=power,
-        audit=audit,
-        continuum=continuum,
-        extreme_twists=extreme_twists,
-        unbounded=unbounded,
-        _contact_source=source,
-    )
-    return motion
 
 
 @dataclass(frozen=True)
@@ -267,6 +315,25 @@ class Solution:
     forces_indeterminate : bool
         The motion is determined but the contact forces are not; each contact
         then carries ``normal_force_range``.
+    certified : bool
+        The verdict is proven: ``solved`` means the only motion, ``ambiguous``
+        lists motions that all satisfy the laws, ``jammed``/``unstable`` carry a
+        certificate. False for an answer found but not proven (the fast path's
+        first motion, the paper's global minimiser).
+    diagnosis : Diagnosis or None
+        Why no motion exists, for ``jammed`` and ``unstable``.
+    certificate : Certificate or None
+        The proof behind the verdict, when there is one to show.
+    search_complete : bool or None
+        For a search over motions: whether the list of motions is complete.
+    prescribed_modes : tuple or None
+        The contact modes the solve was asked to respect.
+    fallback : tuple of Attempt
+        Methods tried first whose answer was not kept, in order.
+    seconds : float
+        Wall time of the whole solve, audit included [s].
+    notes : tuple of (name, value) pairs
+        Solver-specific remarks for people (pivots, stages, formulations); ``details`` shows them as a dict.
     """
 
     status: Status
@@ -276,7 +343,14 @@ class Solution:
     motion: Motion | None = None
     solutions: tuple[Motion, ...] = ()
     forces_indeterminate: bool = False
-    details: dict[str, Any] = field(default_factory=dict)
+    certified: bool = False
+    diagnosis: Diagnosis | None = None
+    certificate: Certificate | None = None
+    search_complete: bool | None = None
+    prescribed_modes: tuple[Mode | None, ...] | None = None
+    fallback: tuple[Attempt, ...] = ()
+    seconds: float = 0.0
+    notes: tuple[tuple[str, Any], ...] = ()
 
     @property
     def twists(self) -> dict[str, np.ndarray]:
@@ -303,6 +377,32 @@ class Solution:
         """True for ``solved``: one motion, audited."""
         return self.status == "solved"
 
+    @property
+    def details(self) -> dict[str, Any]:
+        """The typed fields above as the flat dict of earlier versions (and of the JSON's ``details``).
+
+        Keys: ``uniqueness`` (when a motion is not certified), ``certificate`` (its text),
+        ``search`` ("complete" or why not), ``modes`` (prescribed), ``fallback``
+        ({method: message}), and every note.
+        """
+        out: dict[str, Any] = {}
+        if not self.certified and self.status in ("solved", "ambiguous"):
+            out["uniqueness"] = "not checked"
+        if self.certificate is not None:
+            out["certificate"] = self.certificate.text
+        if self.search_complete is not None:
+            out["search"] = (
+                "complete"
+                if self.search_complete
+                else f"stopped after {len(self.solutions) or int(self.motion is not None)} motions (limit or time)"
+            )
+        if self.prescribed_modes is not None:
+            out["modes"] = list(self.prescribed_modes)
+        out.update(dict(self.notes))
+        if self.fallback:
+            out["fallback"] = {attempt.method: attempt.message for attempt in self.fallback}
+        return out
+
     def to_dict(self) -> dict[str, Any]:
         """Exactly what ``quasistatic solve --json`` prints."""
         out: dict[str, Any] = {
@@ -310,6 +410,7 @@ class Solution:
             "message": self.message,
             "method": self.method,
             "friction": self.friction,
+            "certified": self.certified,
             "forces_indeterminate": self.forces_indeterminate,
         }
         if self.motion is not None:
@@ -321,8 +422,14 @@ class Solution:
         else:
             out["bodies"], out["contacts"], out["power"], out["audit"] = {}, [], None, None
         out["solutions"] = [m.to_dict() for m in self.solutions]
-        if self.details:
-            out["details"] = self.details
+        out["diagnosis"] = None if self.diagnosis is None else self.diagnosis.value
+        out["certificate"] = None if self.certificate is None else self.certificate.to_dict()
+        out["search_complete"] = self.search_complete
+        out["fallback"] = [{"method": a.method, "message": a.message} for a in self.fallback]
+        out["seconds"] = float(self.seconds)
+        details = self.details
+        if details:
+            out["details"] = details
         return out
 
 

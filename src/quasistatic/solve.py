@@ -1,25 +1,28 @@
-"""The one verb: ``solve(scene)``. Dispatches to a backend, then audits every motion."""
+"""The one verb: ``solve(scene)``. Assembles, dispatches to a backend, then audits every motion.
+
+Pipeline: Scene ─▶ :func:`~quasistatic.laws.assemble` ─▶ a backend from the
+registry ─▶ :func:`_audited`: each raw motion converted to physical units
+(:mod:`quasistatic.laws.motion`) and audited on the original scene data
+(:mod:`quasistatic.check`) ─▶ :class:`Solution`. A motion that fails its
+audit is never reported as a success.
+"""
 
 from __future__ import annotations
 
 import dataclasses
-import functools
-import sys
+import time
 from collections.abc import Sequence
-from types import ModuleType
 
-from .audit import DEFAULT_TOLERANCE
-from .backends.base import BackendResult, Options
-from .backends.registry import BACKENDS, Backend, Solver, get_backend
+from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
 from .errors import QuasistaticError
-from .evaluate import derived, to_motion
-from .problem import Problem, assemble
-from .scene import Scene
-from .solution import Mode, Motion, Solution
+from .laws import Problem, RawMotion, assemble, physical_twists, to_world
+from .model import Scene
+from .solution import Attempt, Mode, Motion, Solution
+from .solvers import BACKENDS, BackendResult, Options, Range, get_backend
 
-__all__ = ["solve", "METHODS"]
+__all__ = ["solve", "METHODS", "audited_raw_motion"]
 
-METHODS = ("auto", "lp", "fast", "scip", "paper")
+METHODS = ("auto", *BACKENDS)
 _MODE_NAMES = ("rolling", "sliding", "separating")
 
 
@@ -61,64 +64,40 @@ def solve(
     Solution
         Every motion in it has been audited on the original scene data.
     """
+    started = time.perf_counter()
     problem = scene if isinstance(scene, Problem) else assemble(scene)
     checked = _check_modes(modes, problem)
-    options = _options(max_solutions, time_limit) if checked is None else Options(max_solutions, checked, time_limit)
+    options = Options(max_solutions, checked, time_limit)
     names = _choose(method, problem, checked is not None, all_solutions)
-    fallback: dict[str, str] = {}
+    tried: list[Attempt] = []
     for name in names:
         backend = get_backend(name)
-        if backend.frictionless_only and not _is_frictionless(problem):
+        if not backend.frictional and not problem.is_frictionless:
             raise QuasistaticError(
                 f"method {name!r} is frictionless but contacts {_frictional(problem)} have mu > 0; "
                 "use method 'auto', or set 'friction: none' to drop friction on purpose"
             )
-        solution = _audited(problem, _load(backend)(problem, options), name, tolerance)
-        if fallback:
-            solution = dataclasses.replace(solution, details={**solution.details, "fallback": fallback})
+        solution = _audited(problem, backend.solver(problem, options), name, tolerance, options, tuple(tried), started)
         if solution.ok or name == names[-1]:
             return solution
-        fallback[name] = solution.message
+        tried.append(Attempt(name, solution.message))
     raise AssertionError("unreachable: the last method always returns")
 
 
 def _choose(method: str, problem: Problem, modes_given: bool, all_solutions: bool) -> tuple[str, ...]:
     """Methods to try in order; a later one runs only when the earlier one found no audited motion."""
     if method != "auto":
-        get_backend(method)
-        if modes_given and method != "scip":
+        backend = get_backend(method)
+        if modes_given and not backend.prescribes_modes:
             raise ValueError(f"modes: method {method!r} cannot prescribe contact modes; use method 'auto' or 'scip'")
-        if all_solutions and method in ("fast", "paper"):
+        if all_solutions and not (backend.lists_all_motions or not backend.frictional):
             raise ValueError(f"all_solutions: method {method!r} finds one motion; use method 'auto' or 'scip'")
         return (method,)
-    if _is_frictionless(problem) and not modes_given:
+    if problem.is_frictionless and not modes_given:
         return ("lp",)
-    if modes_given or all_solutions or "fast" not in BACKENDS:
+    if modes_given or all_solutions:
         return ("scip",)
     return ("fast", "scip")
-
-
-@functools.lru_cache(maxsize=64)
-def _options(max_solutions: int, time_limit: float) -> Options:
-    """Options without prescribed modes (frozen, so one object serves every solve that uses them)."""
-    return Options(max_solutions=max_solutions, time_limit=time_limit)
-
-
-def _load(backend: Backend) -> Solver:
-    """``backend.load()``, whose import (and availability check) runs once per registry entry."""
-    module = _MODULES.get(backend)
-    if module is None:
-        # load() raises BackendUnavailableError with the install hint when the backend is missing.
-        module = _MODULES[backend] = sys.modules[getattr(backend.load(), "__module__", "")]
-    solver: Solver = getattr(module, backend.function)
-    return solver
-
-
-_MODULES: dict[Backend, ModuleType] = {}
-
-
-def _is_frictionless(problem: Problem) -> bool:
-    return derived(problem, "frictionless", lambda p: p.is_frictionless)
 
 
 def _frictional(problem: Problem) -> list[int]:
@@ -137,34 +116,54 @@ def _check_modes(modes: Sequence[Mode | None] | None, problem: Problem) -> tuple
     return modes
 
 
-def _audited(problem: Problem, result: BackendResult, method: str, tolerance: float) -> Solution:
+def audited_raw_motion(problem: Problem, raw: RawMotion, ranges: list[Range] | None, tolerance: float) -> Motion:
+    """A backend's raw motion in physical units, audited on the original scene data."""
+    scales = problem.scales
+    geometry = problem.derived("motion_geometry", lambda p: MotionGeometry(p.scene, p.scales))
+    T, forces = to_world(problem, raw.q, raw.c)
+    physical_ranges = None if ranges is None else [(lo * scales.force, None if hi is None else hi * scales.force) for lo, hi in ranges]
+    extremes = tuple(physical_twists(problem, e) for e in raw.extremes)
+    return audited_motion(
+        geometry,
+        scales,
+        T,
+        forces,
+        ranges=physical_ranges,
+        extreme_twists=extremes,
+        continuum=raw.continuum,
+        unbounded=raw.unbounded,
+        tolerance=tolerance,
+    )
+
+
+def _audited(
+    problem: Problem, result: BackendResult, method: str, tolerance: float, options: Options, fallback: tuple[Attempt, ...], started: float
+) -> Solution:
     """Turn raw motions into audited ones; a motion that fails its audit is never a success."""
-    friction = str(problem.friction)
-    motions: list[Motion] = []
-    for raw in result.motions:
-        ranges = result.force_ranges if len(result.motions) == 1 else None
-        motion = to_motion(problem, raw, ranges, tolerance)
-        motions.append(motion)
-    failed = [m for m in motions if not m.audit.passed]
-    if failed:
-        laws = ", ".join(sorted({law for m in failed for law in m.audit.failures()}))
-        return Solution(
-            "failed",
-            f"failed: {method} returned a motion that violates the laws ({laws}); it is not reported as a solution",
-            method,
-            friction,
-            motion=failed[0],
-            details=result.details,
-        )
-    primary = motions[0] if motions else None
-    solutions = tuple(motions) if result.status == "ambiguous" else ()
-    return Solution(
+    ranges = result.force_ranges if len(result.motions) == 1 else None
+    motions = [audited_raw_motion(problem, raw, ranges, tolerance) for raw in result.motions]
+    solution = Solution(
         result.status,
         result.message,
         method,
-        friction,
-        motion=primary,
-        solutions=solutions,
+        str(problem.friction),
+        motion=motions[0] if motions else None,
+        solutions=tuple(motions) if result.status == "ambiguous" else (),
         forces_indeterminate=result.force_ranges is not None and result.status == "solved",
-        details=result.details,
+        certified=result.certified and result.status != "failed",
+        diagnosis=result.diagnosis,
+        certificate=result.certificate,
+        search_complete=result.search_complete,
+        prescribed_modes=options.modes,
+        fallback=fallback,
+        notes=result.notes,
+        seconds=time.perf_counter() - started,
+    )
+    failed = [m for m in motions if not m.audit.passed]
+    if not failed:
+        return solution
+    laws = ", ".join(sorted({law for m in failed for law in m.audit.failures()}))
+    message = f"failed: {method} returned a motion that violates the laws ({laws}); it is not reported as a solution"
+    return dataclasses.replace(
+        solution, status="failed", message=message, motion=failed[0], solutions=(), forces_indeterminate=False, certified=False
     )

@@ -1,1 +1,0 @@
-"""Solver backends, one per module, behind a registry keyed by name."""

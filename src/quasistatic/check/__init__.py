@@ -1,0 +1,20 @@
+"""The independent judge: every motion is audited against the laws on the original scene data.
+
+Imports ``model`` (and the leaf modules ``solution``, ``tolerances``, ``jit``)
+only: no assembly and no solver code, so a bug there cannot hide here.
+"""
+
+from .audit import DEFAULT_TOLERANCE, AuditGeometry, audit_motion, audit_motion_velocities, power_balance, relative_velocities
+from .motion import ContactTable, MotionGeometry, audited_motion
+
+__all__ = [
+    "DEFAULT_TOLERANCE",
+    "AuditGeometry",
+    "ContactTable",
+    "MotionGeometry",
+    "audit_motion",
+    "audit_motion_velocities",
+    "audited_motion",
+    "power_balance",
+    "relative_velocities",
+]

@@ -1,0 +1,134 @@
+"""An audited :class:`~quasistatic.solution.Motion` from physical twists and world forces.
+
+The audit runs at once; each contact's mode and result (:class:`ContactResult`)
+are made from the audit's own arrays when first read, so a mode is always
+what the audit measured, never what a solver claimed.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..model import Scales, Scene
+from ..solution import ContactResult, Mode, Motion
+from ..tolerances import AUDIT, MODE_SPEED
+from .audit import AuditGeometry, audit_arrays
+
+__all__ = ["audited_motion", "ContactTable", "MotionGeometry"]
+
+Range = tuple[float, float | None]
+
+
+class MotionGeometry:
+    """What :func:`audited_motion` reads of a scene: the audit's arrays, contact pairs, the mode threshold.
+
+    Build it once per scene (:meth:`of`) and pass it to every motion of that scene.
+    """
+
+    def __init__(self, scene: Scene, scales: Scales) -> None:
+        self.audit = AuditGeometry.of(scene)
+        self.names = tuple(b.name for b in scene.bodies)
+        self.pairs = tuple((c.body, c.other) for c in scene.contacts)
+        self.threshold = MODE_SPEED * scales.velocity
+
+    @classmethod
+    def of(cls, scene: Scene, scales: Scales) -> MotionGeometry:
+        return cls(scene, scales)
+
+
+def audited_motion(
+    geometry: MotionGeometry,
+    scales: Scales,
+    twists: np.ndarray,
+    forces: np.ndarray,
+    *,
+    ranges: list[Range] | None = None,
+    extreme_twists: tuple[dict[str, np.ndarray], ...] = (),
+    continuum: bool = False,
+    unbounded: bool = False,
+    tolerance: float = AUDIT,
+) -> Motion:
+    """Audit one motion on the original scene data and name each contact's mode.
+
+    Parameters
+    ----------
+    twists : (bodies, k)
+        Physical body twists in scene order [length/time, rad/time].
+    forces : (m, d)
+        World contact forces on each contact's ``body`` [force].
+    ranges : list of (lo, hi) or None
+        Physical normal-force ranges, when the forces are indeterminate [force].
+    """
+    audit, power, evaluation = audit_arrays(geometry.audit, twists, forces, scales, tolerance)
+    table = ContactTable(geometry.pairs, forces, evaluation.slips, evaluation.normal, geometry.threshold, ranges)
+    named = dict(zip(geometry.names, twists, strict=True))
+    return Motion(named, table, power, audit, continuum, extreme_twists, unbounded)
+
+
+class ContactTable:
+    """One motion's per-contact results as arrays (physical units, world frame); a
+    :class:`~quasistatic.solution.ContactSource` that makes :class:`ContactResult` objects on demand.
+
+    Attributes
+    ----------
+    pairs : ``(body, other)`` of each contact
+    forces, slips : (m, d) contact force on ``body`` and tangential relative velocity
+    normal : (m, 3) normal velocity, slip speed and normal force of each contact
+    threshold : speed below which a contact is not moving [length/time]
+    ranges : physical normal-force ranges, or None
+    """
+
+    __slots__ = ("pairs", "forces", "slips", "normal", "threshold", "ranges")
+
+    def __init__(
+        self,
+        pairs: tuple[tuple[str, str], ...],
+        forces: np.ndarray,
+        slips: np.ndarray,
+        normal: np.ndarray,
+        threshold: float,
+        ranges: list[Range] | None,
+    ) -> None:
+        self.pairs, self.forces, self.slips, self.normal = pairs, forces, slips, normal
+        self.threshold, self.ranges = threshold, ranges
+
+    def __getstate__(self) -> tuple[object, ...]:
+        # Floats in lists: pickling a few small arrays costs more than the numbers in them.
+        arrays = (self.forces, self.slips, self.normal)
+        return (self.pairs, self.threshold, self.ranges, *((a.shape, a.ravel().tolist()) for a in arrays))
+
+    def __setstate__(self, state: tuple[Any, ...]) -> None:
+        self.pairs, self.threshold, self.ranges = state[:3]
+        self.forces, self.slips, self.normal = (np.array(values, dtype=float).reshape(shape) for shape, values in state[3:])
+
+    def modes(self) -> tuple[Mode, ...]:
+        threshold = self.threshold
+        return tuple(_mode(u_n, speed, threshold) for u_n, speed, _ in self.normal.tolist())
+
+    def results(self) -> tuple[ContactResult, ...]:
+        ranges: list[Range | None] = list(self.ranges) if self.ranges else [None] * len(self.pairs)
+        return tuple(
+            ContactResult(
+                body=body,
+                other=other,
+                mode=_mode(u_n, speed, self.threshold),
+                force=force,
+                normal_force=f_n,
+                slip=slip,
+                normal_velocity=u_n,
+                normal_force_range=range_i,
+            )
+            for (body, other), (u_n, speed, f_n), force, slip, range_i in zip(
+                self.pairs, self.normal.tolist(), self.forces, self.slips, ranges, strict=True
+            )
+        )
+
+
+def _mode(u_n: float, speed: float, threshold: float) -> Mode:
+    if u_n > threshold:
+        return "separating"
+    if speed > threshold:
+        return "sliding"
+    return "rolling"

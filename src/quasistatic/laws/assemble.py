@@ -1,0 +1,149 @@
+"""Assembly: a Scene becomes the matrices of the contact laws, in scene-relative units.
+
+Every quantity is divided by the scene's own scales (length, force, velocity,
+:class:`~quasistatic.model.Scales`), so one tolerance serves a scene in
+millimetres and grams as well as one in metres and kilograms, and the answer
+does not depend on where the world origin is.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, TypeVar, cast
+
+import numpy as np
+
+from ..model import FloatArray, FrictionModel, Scales, Scene, scene_scales
+from ..model.kinematics import contact_frame, mover_point_velocity, point_velocity_map
+
+__all__ = ["Problem", "assemble"]
+
+T = TypeVar("T")
+
+
+@dataclass(frozen=True)
+class Problem:
+    """The contact laws of one scene in scene-relative units.
+
+    With ``k`` = 3 (2-D) or 6 (3-D) twist entries per body, ``n`` free bodies,
+    ``m`` contacts and ``d`` the dimension:
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene this was assembled from (names, order, original data).
+    frames : (m, d, d)
+        Rows of each contact frame: the tangent(s), then the normal (into ``body``).
+    J : (m, d, k n)
+        Relative contact velocity per unit twist, in contact frames: ``u = J q - b``.
+    b : (m, d)
+        Velocity of the other body's material point (movers only), in contact frames.
+    g : (k n,)
+        Gravity plus applied wrench on each body, about its com.
+    mu : (m,)
+        Friction coefficients [-], zero under ``friction: none``.
+    friction : FrictionModel
+    scales : Scales
+    """
+
+    scene: Scene
+    frames: FloatArray
+    J: FloatArray
+    b: FloatArray
+    g: FloatArray
+    mu: FloatArray
+    friction: FrictionModel
+    scales: Scales
+    _derived: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __getstate__(self) -> dict[str, Any]:
+        # What a solve derived from this problem is rebuilt where it is needed, not pickled.
+        return {key: value for key, value in self.__dict__.items() if key != "_derived"}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state, _derived={})
+
+    def derived(self, key: str, build: Callable[[Problem], T]) -> T:
+        """``build(self)``, computed once and kept with this problem (problems are frozen).
+
+        For what a solver derives from a problem on every solve (contiguous
+        copies, index arrays, names): solving the same problem again, as
+        benchmarks, batches and simulations do, skips that work. ``key`` names
+        the derived value; one key, one ``build``.
+        """
+        values = self._derived
+        if key not in values:
+            values[key] = build(self)
+        return cast(T, values[key])
+
+    @property
+    def dimension(self) -> int:
+        return self.scene.dimension
+
+    @property
+    def n_contacts(self) -> int:
+        return int(self.J.shape[0])
+
+    @property
+    def n_dof(self) -> int:
+        return int(self.J.shape[2])
+
+    @property
+    def Jn(self) -> FloatArray:
+        """Normal rows of J, (m, k n)."""
+        return self.J[:, -1, :]
+
+    @property
+    def Jt(self) -> FloatArray:
+        """Tangent rows of J, (m, d - 1, k n)."""
+        return self.J[:, :-1, :]
+
+    @property
+    def bn(self) -> FloatArray:
+        return self.b[:, -1]
+
+    @property
+    def bt(self) -> FloatArray:
+        return self.b[:, :-1]
+
+    @property
+    def is_frictionless(self) -> bool:
+        return self.derived("frictionless", lambda p: not bool(np.any(p.mu > 0)))
+
+    def velocities(self, q: FloatArray) -> FloatArray:
+        """Relative contact velocities ``u = J q - b`` in contact frames, (m, d), at the scene-relative twist ``q``."""
+        return np.einsum("mdn,n->md", self.J, q) - self.b
+
+    def with_velocities(self, b: FloatArray) -> Problem:
+        """The same contacts with other prescribed velocities (scene-relative)."""
+        return Problem(self.scene, self.frames, self.J, b, self.g, self.mu, self.friction, self.scales)
+
+
+def assemble(scene: Scene) -> Problem:
+    """Build the scene-relative matrices of the contact laws."""
+    dim = scene.dimension
+    scales = scene_scales(scene)
+    L, V = scales.length, scales.velocity
+    k = scene.twist_size
+    n_dof = k * len(scene.bodies)
+    m = len(scene.contacts)
+    frames = np.empty((m, dim, dim))
+    J = np.zeros((m, dim, n_dof))
+    b = np.zeros((m, dim))
+    coms = {body.name: (body.com - scales.origin) / L for body in scene.bodies}
+    for i, contact in enumerate(scene.contacts):
+        frames[i] = contact_frame(contact.normal)
+        point = (contact.point - scales.origin) / L
+        world = np.zeros((dim, n_dof))
+        a = scene.body_index(contact.body)
+        world[:, a * k : (a + 1) * k] += point_velocity_map(point - coms[contact.body])
+        if contact.other in coms:
+            o = scene.body_index(contact.other)
+            world[:, o * k : (o + 1) * k] -= point_velocity_map(point - coms[contact.other])
+        else:
+            b[i] = frames[i] @ mover_point_velocity(scene, contact) / V
+        J[i] = frames[i] @ world
+    g = np.concatenate([scene.load(body) / scales.wrench_units(dim) for body in scene.bodies])
+    mu = np.array([c.mu for c in scene.contacts]) if scene.friction.kind != "none" else np.zeros(m)
+    return Problem(scene, frames, J, b, g, mu, scene.friction, scales)

@@ -1,0 +1,168 @@
+"""The exact contact laws with every contact's mode fixed: smooth equations, and their Jacobian.
+
+With the modes fixed, Coulomb's laws become equations (exact circular cones
+in 3-D, the two edges in 2-D):
+
+    sum_i J_i^T c_i + g = 0                       equilibrium (n rows)
+    u_n,i = 0                                     each closed contact
+    u_t,i = 0                                     each rolling contact (d - 1 rows)
+    c_t,i = -mu_i c_n,i u_t,i / |u_t,i|           each sliding contact (substituted, no unknowns)
+
+Unknowns ``x``: the twist ``q`` (n), then per closed contact its normal force
+and, when it rolls, its tangential force. The system is square. This module is
+the one place these laws are written: the fast path's Newton iteration (compiled
+with numba), the exact-cone refinement and the paper method's polish all
+solve it.
+
+Encoding: ``kind[i]`` is 0 (separating), 1 (rolling, frictional) or 2
+(sliding, or closed and frictionless); ``column[i]`` is where contact i's
+unknowns start in ``x`` and its equations start in the residual.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from ..jit import njit
+from ..model import FloatArray
+from .assemble import Problem
+from .modes import ModeMasks
+
+__all__ = ["SEPARATING", "ROLLING", "SLIDING", "system", "columns", "FixedModeLaws"]
+
+SEPARATING, ROLLING, SLIDING = 0, 1, 2
+IntArray = npt.NDArray[np.int64]
+
+
+@njit
+def columns(kind: IntArray, n: int, t: int) -> tuple[IntArray, int]:
+    """Where each contact's unknowns start, and the number of unknowns."""
+    m = kind.shape[0]
+    column = np.zeros(m, dtype=np.int64)
+    size = n
+    for i in range(m):
+        column[i] = size
+        size += 0 if kind[i] == SEPARATING else (1 + t if kind[i] == ROLLING else 1)
+    return column, size
+
+
+@njit
+def system(
+    J: FloatArray, b: FloatArray, mu: FloatArray, g: FloatArray, x: FloatArray, kind: IntArray, column: IntArray, n: int
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Residual (N,), Jacobian (N, N) of the fixed-mode laws at ``x``, and the contact forces (m, d) in contact frames.
+
+    ``J`` (m, d, n), ``b`` (m, d), ``mu`` (m,), ``g`` (n,) as in :class:`~quasistatic.laws.Problem`.
+    """
+    m, d = J.shape[0], J.shape[1]
+    t = d - 1
+    size = x.shape[0]
+    residual = np.zeros(size)
+    jacobian = np.zeros((size, size))
+    forces = np.zeros((m, d))
+    slip = np.zeros(t)
+    residual[:n] = g
+    for i in range(m):
+        if kind[i] == SEPARATING:
+            continue
+        for s in range(t):
+            slip[s] = -b[i, s]
+            for j in range(n):
+                slip[s] += J[i, s, j] * x[j]
+        col = column[i]
+        cn = x[col]
+        forces[i, t] = cn
+        # Closed: no normal velocity; the normal force enters equilibrium.
+        residual[col] = -b[i, t]
+        for j in range(n):
+            residual[col] += J[i, t, j] * x[j]
+            jacobian[col, j] = J[i, t, j]
+            jacobian[j, col] += J[i, t, j]
+        if kind[i] == ROLLING:
+            for s in range(t):
+                forces[i, s] = x[col + 1 + s]
+                residual[col + 1 + s] = slip[s]
+                for j in range(n):
+                    jacobian[col + 1 + s, j] = J[i, s, j]
+                    jacobian[j, col + 1 + s] += J[i, s, j]
+        elif mu[i] > 0.0:
+            _sliding_friction(J, mu, i, cn, col, slip, n, forces, jacobian)
+        for j in range(n):
+            for s in range(d):
+                residual[j] += J[i, s, j] * forces[i, s]
+    return residual, jacobian, forces
+
+
+@njit
+def _sliding_friction(
+    J: FloatArray, mu: FloatArray, i: int, cn: float, col: int, slip: FloatArray, n: int, forces: FloatArray, jacobian: FloatArray
+) -> None:
+    """Friction ``-mu cn e`` (``e = slip/|slip|``) of sliding contact ``i`` into ``forces``, its derivatives into ``jacobian``.
+
+    d(-mu cn e)/d cn = -mu e;  d(-mu cn e)/d slip = -mu cn (I - e e^T) / |slip|  (zero in 2-D, where e is a sign).
+    """
+    t = slip.shape[0]
+    speed = np.sqrt(np.sum(slip * slip))
+    if speed <= 0.0:
+        return
+    e = slip / speed
+    k = -mu[i] * cn / speed
+    for s in range(t):
+        forces[i, s] = -mu[i] * cn * e[s]
+    for j in range(n):
+        for s in range(t):
+            jacobian[j, col] += J[i, s, j] * (-mu[i] * e[s])
+        for k2 in range(n):
+            total = 0.0
+            for s in range(t):
+                for r in range(t):
+                    projector = k * ((1.0 if s == r else 0.0) - e[s] * e[r])
+                    total += J[i, s, j] * projector * J[i, r, k2]
+            jacobian[j, k2] += total
+
+
+class FixedModeLaws:
+    """The fixed-mode laws of one problem and one mode pattern, for a least-squares solver.
+
+    Parameters
+    ----------
+    problem : Problem
+    masks : ModeMasks
+        Closed, rolling and sliding contacts.
+    """
+
+    def __init__(self, problem: Problem, masks: ModeMasks) -> None:
+        self.problem, self.masks = problem, masks
+        kind = np.where(masks.closed, np.where(masks.rolling, ROLLING, SLIDING), SEPARATING).astype(np.int64)
+        self.kind = kind
+        self.n, self.t = problem.n_dof, problem.dimension - 1
+        self.column, self.size = columns(kind, self.n, self.t)
+        self.J, self.b = np.ascontiguousarray(problem.J, dtype=float), np.ascontiguousarray(problem.b, dtype=float)
+        self.mu, self.g = np.ascontiguousarray(problem.mu, dtype=float), np.ascontiguousarray(problem.g, dtype=float)
+
+    def start(self, q: FloatArray, c: FloatArray, nonnegative: bool = True) -> FloatArray:
+        """The unknowns at twist ``q`` with contact-frame forces ``c`` (m, d); negative normal forces clipped to 0 if ``nonnegative``."""
+        x = np.zeros(self.size)
+        x[: self.n] = q
+        for i in np.flatnonzero(self.kind != SEPARATING):
+            x[self.column[i]] = max(float(c[i, -1]), 0.0) if nonnegative else float(c[i, -1])
+            if self.kind[i] == ROLLING:
+                x[self.column[i] + 1 : self.column[i] + 1 + self.t] = c[i, :-1]
+        return x
+
+    def lower_bounds(self) -> FloatArray:
+        """Normal forces >= 0, everything else free."""
+        lower = np.full(self.size, -np.inf)
+        lower[self.column[self.kind != SEPARATING]] = 0.0
+        return lower
+
+    def residual(self, x: FloatArray) -> FloatArray:
+        return system(self.J, self.b, self.mu, self.g, x, self.kind, self.column, self.n)[0]
+
+    def jacobian(self, x: FloatArray) -> FloatArray:
+        return system(self.J, self.b, self.mu, self.g, x, self.kind, self.column, self.n)[1]
+
+    def motion(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Twist (n,) and contact-frame forces (m, d) at ``x``."""
+        return x[: self.n].copy(), system(self.J, self.b, self.mu, self.g, x, self.kind, self.column, self.n)[2]

@@ -1,0 +1,94 @@
+"""A solver's motion in scene-relative units, and its conversion to physical units and world frame."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..jit import HAVE_NUMBA, njit
+from ..model import FloatArray
+from .assemble import Problem
+
+__all__ = ["RawMotion", "WorldLayout", "to_world", "physical_twists"]
+
+
+@dataclass(frozen=True)
+class RawMotion:
+    """A backend's answer in scene-relative units.
+
+    Attributes
+    ----------
+    q : (k n,)
+        Stacked body twists.
+    c : (m, d)
+        Contact forces in contact frames (tangent(s), normal), on ``body``.
+    extremes : tuple of (k n,) arrays
+        For a continuum of motions: its extreme twists.
+    unbounded : bool
+        For a continuum: it extends to infinity.
+    """
+
+    q: FloatArray
+    c: FloatArray
+    extremes: tuple[FloatArray, ...] = ()
+    unbounded: bool = False
+
+    @property
+    def continuum(self) -> bool:
+        return bool(self.extremes) or self.unbounded
+
+
+class WorldLayout:
+    """What the conversion to physical units needs of a problem: body names, twist units, contact frames.
+
+    Built once per problem (:meth:`Problem.derived`).
+    """
+
+    def __init__(self, problem: Problem) -> None:
+        scene, scales = problem.scene, problem.scales
+        k, d = scene.twist_size, scene.dimension
+        self.names = tuple(b.name for b in scene.bodies)
+        self.units = np.array([scales.velocity] * d + [scales.velocity / scales.length] * (k - d))
+        self.frames = np.ascontiguousarray(problem.frames, dtype=float)
+
+
+def _layout(problem: Problem) -> WorldLayout:
+    return problem.derived("world_layout", WorldLayout)
+
+
+def physical_twists(problem: Problem, q: FloatArray) -> dict[str, FloatArray]:
+    """Scene-relative stacked twists to named physical twists."""
+    layout = _layout(problem)
+    return dict(zip(layout.names, np.reshape(q, (-1, layout.units.size)) * layout.units, strict=True))
+
+
+def to_world(problem: Problem, q: FloatArray, c: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Physical twists (bodies, k) and world contact forces (m, d) of a scene-relative ``q`` and ``c``."""
+    layout = _layout(problem)
+    force = problem.scales.force
+    if HAVE_NUMBA:
+        q, c = np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(c, dtype=float)
+        return _to_world_kernel(q, c, layout.frames, layout.units, force)
+    T = np.reshape(q, (-1, layout.units.size)) * layout.units
+    return T, np.matmul(c[:, None, :], layout.frames)[:, 0, :] * force
+
+
+@njit
+def _to_world_kernel(q: FloatArray, c: FloatArray, frames: FloatArray, units: FloatArray, force: float) -> tuple[FloatArray, FloatArray]:
+    """:func:`to_world` as one compiled loop (a few numpy calls cost more than the arithmetic on small scenes)."""
+    k = units.shape[0]
+    bodies = q.shape[0] // k
+    T = np.empty((bodies, k))
+    for a in range(bodies):
+        for j in range(k):
+            T[a, j] = q[a * k + j] * units[j]
+    m, d = c.shape
+    forces = np.zeros((m, d))
+    for i in range(m):
+        for j in range(d):
+            total = 0.0
+            for s in range(d):
+                total += c[i, s] * frames[i, s, j]
+            forces[i, j] = total * force
+    return T, forces

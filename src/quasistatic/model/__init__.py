@@ -1,0 +1,25 @@
+"""The model: what a scene is (bodies, movers, robots, contacts, friction), its kinematics, scales and files.
+
+Imports nothing of the package above it (only ``errors`` and ``tolerances``);
+every other stage reads a :class:`Scene`, which is validated here once.
+"""
+
+from .friction import FrictionModel, parse_friction
+from .io import FORMAT_VERSION, load_scene
+from .scales import Scales, scene_scales
+from .scene import Body, Contact, FloatArray, Mover, Robot, Scene
+
+__all__ = [
+    "FORMAT_VERSION",
+    "Body",
+    "Contact",
+    "FloatArray",
+    "FrictionModel",
+    "Mover",
+    "Robot",
+    "Scales",
+    "Scene",
+    "load_scene",
+    "parse_friction",
+    "scene_scales",
+]

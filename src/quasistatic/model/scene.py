@@ -1,0 +1,404 @@
+"""Scenes: free bodies, movers, robots and contacts, validated once and frozen.
+
+Each part converts its own numbers to read-only float arrays when it is
+built; :class:`Scene` then checks what needs the whole scene (lengths for the
+dimension, names, unit normals, robot Jacobians) and keeps *new* parts with
+the defaults filled in, so the caller's objects are never changed. Later
+stages can trust a Scene without checking it again.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+from collections.abc import Collection, Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import SceneError
+from ..tolerances import NORMAL_LENGTH
+from .friction import FrictionModel, parse_friction
+
+__all__ = ["Body", "Mover", "Robot", "Contact", "Scene", "FloatArray"]
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def _array(value: Any, path: str, ndim: int = 1) -> FloatArray:
+    """A read-only float array of ``ndim`` dimensions, every entry finite."""
+    what = "a list of numbers" if ndim == 1 else "a matrix (list of rows) of numbers"
+    if isinstance(value, (str, bytes, bool)):
+        raise SceneError(path, value, f"expected {what}")
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise SceneError(path, value, f"expected {what}") from None
+    if array.ndim != ndim:
+        raise SceneError(path, value, f"expected {what}")
+    if not np.all(np.isfinite(array)):
+        raise SceneError(path, value, "every entry must be a finite number (no NaN or inf)")
+    array.setflags(write=False)
+    return array
+
+
+def _number(value: Any, path: str, minimum: float | None = None) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise SceneError(path, value, "expected a number")
+    number = float(value)
+    if not math.isfinite(number):
+        raise SceneError(path, value, "must be a finite number (no NaN or inf)")
+    if minimum is not None and number < minimum:
+        raise SceneError(path, value, f"must be >= {minimum:g}")
+    return number
+
+
+def _name(value: Any, path: str) -> str:
+    if not isinstance(value, str) or not value:
+        raise SceneError(path, value, "names must be non-empty strings")
+    return value
+
+
+def _assign(obj: object, **values: Any) -> None:
+    """Set the fields of a frozen part while it is being built (its own ``__init__`` only)."""
+    for key, value in values.items():
+        object.__setattr__(obj, key, value)
+
+
+@dataclass(frozen=True, init=False)
+class Body:
+    """A free rigid body: its motion is what is solved for.
+
+    Attributes
+    ----------
+    name : str
+    mass : float
+        Mass [kg or any consistent unit], >= 0.
+    com : array (d,)
+        Centre of mass, world frame [length].
+    wrench : array (3,) in 2-D or (6,) in 3-D, or None
+        Applied wrench: force, then moment about the com. Zero once in a Scene if omitted.
+    """
+
+    name: str
+    mass: float
+    com: FloatArray
+    wrench: FloatArray | None
+
+    def __init__(self, name: str, mass: float, com: npt.ArrayLike, wrench: npt.ArrayLike | None = None) -> None:
+        path = f"bodies.{name}"
+        _assign(
+            self,
+            name=_name(name, "bodies"),
+            mass=_number(mass, f"{path}.mass", minimum=0.0),
+            com=_array(com, f"{path}.com"),
+            wrench=None if wrench is None else _array(wrench, f"{path}.wrench"),
+        )
+
+
+@dataclass(frozen=True, init=False)
+class Mover:
+    """A body whose motion is prescribed: fixed, a rigid twist, or a robot link.
+
+    Attributes
+    ----------
+    name : str
+    twist : array (3,) in 2-D or (6,) in 3-D, or None
+        Linear velocity of the point ``origin``, then angular velocity (world frame); zero once in a Scene if omitted.
+    origin : array (d,) or None
+        Reference point of ``twist``; the world origin once in a Scene if omitted.
+    robot : str, optional
+        Name of the robot driving this link; its contacts then carry a ``jacobian``.
+    """
+
+    name: str
+    twist: FloatArray | None
+    origin: FloatArray | None
+    robot: str | None
+
+    def __init__(
+        self, name: str, twist: npt.ArrayLike | None = None, origin: npt.ArrayLike | None = None, robot: str | None = None
+    ) -> None:
+        path = f"movers.{name}"
+        if robot is not None and not isinstance(robot, str):
+            raise SceneError(f"{path}.robot", robot, "expected a robot's name")
+        _assign(
+            self,
+            name=_name(name, "movers"),
+            twist=None if twist is None else _array(twist, f"{path}.twist"),
+            origin=None if origin is None else _array(origin, f"{path}.origin"),
+            robot=robot,
+        )
+
+
+@dataclass(frozen=True, init=False)
+class Robot:
+    """A robot given by its joint velocities [rad/s or length/s per joint]."""
+
+    name: str
+    joint_velocities: FloatArray
+
+    def __init__(self, name: str, joint_velocities: npt.ArrayLike) -> None:
+        _assign(
+            self,
+            name=_name(name, "robots"),
+            joint_velocities=_array(joint_velocities, f"robots.{name}.joint_velocities"),
+        )
+
+
+@dataclass(frozen=True, init=False)
+class Contact:
+    """A point contact between a free body and another body.
+
+    Attributes
+    ----------
+    body : str
+        The free body; ``normal`` points into it and ``force`` acts on it.
+    other : str
+        A mover or another free body.
+    point : array (d,)
+        Contact point, world frame [length].
+    normal : array (d,)
+        Unit normal into ``body`` (normalised once in a Scene if within 1e-3 of unit length).
+    mu : float
+        Coulomb friction coefficient [-], >= 0.
+    jacobian : array (d, n_joints), optional
+        For a robot-driven ``other``: world velocity of its material point at
+        ``point`` per unit joint velocity.
+    """
+
+    body: str
+    other: str
+    point: FloatArray
+    normal: FloatArray
+    mu: float
+    jacobian: FloatArray | None
+
+    def __init__(
+        self,
+        body: str,
+        other: str,
+        point: npt.ArrayLike,
+        normal: npt.ArrayLike,
+        mu: float = 0.0,
+        jacobian: npt.ArrayLike | None = None,
+    ) -> None:
+        _assign(
+            self,
+            body=_name(body, "contact.body"),
+            other=_name(other, "contact.other"),
+            point=_array(point, "contact.point"),
+            normal=_array(normal, "contact.normal"),
+            mu=_number(mu, "contact.mu", minimum=0.0),
+            jacobian=None if jacobian is None else _array(jacobian, "contact.jacobian", ndim=2),
+        )
+
+
+@dataclass(frozen=True, init=False)
+class Scene:
+    """A validated, frozen scene. Construction checks everything.
+
+    Attributes
+    ----------
+    bodies, movers, robots, contacts : tuples of the parts above
+        Contacts keep their order in every output.
+    dimension : {2, 3}
+        2 means planar, in the x-y plane.
+    gravity : array (d,)
+        Gravitational acceleration; [0, 0, -9.81] (3-D) or [0, -9.81] (2-D) when given as None.
+    friction : FrictionModel
+        ``exact`` (default), ``pyramid:K`` or ``none`` (a string is parsed).
+    """
+
+    bodies: tuple[Body, ...]
+    contacts: tuple[Contact, ...]
+    movers: tuple[Mover, ...]
+    robots: tuple[Robot, ...]
+    dimension: int
+    gravity: FloatArray
+    friction: FrictionModel
+
+    def __init__(
+        self,
+        bodies: Iterable[Body],
+        contacts: Iterable[Contact],
+        movers: Iterable[Mover] = (),
+        robots: Iterable[Robot] = (),
+        dimension: int = 3,
+        gravity: npt.ArrayLike | None = None,
+        friction: FrictionModel | str = "exact",
+    ) -> None:
+        if isinstance(dimension, bool) or dimension not in (2, 3):
+            raise SceneError("dimension", dimension, "must be 2 or 3")
+        model = _friction(friction, dimension)
+        default_gravity = [0.0, -9.81] if dimension == 2 else [0.0, 0.0, -9.81]
+        gravity_vector = _sized(_array(default_gravity if gravity is None else gravity, "gravity"), dimension, "gravity")
+        parts = _Parts(dimension, tuple(bodies), tuple(movers), tuple(robots))
+        _assign(
+            self,
+            bodies=parts.bodies,
+            movers=parts.movers,
+            robots=parts.robots,
+            contacts=tuple(parts.contact(c, f"contacts[{i}]") for i, c in enumerate(contacts)),
+            dimension=dimension,
+            gravity=gravity_vector,
+            friction=model,
+        )
+
+    def body_index(self, name: str) -> int:
+        """Index of a free body by name."""
+        return [b.name for b in self.bodies].index(name)
+
+    def mover(self, name: str) -> Mover:
+        """A mover by name."""
+        return next(m for m in self.movers if m.name == name)
+
+    def robot(self, name: str) -> Robot:
+        """A robot by name."""
+        return next(r for r in self.robots if r.name == name)
+
+    def is_body(self, name: str) -> bool:
+        """True when ``name`` is a free body (else it is a mover)."""
+        return any(b.name == name for b in self.bodies)
+
+    def load(self, body: Body) -> FloatArray:
+        """Gravity plus applied wrench on ``body``, about its com [force, force x length]."""
+        wrench = np.zeros(self.twist_size) if body.wrench is None else np.array(body.wrench, dtype=float)
+        wrench[: self.dimension] += body.mass * self.gravity
+        return wrench
+
+    @property
+    def twist_size(self) -> int:
+        """Entries in one body twist: 3 in 2-D, 6 in 3-D."""
+        return 3 if self.dimension == 2 else 6
+
+
+def _friction(friction: FrictionModel | str, dimension: int) -> FrictionModel:
+    model = parse_friction(friction) if isinstance(friction, str) else friction
+    if not isinstance(model, FrictionModel):
+        raise SceneError("friction", friction, "expected 'exact', 'none' or 'pyramid:K'")
+    if model.kind == "pyramid" and dimension == 2:
+        raise SceneError("friction", str(model), "pyramid:K is for 3-D; the 2-D cone is already exact")
+    return model
+
+
+def _sized(vector: FloatArray, length: int, path: str) -> FloatArray:
+    if vector.shape != (length,):
+        raise SceneError(path, vector.tolist(), f"expected a list of {length} numbers")
+    return vector
+
+
+class _Parts:
+    """The scene's bodies, movers and robots checked together, with their defaults filled in (new objects)."""
+
+    def __init__(self, dimension: int, bodies: tuple[Body, ...], movers: tuple[Mover, ...], robots: tuple[Robot, ...]) -> None:
+        self.dimension = dimension
+        self.twist_size = 3 if dimension == 2 else 6
+        if not bodies:
+            raise SceneError("bodies", [], "at least one free body is required")
+        _check_types(bodies, Body, "bodies")
+        _check_types(movers, Mover, "movers")
+        _check_types(robots, Robot, "robots")
+        _check_unique_names(bodies, movers, robots)
+        self.robots = robots
+        self.robot_joints = {r.name: r.joint_velocities.size for r in robots}
+        self.bodies = tuple(self._body(b) for b in bodies)
+        self.movers = tuple(self._mover(m) for m in movers)
+        self.body_names = {b.name for b in bodies}
+        self.mover_robot = {m.name: m.robot for m in movers}
+
+    def _body(self, body: Body) -> Body:
+        path = f"bodies.{body.name}"
+        wrench = np.zeros(self.twist_size) if body.wrench is None else body.wrench
+        return dataclasses.replace(
+            body,
+            com=_sized(body.com, self.dimension, f"{path}.com"),
+            wrench=_sized(_array(wrench, path), self.twist_size, f"{path}.wrench"),
+        )
+
+    def _mover(self, mover: Mover) -> Mover:
+        path = f"movers.{mover.name}"
+        if mover.robot is not None:
+            if mover.twist is not None:
+                raise SceneError(
+                    f"{path}.twist", mover.twist.tolist(), "a robot-driven mover takes its motion from the robot; give no twist"
+                )
+            if mover.robot not in self.robot_joints:
+                raise SceneError(f"{path}.robot", mover.robot, _unknown("robot", mover.robot, self.robot_joints))
+        twist = np.zeros(self.twist_size) if mover.twist is None else mover.twist
+        origin = np.zeros(self.dimension) if mover.origin is None else mover.origin
+        return dataclasses.replace(
+            mover,
+            twist=_sized(_array(twist, path), self.twist_size, f"{path}.twist"),
+            origin=_sized(_array(origin, path), self.dimension, f"{path}.origin"),
+        )
+
+    def contact(self, contact: Contact, path: str) -> Contact:
+        if not isinstance(contact, Contact):
+            raise SceneError(path, type(contact).__name__, "expected a Contact")
+        self._check_pair(contact, path)
+        point = _sized(contact.point, self.dimension, f"{path}.point")
+        normal = _sized(contact.normal, self.dimension, f"{path}.normal")
+        length = float(np.linalg.norm(normal))
+        if abs(length - 1.0) > NORMAL_LENGTH:
+            raise SceneError(f"{path}.normal", normal.tolist(), f"must be a unit vector (its length is {length:.6g})")
+        return dataclasses.replace(contact, point=point, normal=normal / length, jacobian=self._jacobian(contact, path))
+
+    def _check_pair(self, contact: Contact, path: str) -> None:
+        if contact.body not in self.body_names:
+            reason = (
+                f"must be a free body; {contact.body!r} is a mover (contacts between two movers do not constrain anything)"
+                if contact.body in self.mover_robot
+                else _unknown("free body", contact.body, self.body_names)
+            )
+            raise SceneError(f"{path}.body", contact.body, reason)
+        if contact.other not in self.body_names and contact.other not in self.mover_robot:
+            raise SceneError(
+                f"{path}.other", contact.other, _unknown("body or mover", contact.other, self.body_names | set(self.mover_robot))
+            )
+        if contact.other == contact.body:
+            raise SceneError(f"{path}.other", contact.other, "a body cannot touch itself")
+
+    def _jacobian(self, contact: Contact, path: str) -> FloatArray | None:
+        robot = self.mover_robot.get(contact.other)
+        if robot is None:
+            if contact.jacobian is not None:
+                reason = f"only contacts with a robot-driven mover take a jacobian; {contact.other!r} is not one"
+                raise SceneError(f"{path}.jacobian", contact.jacobian.tolist(), reason)
+            return None
+        dim, joints = self.dimension, self.robot_joints[robot]
+        if contact.jacobian is None:
+            reason = f"required: {contact.other!r} is driven by robot {robot!r} ({dim} x {joints} expected)"
+            raise SceneError(f"{path}.jacobian", None, reason)
+        if contact.jacobian.shape != (dim, joints):
+            reason = f"expected shape ({dim}, {joints}): {dim} rows, one column per joint of robot {robot!r}"
+            raise SceneError(f"{path}.jacobian", f"shape {contact.jacobian.shape}", reason)
+        return contact.jacobian
+
+
+def _check_types(items: tuple[Any, ...], kind: type, path: str) -> None:
+    for index, item in enumerate(items):
+        if not isinstance(item, kind):
+            raise SceneError(f"{path}[{index}]", type(item).__name__, f"expected a {kind.__name__}")
+
+
+def _check_unique_names(bodies: tuple[Body, ...], movers: tuple[Mover, ...], robots: tuple[Robot, ...]) -> None:
+    names: dict[str, str] = {}
+    for kind, items in (("bodies", bodies), ("movers", movers)):
+        for item in items:
+            if item.name in names:
+                raise SceneError(f"{kind}.{item.name}", item.name, f"name already used in {names[item.name]}")
+            names[item.name] = kind
+    robot_names = [r.name for r in robots]
+    if len(set(robot_names)) != len(robot_names):
+        raise SceneError("robots", robot_names, "robot names must be unique")
+
+
+def _unknown(kind: str, name: Any, known: Collection[str] | Mapping[str, Any]) -> str:
+    names = sorted(known)
+    close = difflib.get_close_matches(str(name), names, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else f"; known: {', '.join(map(repr, names)) or 'none'}"
+    return f"no {kind} of that name{hint}"

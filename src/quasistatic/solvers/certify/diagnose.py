@@ -1,0 +1,87 @@
+"""Certified verdicts when no motion exists: ``jammed`` or ``unstable``, in that order.
+
+1. No twist keeps every contact closed or opening for the commanded mover
+   motion (``Jn q >= bn`` infeasible): jammed, with a Farkas certificate.
+2. No force distribution inside the friction cones balances the load:
+   unstable (no quasi-static equilibrium even with the movers stopped).
+3. Otherwise the commanded motion wedges the parts: jammed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...laws import Problem
+from ...laws.polyhedral import force_polytope
+from ...solution import Certificate, CertificateKind, Diagnosis, Status
+from ...tolerances import LP_FEASIBILITY
+from ..numerics.highs import solve_lp
+from ..result import BackendResult
+
+__all__ = ["diagnose", "equilibrium_exists", "kinematic_certificate", "MESSAGES", "no_motion"]
+
+MESSAGES = {
+    Diagnosis.KINEMATIC: (
+        "jammed: no motion of the free bodies is compatible with the commanded mover motion "
+        "(the movers would have to penetrate them); change the commanded motion"
+    ),
+    Diagnosis.WEDGED: (
+        "jammed: the parts could be held at rest, but friction wedges them against the commanded "
+        "motion (no solution with finite forces); change the commanded motion or reduce friction"
+    ),
+    Diagnosis.PRESCRIBED_MODES: "jammed: no motion exists with the prescribed contact modes",
+    Diagnosis.NO_EQUILIBRIUM: (
+        "unstable: no quasi-static equilibrium exists within the friction cones, so the object "
+        "falls, slides or accelerates; add support or friction"
+    ),
+}
+"""The message of each diagnosis (one sentence a person can act on)."""
+
+
+def no_motion(diagnosis: Diagnosis, certificate: Certificate) -> BackendResult:
+    """The certified verdict for a proven diagnosis."""
+    status: Status = "unstable" if diagnosis is Diagnosis.NO_EQUILIBRIUM else "jammed"
+    return BackendResult(status, MESSAGES[diagnosis], diagnosis=diagnosis, certificate=certificate)
+
+
+def kinematic_certificate(problem: Problem) -> np.ndarray | None:
+    """Multipliers y >= 0 with Jn^T y = 0, bn.y = 1 (proof of infeasibility), or None."""
+    Jn, bn = problem.Jn, problem.bn
+    m, n = Jn.shape
+    A = np.vstack([Jn.T, bn[None, :]])
+    rhs = np.r_[np.zeros(n), 1.0]
+    lp = solve_lp(np.zeros(m), A, rhs, rhs, np.zeros(m))
+    if lp.status == "optimal" and np.max(np.abs(A @ lp.x - rhs), initial=0.0) <= LP_FEASIBILITY:
+        return lp.x
+    return None
+
+
+def equilibrium_exists(problem: Problem, edges: np.ndarray) -> bool:
+    """True when some forces in the (polyhedral) cones spanned by ``edges`` balance the load."""
+    polytope = force_polytope(problem, edges)
+    cols = polytope.A.shape[1]
+    lp = solve_lp(np.zeros(cols), polytope.A, polytope.rhs, polytope.rhs, np.zeros(cols))
+    return lp.status == "optimal"
+
+
+def diagnose(problem: Problem, inner_edges: np.ndarray, outer_edges: np.ndarray | None = None) -> BackendResult:
+    """Explain why no motion exists. ``inner_edges`` span cones inside the true ones.
+
+    For the exact 3-D cone pass ``outer_edges`` too (a polygon around the circle):
+    no equilibrium with the outer cones proves none with the exact ones.
+    """
+    multipliers = kinematic_certificate(problem)
+    if multipliers is not None:
+        return no_motion(
+            Diagnosis.KINEMATIC, Certificate(CertificateKind.FARKAS, "kinematic (Farkas multipliers)", tuple(multipliers.tolist()))
+        )
+    if equilibrium_exists(problem, inner_edges):
+        text = "equilibrium exists; no motion found by the complete search"
+        return no_motion(Diagnosis.WEDGED, Certificate(CertificateKind.COMPLETE_SEARCH, text))
+    if outer_edges is None or not equilibrium_exists(problem, outer_edges):
+        text = "no equilibrium in the friction cones (LP infeasible)"
+        return no_motion(Diagnosis.NO_EQUILIBRIUM, Certificate(CertificateKind.INFEASIBLE_EQUILIBRIUM, text))
+    return BackendResult(
+        "failed",
+        "failed: no motion was found, and whether the exact cones admit an equilibrium is too close to call",
+    )

@@ -1,0 +1,353 @@
+"""Exact circular Coulomb cones in 3-D: a certified pyramid search, then exact refinement.
+
+An inscribed pyramid is exact for rolling contacts (its forces lie inside the
+cone) and for a sliding contact whose slip is exactly opposite one of its
+edges (the force then lies on the cone, opposite the slip). So: find every
+motion with an 8-edge pyramid by the certified search, then refine each one by
+solving the exact laws with its contact modes fixed (smooth equations, by
+least squares from the pyramid motion: a bounded trust region, then
+Levenberg-Marquardt if that stalls). A sliding contact of the pyramid may
+roll or separate under the circle, so those mode changes are tried too; where
+the least-squares forces of a statically indeterminate set leave the cones,
+the forces are recovered at the refined twist by an LP. Where 8 edges leave
+the answer undecided (a motion that does not refine, a wedge, no motion with
+prescribed modes, equilibrium too close to call), the search runs again with
+32 edges.
+
+What is proven: ``unstable`` (no equilibrium even in a pyramid circumscribing
+the exact cone), kinematic ``jammed`` (a Farkas certificate), wedged
+``jammed`` and "no motion with these modes" (a sector relaxation of the exact
+laws is infeasible, :mod:`.wedge`; failing that, the paper's exact program
+solved globally), and ``ambiguous`` (two distinct audited exact motions).
+The list of motions is complete for the pyramid; each reported motion
+satisfies the exact laws (the audit checks it), but motions of the exact cone
+that the pyramid misses are not excluded by proof, and the details say so.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from collections.abc import Iterator
+
+import numpy as np
+import scipy.optimize
+
+from ...laws import ModeMasks, Problem, RawMotion, contact_modes, slips
+from ...laws.fixed_modes import FixedModeLaws
+from ...laws.polyhedral import aligned_edges, polyhedral_form
+from ...solution import Certificate, CertificateKind, Diagnosis
+from ...tolerances import CONE_ROUNDOFF, FIXED_MODE_RESIDUAL, FREE_TWIST_DIRECTION, FRICTION_ALIGNMENT, MODE_SPEED, SAME_TWIST
+from ..numerics.highs import solve_lp
+from ..result import BackendResult, Options
+from .diagnose import diagnose, equilibrium_exists, no_motion
+from .min_power import solve_min_power
+from .search import enumerate_motions, summarise
+from .wedge import exact_cones_jam
+
+__all__ = ["solve_exact_3d", "SEARCH_EDGES"]
+
+SEARCH_EDGES = 8  # pyramid edges of the first certified search
+VERDICT_EDGES = 256  # polygons tried when the searched ones cannot decide between unstable and at rest
+WIDER_SEARCH_EDGES = 32  # the most edges the mixed-integer search is run with (its size grows with them)
+RANGE_EDGES = 64  # polygon used for force ranges at rolling contacts (inner, within 0.12 %)
+
+
+def solve_exact_3d(problem: Problem, options: Options) -> BackendResult:
+    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided."""
+    options = options.start_clock()
+    undecided, relaxed = "", False
+    for count in (SEARCH_EDGES, WIDER_SEARCH_EDGES):
+        result, undecided = _search(problem, options, count)
+        if result is not None:
+            return result
+        if undecided in ("wedged", "modes") and not relaxed:  # the pyramid has no motion: try to prove it for the circle
+            relaxed = True
+            if proof := _wedge_proof(problem, options):
+                return _no_motion(problem, options, proof)
+    if undecided == "wedged":
+        return _confirm_wedged(problem, options)
+    if undecided == "modes":
+        return _free_motions_with_modes(problem, options)
+    if undecided == "equilibrium":
+        return _equilibrium_verdict(problem, VERDICT_EDGES)
+    return BackendResult(
+        "failed", f"failed: a motion of the {WIDER_SEARCH_EDGES}-edge pyramid model did not converge to one of the exact cone"
+    )
+
+
+def _no_motion(problem: Problem, options: Options, proof: str) -> BackendResult:
+    """The certified ``jammed`` once the exact cones are proven to have no motion (with the prescribed modes, if any)."""
+    diagnosis = Diagnosis.WEDGED if options.modes is None else Diagnosis.PRESCRIBED_MODES
+    return no_motion(diagnosis, Certificate(CertificateKind.SECTOR_RELAXATION, proof))
+
+
+def _wedge_proof(problem: Problem, options: Options) -> str:
+    """A certificate that the exact cones admit no motion (a sector relaxation of the exact laws is infeasible), or ''."""
+    proven, sectors = exact_cones_jam(problem, options, options.modes, lambda q: _is_exact_motion(problem, q))
+    if not proven:
+        return ""
+    return f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; SCIP, complete search)"
+
+
+def _is_exact_motion(problem: Problem, q: np.ndarray) -> bool:
+    """Whether forces satisfying the exact laws exist at twist ``q`` (with the modes it gives each contact)."""
+    if np.min(problem.velocities(q)[:, -1], initial=0.0) < -MODE_SPEED:
+        return False
+    return _forces_at(problem, q, ModeMasks.of(problem, contact_modes(problem, q))) is not None
+
+
+def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResult | None, str]:
+    """Motions of a ``count``-edge pyramid refined to the exact cone, or None and why the pyramid cannot decide.
+
+    Undecided: ``refinement`` (a pyramid motion has no exact motion next to
+    it), ``wedged`` (the pyramid jams but the wider exact cone may not),
+    ``modes`` (no pyramid motion with the prescribed modes) or ``equilibrium``
+    (equilibrium exists in the circumscribed pyramid but not the inscribed one).
+    """
+    edges = aligned_edges(problem, count)
+    motions, complete = enumerate_motions(polyhedral_form(problem, edges), options)
+    if motions:
+        result = _refined_result(problem, motions, complete, options, count)
+        return result, "" if result is not None else "refinement"
+    if not complete:
+        return BackendResult("failed", "failed: the certified search hit its time limit before finding a motion"), ""
+    if options.modes is not None:
+        return None, "modes"
+    verdict = diagnose(problem, edges, edges / np.cos(np.pi / count))
+    if verdict.status == "failed":
+        return None, "equilibrium"
+    if verdict.diagnosis is Diagnosis.WEDGED:
+        return None, "wedged"
+    return verdict, ""
+
+
+def _equilibrium_verdict(problem: Problem, count: int) -> BackendResult:
+    """No motion found: ``unstable`` if ``count``-edge polygons around the circles admit no equilibrium."""
+    edges = aligned_edges(problem, count)
+    if not equilibrium_exists(problem, edges / np.cos(np.pi / count)):
+        text = f"no equilibrium in {count}-edge pyramids around the exact cones"
+        return no_motion(Diagnosis.NO_EQUILIBRIUM, Certificate(CertificateKind.INFEASIBLE_EQUILIBRIUM, text))
+    return BackendResult(
+        "failed",
+        f"failed: no motion was found, and whether the exact cones admit an equilibrium is too close to call "
+        f"(undecided with {count}-edge polygons inside and outside the circle, searched with {WIDER_SEARCH_EDGES})",
+    )
+
+
+def _confirm_wedged(problem: Problem, options: Options) -> BackendResult:
+    """The pyramids jam and the sector relaxation cannot tell: the paper's exact program decides, on the same clock.
+
+    Its wedged ``jammed`` is proven for the exact cones (no motion within
+    1000 times the scene's scales); a motion it finds is audited and
+    attached, but the list is not known to be complete, so that is ``failed``.
+    """
+    exact = solve_min_power(problem, options)
+    if exact.status == "jammed":
+        pyramids = f"{SEARCH_EDGES}- and {WIDER_SEARCH_EDGES}-edge pyramids"
+        proof = f"no motion in {pyramids}; the paper's exact program proves none (within its bounds)"
+        return no_motion(Diagnosis.WEDGED, Certificate(CertificateKind.GLOBAL_OPTIMUM, proof))
+    if exact.status == "solved":
+        message = (
+            f"failed: the {WIDER_SEARCH_EDGES}-edge pyramid jams, but the exact cones admit a motion (the paper's program found it; "
+            "attached, audited); whether it is the only one is not known"
+        )
+        return BackendResult("failed", message, exact.motions, certified=False).with_notes(paper=exact.message)
+    return BackendResult(
+        "failed",
+        f"failed: {SEARCH_EDGES}- and {WIDER_SEARCH_EDGES}-edge pyramids jam, but that is not proven for the exact cones "
+        f"(sector relaxations inconclusive; the paper's program: {exact.message}); "
+        "friction 'pyramid:K' gives a certified answer for the pyramid, or raise time_limit",
+    )
+
+
+def _refined_result(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, count: int) -> BackendResult | None:
+    """Every pyramid motion refined to the exact cone, summarised; None when that decides nothing.
+
+    Where some motion cannot be refined, two distinct exact motions (or a
+    continuum) still prove ``ambiguous``, with a list that may be incomplete.
+    """
+    refined = [_refine(problem, motion) for motion in motions]
+    unique: list[RawMotion] = []
+    for motion in refined:
+        if motion is not None and _keeps_prescribed(problem, motion, options) and not any(_same_exact(problem, motion, o) for o in unique):
+            unique.append(motion)
+    unrefined = sum(r is None for r in refined)
+    if not unique:
+        return None
+    if not unrefined:
+        note = f"motions refined from a {count}-edge pyramid; completeness proven for the pyramid"
+        return _summary(problem, unique, complete, options, note)
+    if len(unique) >= 2 or any(motion.continuum for motion in unique):
+        note = f"{unrefined} motion(s) of the {count}-edge pyramid did not converge to one of the exact cone: the list is incomplete"
+        return _summary(problem, unique, False, options, note)
+    return None
+
+
+def _summary(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, note: str) -> BackendResult:
+    range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motions[0].q)))
+    return summarise(range_form, motions, complete, options).with_notes(exact_cone=note)
+
+
+def _free_motions_with_modes(problem: Problem, options: Options) -> BackendResult:
+    """No pyramid motion has the prescribed modes, yet an exact one may (a pyramid bends slips towards its edges):
+    the motions of the free solve that have them, else ``failed``."""
+    free = solve_exact_3d(problem, dataclasses.replace(options, modes=None))
+    matching = [motion for motion in free.motions if _keeps_prescribed(problem, motion, options)]
+    if matching and free.status in ("solved", "ambiguous"):
+        note = "the motions with the prescribed modes among every motion of the free search (its exact refinement)"
+        return _summary(problem, matching, bool(free.search_complete), options, note)
+    return BackendResult(
+        "failed",
+        f"failed: no motion with the prescribed contact modes exists for {SEARCH_EDGES}- and {WIDER_SEARCH_EDGES}-edge pyramids inscribed "
+        "in the exact cones, but with exact cones that is not proven; use friction 'pyramid:K' for a certified answer",
+    )
+
+
+def _keeps_prescribed(problem: Problem, motion: RawMotion, options: Options) -> bool:
+    """A refined motion still has the prescribed modes (refinement may bring a sliding contact to rest)."""
+    if options.modes is None:
+        return True
+    return all(want is None or want == got for want, got in zip(options.modes, contact_modes(problem, motion.q), strict=True))
+
+
+def _same_exact(problem: Problem, a: RawMotion, b: RawMotion) -> bool:
+    return (
+        a.continuum == b.continuum
+        and bool(np.max(np.abs(a.q - b.q)) <= SAME_TWIST)
+        and contact_modes(problem, a.q) == contact_modes(problem, b.q)
+    )
+
+
+def _refine(problem: Problem, motion: RawMotion) -> RawMotion | None:
+    """The exact motion next to a pyramid motion: with the pyramid's modes, else with one or two of them changed.
+
+    A pyramid's sliding contact may separate or roll under the circle (its
+    slip runs between two edges, where the pyramid's friction is weaker), so
+    those changes are tried, nearest first, before giving up.
+    """
+    if not motion.continuum and _max_dissipation_error(problem, motion) <= FRICTION_ALIGNMENT:
+        return motion
+    modes = np.array(contact_modes(problem, motion.q), dtype=object)
+    for attempt, changed in enumerate(_mode_changes(modes)):
+        # Newton converges in a few dozen steps from a nearby start; a changed pattern that has not by then is wrong.
+        refined = _refine_with_modes(problem, motion, changed, evaluations=200 if attempt == 0 else 20)
+        if refined is not None:
+            return refined
+    return None
+
+
+def _mode_changes(modes: np.ndarray) -> Iterator[np.ndarray]:
+    """``modes`` itself, then each sliding contact rolling or separating, then each pair of such changes."""
+    yield modes
+    singles = [(i, new) for i in np.flatnonzero(modes == "sliding") for new in ("rolling", "separating")]
+    for size in (1, 2):
+        for combination in itertools.combinations(singles, size):
+            if len({i for i, _ in combination}) == size:
+                changed = modes.copy()
+                for i, new in combination:
+                    changed[i] = new
+                yield changed
+
+
+def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, evaluations: int) -> RawMotion | None:
+    """Bounded Gauss-Newton (trust region, normal forces >= 0) on the exact laws with the given contact modes.
+
+    With the modes fixed, the exact laws are smooth equations
+    (:mod:`quasistatic.laws.fixed_modes`). Returns None when they have no
+    solution near the pyramid motion that keeps every mode and inequality
+    (within ``evaluations`` residual evaluations per unknown).
+
+    A pyramid continuum is refined from its interior point: the pyramid lets a
+    slip turn within a face's fan at no change of force, the circle does not,
+    so the exact motion is often unique. It stays a continuum (with the
+    pyramid's extremes) only where the exact equations leave a twist direction
+    free at the solution (a null vector of their Jacobian with a twist part).
+    """
+    masks = ModeMasks.of(problem, modes)  # a frictionless contact gets no slip equation
+    laws = FixedModeLaws(problem, masks)
+    x0 = laws.start(motion.q, motion.c)
+    options = {"xtol": 1e-15, "ftol": 1e-15, "gtol": 1e-15, "max_nfev": evaluations * x0.size}
+    fit = scipy.optimize.least_squares(laws.residual, x0, jac=laws.jacobian, bounds=(laws.lower_bounds(), np.inf), method="trf", **options)
+    if np.max(np.abs(fit.fun), initial=0.0) > FIXED_MODE_RESIDUAL:
+        # The bounded trust region can stall where unbounded Levenberg-Marquardt converges (a random
+        # 6-contact grasp); a negative normal force is then caught below, where forces are recovered by LP.
+        fit = scipy.optimize.least_squares(laws.residual, x0, jac=laws.jacobian, method="lm", **options)
+    q, c = laws.motion(fit.x)
+    # A sliding contact may come to rest (its force then sits on the cone): still a solution.
+    new_modes = np.array(contact_modes(problem, q))
+    frictional = problem.mu > 0
+    same = np.where(frictional, new_modes == modes, (new_modes == "separating") == (modes == "separating"))
+    keeps_modes = bool(np.all(same | (masks.sliding & (new_modes == "rolling"))))
+    converged = float(np.max(np.abs(laws.residual(fit.x)), initial=0.0)) <= FIXED_MODE_RESIDUAL
+    if not (converged and keeps_modes):
+        return None
+    if not _inside_cones(problem, c, masks.rolling):
+        # The twist is right but the least-squares forces of a statically indeterminate
+        # set may carry a squeeze outside the cones: pick admissible ones at this twist.
+        recovered = _forces_at(problem, q, masks)
+        if recovered is None:
+            return None
+        c = recovered
+    if motion.continuum and _twist_is_free(laws.jacobian(fit.x), problem.n_dof):
+        return RawMotion(q, c, motion.extremes, motion.unbounded)
+    return RawMotion(q, c)
+
+
+def _inside_cones(problem: Problem, c: np.ndarray, rolling: np.ndarray) -> bool:
+    normal_ok = np.all(c[:, 2] >= -CONE_ROUNDOFF)
+    return bool(normal_ok and np.all(np.linalg.norm(c[rolling, :2], axis=1) <= problem.mu[rolling] * c[rolling, 2] + CONE_ROUNDOFF))
+
+
+def _forces_at(problem: Problem, q: np.ndarray, masks: ModeMasks) -> np.ndarray | None:
+    """Least total normal force (m, 3) that balances the load at twist ``q`` with the given modes; None if none does.
+
+    Linear in the unknowns: a sliding contact's friction is ``-mu cn slip/|slip|``
+    (the slip is known), a rolling one's lies in a ``RANGE_EDGES``-gon inscribed
+    in its cone (so inside the exact cone), an open contact carries nothing.
+    """
+    closed, rolling, sliding = masks.closed, masks.rolling, masks.sliding
+    m, n = problem.n_contacts, problem.n_dof
+    edges = aligned_edges(problem, RANGE_EDGES)
+    slip = slips(problem, q)
+    direction = np.zeros((m, 2))
+    speed = np.linalg.norm(slip[sliding], axis=1, keepdims=True)
+    direction[sliding] = -problem.mu[sliding, None] * slip[sliding] / np.maximum(speed, 1e-300)
+    rows = np.flatnonzero(rolling)
+    # Columns: cn (m), then beta (len(rows) x K) for the rolling contacts.
+    K = RANGE_EDGES
+    normal_push = problem.Jn.T + np.einsum("mt,mtn->nm", direction, problem.Jt)
+    edge_push = np.einsum("rkt,rtn->nrk", edges[rows], problem.Jt[rows]).reshape(n, len(rows) * K)
+    bound = np.hstack([np.diag(problem.mu)[rows], -np.repeat(np.eye(len(rows)), K, axis=1)])  # mu cn - sum beta >= 0
+    A = np.vstack([np.hstack([normal_push, edge_push]), bound])
+    lower = np.r_[-problem.g, np.zeros(len(rows))]
+    upper = np.r_[-problem.g, np.full(len(rows), np.inf)]
+    col_upper = np.r_[np.where(closed, np.inf, 0.0), np.full(len(rows) * K, np.inf)]
+    cost = np.r_[np.ones(m), np.zeros(len(rows) * K)]
+    lp = solve_lp(cost, A, lower, upper, np.zeros(cost.size), col_upper)
+    if lp.status != "optimal":
+        return None
+    cn, beta = lp.x[:m], lp.x[m:].reshape(len(rows), K)
+    c = np.zeros((m, 3))
+    c[:, 2] = cn
+    c[:, :2] = direction * cn[:, None]
+    c[rows, :2] = np.einsum("rk,rkt->rt", beta, edges[rows])
+    return c
+
+
+def _twist_is_free(jacobian: np.ndarray, n_twist: int) -> bool:
+    """True when the equations' Jacobian has a null vector that moves the twist (a local continuum)."""
+    _, sigma, vt = np.linalg.svd(np.asarray(jacobian), full_matrices=True)
+    rank = int(np.sum(sigma > 1e-8 * max(1.0, float(sigma[0]) if sigma.size else 1.0)))  # numerical rank, relative to the largest
+    return bool(np.any(np.linalg.norm(vt[rank:, :n_twist], axis=1) > FREE_TWIST_DIRECTION))
+
+
+def _max_dissipation_error(problem: Problem, motion: RawMotion) -> float:
+    """Largest distance of a sliding contact's friction force from -mu cn slip/|slip|."""
+    worst = 0.0
+    for i, s in enumerate(slips(problem, motion.q)):
+        speed = float(np.linalg.norm(s))
+        if speed > MODE_SPEED:
+            target = -problem.mu[i] * motion.c[i, -1] * s / speed
+            worst = max(worst, float(np.linalg.norm(motion.c[i, :-1] - target)))
+    return worst

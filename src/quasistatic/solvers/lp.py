@@ -1,0 +1,255 @@
+"""Frictionless forward object motion problem: one LP (paper section 2.2), by Lemke's method or HiGHS.
+
+Velocity formulation (eq. 25, 7):  min -g.q  s.t.  Jn q >= bn.
+Its duals are the normal forces; the dual LP is the force formulation
+(eq. 12, 26, 27):  max bn.c  s.t.  Jn^T c + g = 0, c >= 0, and strong
+duality is the power balance (eq. 19): mover power = potential-energy gain.
+
+Small problems: the optimality conditions of this LP pair are exactly the
+frictionless contact laws, a monotone LCP (the fast path's, without edges),
+and Lemke's method finds a primal-dual optimal pair in a few microseconds
+where a call to HiGHS costs a few hundred. Any optimal pair serves: the
+primal optimal face is the same for every dual optimum, so the uniqueness
+and force-range analysis below gives the same answer. When Lemke's method
+ends on a ray (the LP is infeasible or unbounded) or its pair does not
+check out, HiGHS solves the LP and the verdict comes from it as before.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..jit import njit
+from ..laws import Problem, RawMotion
+from ..solution import Certificate, CertificateKind, Diagnosis
+from ..tolerances import FORCE_RANK, LEMKE_PAIR, LP_FEASIBILITY, MODE_SPEED, MOTION_RANK, PIVOT, ZERO
+from .certify.diagnose import MESSAGES, kinematic_certificate
+from .numerics.highs import INF, solve_lp
+from .numerics.lcp import PIVOTS_PER_ROW, solve_split_lcp
+from .numerics.lemke import SOLUTION
+from .numerics.ranges import cone_is_trivial, ranges_are_wide, twist_extremes, value_ranges
+from .result import BackendResult, Options, Range
+
+__all__ = ["solve_frictionless"]
+
+
+LEMKE_MAX_ROWS = 200  # largest LCP (2 twist entries per dof + contacts) solved by Lemke's method first
+JACOBI_MAX = 24  # largest min(rows, cols) whose rank is found by Jacobi rotations (LAPACK beyond)
+
+
+def solve_frictionless(problem: Problem, options: Options) -> BackendResult:
+    """Solve with every contact frictionless (mu ignored)."""
+    data = problem.derived("lp", _Frictionless)
+    Jn, bn, g = data.Jn, data.bn, data.g
+    m = problem.n_contacts
+    q = c = analysis = None
+    if data.lemke:
+        status, q, c, analysis = _lemke_pair(
+            data.J, data.b, data.mu, g, data.frictional, data.base, Jn, bn, MODE_SPEED, PIVOT, PIVOTS_PER_ROW, ZERO, MOTION_RANK, FORCE_RANK
+        )
+        if status != SOLUTION or not analysis[0] <= LEMKE_PAIR:  # no pair, or it misses an optimality condition
+            analysis = None  # HiGHS decides
+    if analysis is None:
+        lp = solve_lp(-g, Jn, bn, np.full(m, INF))
+        if lp.status != "optimal":
+            return _verdict(problem, lp.status)
+        q, forces = lp.x, np.maximum(lp.row_dual, 0.0)
+        analysis = _analyse(Jn, bn, g, q, forces, ZERO, MOTION_RANK, FORCE_RANK)
+        c = np.zeros((m, problem.dimension))
+        c[:, -1] = forces
+    assert q is not None and c is not None
+    _, slack, support, tight, closed, motion_unique, forces_unique = analysis
+    # {d : Jn_S d = 0, Jn_T d >= 0} is only the origin at once when Jn_S has full column rank.
+    if not motion_unique and not cone_is_trivial(Jn[support], Jn[tight]):
+        extremes, unbounded = twist_extremes(q.size, Jn[support], bn[support], Jn[~support], bn[~support])
+        motion = RawMotion(q, c, tuple(extremes), unbounded)
+        return BackendResult("ambiguous", _ambiguous_message(unbounded), (motion,))
+    # Forces are unique when the closed contacts' normals are independent.
+    ranges = None if forces_unique else _force_ranges(Jn, g, slack)
+    if ranges is not None:
+        return BackendResult("solved", "solved: one motion; the contact forces are indeterminate", (RawMotion(q, c),), ranges)
+    return BackendResult("solved", "solved: one motion with unique contact forces", (RawMotion(q, c),))
+
+
+class _Frictionless:
+    """What :func:`solve_frictionless` derives from a problem once: contiguous data and the LCP's inputs."""
+
+    def __init__(self, problem: Problem) -> None:
+        self.J, self.b, self.g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.g))
+        self.Jn = np.ascontiguousarray(problem.Jn, dtype=float)
+        self.bn = np.ascontiguousarray(problem.bn, dtype=float)
+        self.mu = np.zeros(problem.n_contacts)  # no edges: the LP pair's optimality conditions
+        self.frictional = np.zeros(0, dtype=np.int64)
+        self.base = np.zeros(0)
+        self.lemke = 2 * problem.n_dof + problem.n_contacts <= LEMKE_MAX_ROWS
+
+
+@njit
+def _lemke_pair(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    frictional: np.ndarray,
+    base: np.ndarray,
+    Jn: np.ndarray,
+    bn: np.ndarray,
+    mode_tol: float,
+    pivot_tol: float,
+    pivots_per_row: int,
+    zero: float,
+    motion_rank: float,
+    force_rank: float,
+) -> tuple[int, np.ndarray, np.ndarray, tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool, bool]]:
+    """Lemke's method on the LP pair's optimality conditions (the fast kernel, no edges), then :func:`_analyse`.
+
+    Returns Lemke's status, the twist, the contact-frame forces (normal only;
+    negative round-off clipped) and the analysis of the pair, in one compiled call.
+    """
+    status, _, q, c, _, _ = solve_split_lcp(J, b, mu, g, frictional, base, False, 0, 0.0, mode_tol, pivot_tol, 0.0, pivots_per_row)
+    last = c.shape[1] - 1
+    normal = c[:, last].copy()
+    analysis = _analyse(Jn, bn, g, q, normal, zero, motion_rank, force_rank)
+    for i in range(c.shape[0]):
+        c[i, last] = max(normal[i], 0.0)
+    return status, q, c, analysis
+
+
+@njit
+def _analyse(
+    Jn: np.ndarray, bn: np.ndarray, g: np.ndarray, q: np.ndarray, forces: np.ndarray, zero: float, motion_rank: float, force_rank: float
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool, bool]:
+    """What the verdict needs of a primal-dual pair ``(q, forces)``.
+
+    Returns the largest violation of the optimality conditions (primal and dual
+    feasibility, complementarity; infinite when a value is not finite), the
+    slacks ``Jn q - bn``, the masks of supporting (force > ``zero``), tight but
+    unloaded, and closed (slack <= ``zero``) contacts, whether the supporting
+    normals have full column rank (singular values > ``motion_rank``, as
+    :func:`.numerics.ranges.null_space`: then the motion is unique) and whether the closed
+    ones are independent (singular values > ``force_rank``, as ``_force_ranges``: then
+    the forces are unique). One SVD at most in the usual case: independent
+    closed normals make their supporting subset independent too.
+    """
+    m, n = Jn.shape
+    slack = np.empty(m)
+    residual = 0.0
+    for i in range(m):
+        s = -bn[i]
+        for j in range(n):
+            s += Jn[i, j] * q[j]
+        slack[i] = s
+        residual = max(residual, -s, -forces[i], abs(forces[i] * s))
+    for j in range(n):
+        e = g[j]
+        for i in range(m):
+            e += Jn[i, j] * forces[i]
+        residual = max(residual, abs(e))
+    support = forces > zero
+    closed = slack <= zero
+    tight = closed & ~support
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(forces)) and np.all(np.isfinite(slack))):
+        return np.inf, slack, support, tight, closed, False, False
+    k = int(np.sum(closed))
+    forces_unique = k == 0 or (k <= n and _rank(Jn[closed], force_rank) == k)
+    nested = forces_unique and not np.any(support & ~closed)  # supporting rows among independent closed ones
+    motion_unique = int(np.sum(support)) == n if nested else _rank(Jn[support], motion_rank) == n
+    return residual, slack, support, tight, closed, motion_unique, forces_unique
+
+
+@njit
+def _rank(A: np.ndarray, tol: float) -> int:
+    """Number of singular values of ``A`` above ``tol`` (absolute: the data are scene-relative)."""
+    if A.shape[0] == 0 or A.shape[1] == 0:
+        return 0
+    if min(A.shape) > JACOBI_MAX:  # Jacobi sweeps cost O(k^3) each: LAPACK wins on large matrices
+        return int(np.sum(np.linalg.svd(np.ascontiguousarray(A))[1] > tol))
+    return int(np.sum(_singular_values(A) > tol))
+
+
+@njit
+def _singular_values(A: np.ndarray) -> np.ndarray:
+    """Singular values of a small matrix by one-sided Jacobi rotations (Hestenes), unsorted.
+
+    The columns of ``A`` (or of ``A^T``, whichever has fewer) are rotated in
+    pairs until every pair is orthogonal to working precision; their norms are
+    then the singular values, each to high relative accuracy (Demmel & Veselic
+    1992). For the few-by-few matrices here this is several times cheaper
+    than a LAPACK call through its wrappers.
+    """
+    W = A.copy() if A.shape[0] >= A.shape[1] else A.T.copy()
+    rows, cols = W.shape
+    for _ in range(60):
+        rotated = False
+        for p in range(cols - 1):
+            for q in range(p + 1, cols):
+                alpha = beta = gamma = 0.0
+                for i in range(rows):
+                    alpha += W[i, p] * W[i, p]
+                    beta += W[i, q] * W[i, q]
+                    gamma += W[i, p] * W[i, q]
+                if gamma == 0.0 or abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                zeta = (beta - alpha) / (2.0 * gamma)
+                t = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
+                cos = 1.0 / np.sqrt(1.0 + t * t)
+                sin = cos * t
+                for i in range(rows):
+                    wp, wq = W[i, p], W[i, q]
+                    W[i, p] = cos * wp - sin * wq
+                    W[i, q] = sin * wp + cos * wq
+        if not rotated:
+            break
+    sigma = np.empty(cols)
+    for j in range(cols):
+        total = 0.0
+        for i in range(rows):
+            total += W[i, j] * W[i, j]
+        sigma[j] = np.sqrt(total)
+    return sigma
+
+
+def _force_ranges(Jn: np.ndarray, g: np.ndarray, slack: np.ndarray) -> list[Range] | None:
+    """Normal-force ranges over the dual optimal face, or None when the forces are unique.
+
+    Only closed contacts (zero slack) may carry force on that face.
+    """
+    closed = slack <= ZERO
+    k = int(closed.sum())
+    if np.linalg.matrix_rank(Jn[closed], tol=FORCE_RANK) == k:
+        return None
+    closed_ranges = iter(value_ranges(Jn[closed].T, -g, np.eye(k), np.zeros(k)))
+    ranges = [next(closed_ranges) if is_closed else (0.0, 0.0) for is_closed in closed]
+    return ranges if ranges_are_wide(ranges) else None
+
+
+def _verdict(problem: Problem, status: str) -> BackendResult:
+    """Jammed or unstable, each confirmed by a checked certificate."""
+    Jn, g = problem.Jn, problem.g
+    m, n = Jn.shape
+    multipliers = kinematic_certificate(problem)
+    if multipliers is not None:
+        certificate = Certificate(CertificateKind.FARKAS, "kinematic (Farkas multipliers)", tuple(multipliers.tolist()))
+        return BackendResult("jammed", MESSAGES[Diagnosis.KINEMATIC], diagnosis=Diagnosis.KINEMATIC, certificate=certificate)
+    # Unstable: a twist d with Jn d >= 0 and g.d > 0 does unbounded work; box |d| <= 1 keeps the LP bounded.
+    ray = solve_lp(g, Jn, np.zeros(m), np.full(m, INF), np.full(n, -1.0), np.full(n, 1.0), maximize=True)
+    if ray.status == "optimal" and ray.objective > LP_FEASIBILITY and np.all(Jn @ ray.x >= -LP_FEASIBILITY * ray.objective):
+        direction = ray.x / ray.objective
+        certificate = Certificate(CertificateKind.RAY, "a twist along which the load does unbounded work", tuple(direction.tolist()))
+        return BackendResult("unstable", _UNSTABLE_RAY, diagnosis=Diagnosis.NO_EQUILIBRIUM, certificate=certificate)
+    return BackendResult("failed", f"failed: HiGHS reported {status} but no certificate could be checked")
+
+
+_UNSTABLE_RAY = (
+    "unstable: no quasi-static equilibrium exists (the load can do unbounded work), so the "
+    "object falls or accelerates; add support or friction"
+)
+
+
+def _ambiguous_message(unbounded: bool) -> str:
+    extent = "unbounded" if unbounded else "bounded"
+    return (
+        f"ambiguous: an {extent} continuum of motions satisfies the laws "
+        "(frictionless contacts leave it undetermined); its extreme motions are listed"
+    )

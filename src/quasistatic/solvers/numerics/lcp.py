@@ -1,0 +1,405 @@
+"""The polyhedral contact laws as one standard LCP, solved by Lemke's method; exact 3-D cones by re-aligned edges.
+
+The polyhedral laws (see :mod:`quasistatic.laws.polyhedral`) form a mixed LCP:
+the twist ``q`` is free and equilibrium is an equation. Splitting ``q = q+ - q-``
+and pairing each half with one sign of the equilibrium residual,
+
+    0 <= q+  _|_  -g - Jn^T cn - (D^T Jt)^T beta  >= 0
+    0 <= q-  _|_   g + Jn^T cn + (D^T Jt)^T beta  >= 0
+
+makes it a standard LCP (both rows non-negative is equilibrium) whose
+twist-force coupling is skew-symmetric, so ``z^T M z = sum mu cn lam >= 0``
+(the matrix is copositive). Only contacts with ``mu > 0`` get edges.
+
+For exact 3-D cones the kernel turns each sliding contact's pyramid so one
+edge lies opposite its slip and solves again, and solves the exact
+fixed-mode laws (:mod:`quasistatic.laws.fixed_modes`) by Newton's method;
+see :mod:`quasistatic.solvers.fast`. Everything runs in one kernel, compiled
+by numba when it is installed. The frictionless LP (:mod:`quasistatic.solvers.lp`)
+uses the same kernel without edges.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...jit import njit
+from ...laws.fixed_modes import columns, system
+from .lemke import SOLUTION, lemke
+
+__all__ = ["solve_split_lcp", "NOT_CONVERGED", "PIVOTS_PER_ROW"]
+
+PIVOTS_PER_ROW = 20  # Lemke pivot cap per LCP row
+NOT_CONVERGED = 3  # kernel status beyond Lemke's: neither re-alignment nor Newton's method reached the exact cone
+
+
+@njit
+def solve_split_lcp(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    frictional: np.ndarray,
+    base: np.ndarray,
+    exact: bool,
+    max_realignments: int,
+    dissipation_tol: float,
+    mode_tol: float,
+    pivot_tol: float,
+    feasibility_tol: float,
+    pivots_per_row: int,
+) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
+    """Lemke on the split-twist LCP, then (exact 3-D cones) edge re-alignment.
+
+    ``J`` (m, d, n), ``b`` (m, d), ``mu`` (m,), ``g`` (n,) as in Problem;
+    ``frictional`` (f,) the contacts with ``mu > 0``; ``base`` (K,) the edge
+    signs in 2-D or the unrotated edge angles in 3-D.
+
+    Returns status (lemke's, or 3: not converged), stage (0: first solve,
+    1: after re-alignment, 2: Newton's method), twist ``q`` (n,), forces
+    ``c`` (m, d) in contact frames, pivots and re-alignments.
+    """
+    m, d, n = J.shape
+    f = frictional.shape[0]
+    Jn = np.ascontiguousarray(J[:, d - 1, :])
+    bn = np.ascontiguousarray(b[:, d - 1])
+    Jt = np.empty((f, d - 1, n))
+    bt = np.empty((f, d - 1))
+    mu_f = np.empty(f)
+    for a in range(f):
+        Jt[a] = J[frictional[a], : d - 1, :]
+        bt[a] = b[frictional[a], : d - 1]
+        mu_f[a] = mu[frictional[a]]
+    offsets = np.zeros(f)
+    edges = _edges(base, offsets, d - 1)
+    M, qv = _assemble(Jn, Jt, bn, bt, mu_f, g, edges, frictional)
+    cap = pivots_per_row * qv.shape[0]
+    status, z, pivots, basis = lemke(M, qv, np.ones(qv.shape[0]), cap, pivot_tol)
+    q, c = _motion(z, edges, frictional, m, d, n)
+    realignments = 0
+    if status != SOLUTION or not exact:
+        return status, 0, q, c, pivots, realignments
+    slip = np.empty((f, 2))
+    previous = np.inf
+    while True:
+        # Sliding contacts' slips, and how far their friction is from -mu cn slip/|slip|.
+        error = 0.0
+        for a in range(f):
+            i = frictional[a]
+            for s in range(2):
+                slip[a, s] = -bt[a, s]
+                for j in range(n):
+                    slip[a, s] += Jt[a, s, j] * q[j]
+            speed = np.sqrt(slip[a, 0] ** 2 + slip[a, 1] ** 2)
+            if speed > mode_tol:
+                scale = mu_f[a] * c[i, 2] / speed
+                error = max(error, np.sqrt((c[i, 0] + scale * slip[a, 0]) ** 2 + (c[i, 1] + scale * slip[a, 1]) ** 2))
+                offsets[a] = np.arctan2(-slip[a, 1], -slip[a, 0])
+        if error <= dissipation_tol:
+            return SOLUTION, min(realignments, 1), q, c, pivots, realignments
+        if realignments == 0 or realignments == max_realignments or error > 0.5 * previous:
+            # First, and whenever re-alignment stalls (a pyramid lets a slip turn within its
+            # vertex's fan at no change of force): the exact laws with these contact modes.
+            converged, q_exact, c_exact = _newton(J, b, mu, g, q, c, mode_tol, dissipation_tol)
+            if converged:
+                return SOLUTION, 2, q_exact, c_exact, pivots, realignments
+            if realignments == max_realignments:
+                return NOT_CONVERGED, 2, q, c, pivots, realignments
+        previous = error
+        realignments += 1
+        edges = _edges(base, offsets, 2)
+        M, qv = _assemble(Jn, Jt, bn, bt, mu_f, g, edges, frictional)
+        feasible, z = _basis_solution(M, qv, basis, feasibility_tol)
+        if not feasible:
+            status, z, more, basis = lemke(M, qv, np.ones(qv.shape[0]), cap, pivot_tol)
+            pivots += more
+            if status != SOLUTION:
+                q, c = _motion(z, edges, frictional, m, d, n)
+                return status, 1, q, c, pivots, realignments
+        q, c = _motion(z, edges, frictional, m, d, n)
+
+
+@njit
+def _newton(
+    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, q: np.ndarray, c: np.ndarray, mode_tol: float, tol: float
+) -> tuple[bool, np.ndarray, np.ndarray]:
+    """The exact 3-D laws with fixed contact modes, by damped Newton steps, from the motion ``(q, c)``.
+
+    Unknowns: twist ``q`` (n), normal force of each closed contact, tangential
+    force of each rolling (frictional) one. Equations: equilibrium; closed
+    contacts do not move along their normal; rolling ones do not slip. A
+    sliding contact's friction is ``-mu cn slip/|slip|``. The modes start as
+    those of ``q``; a closed contact whose normal force turns negative opens,
+    an open one that would penetrate closes and a sliding one that stops rolls,
+    and the equations are solved again (a few times at most). Returns whether
+    a solution kept every mode and inequality (normal forces >= 0, rolling
+    forces in their cones, sliding contacts sliding, open ones apart), and it.
+    """
+    m, d, n = J.shape
+    kind = np.zeros(m, dtype=np.int64)  # 0 separating, 1 rolling (frictional), 2 sliding or frictionless
+    for i in range(m):
+        u_n, speed = _contact_speeds(J, b, q, i)
+        if u_n <= mode_tol:
+            kind[i] = 1 if mu[i] > 0.0 and speed <= mode_tol else 2
+    forces = c.copy()
+    for _ in range(8):
+        column, size = columns(kind, n, 2)
+        x = np.zeros(size)
+        x[:n] = q
+        for i in range(m):
+            if kind[i] > 0:
+                x[column[i]] = max(forces[i, 2], 0.0)
+            if kind[i] == 1:
+                x[column[i] + 1] = forces[i, 0]
+                x[column[i] + 2] = forces[i, 1]
+        x, norm, forces = _gauss_newton(J, b, mu, g, x, kind, column, n)
+        q = x[:n].copy()
+        changed = False
+        for i in range(m):
+            u_n, speed = _contact_speeds(J, b, q, i)
+            if kind[i] == 0 and u_n < 0.0:
+                kind[i] = 1 if mu[i] > 0.0 and speed <= mode_tol else 2
+                changed = True
+            elif kind[i] > 0 and forces[i, 2] < 0.0:
+                kind[i] = 0
+                forces[i, :] = 0.0
+                changed = True
+            elif kind[i] == 2 and mu[i] > 0.0 and speed <= mode_tol:
+                kind[i] = 1
+                changed = True
+        if changed:
+            continue
+        ok = norm <= tol
+        for i in range(m):
+            if kind[i] == 1:
+                ok = ok and np.sqrt(forces[i, 0] ** 2 + forces[i, 1] ** 2) <= mu[i] * forces[i, 2] * (1.0 + 1e-12)
+        return ok, q, forces
+    return False, q, forces
+
+
+@njit
+def _contact_speeds(J: np.ndarray, b: np.ndarray, q: np.ndarray, i: int) -> tuple[float, float]:
+    """Normal velocity and slip speed of contact ``i`` at twist ``q``."""
+    u = -b[i].copy()
+    for s in range(3):
+        for j in range(q.shape[0]):
+            u[s] += J[i, s, j] * q[j]
+    return u[2], np.sqrt(u[0] ** 2 + u[1] ** 2)
+
+
+@njit
+def _gauss_newton(
+    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, x: np.ndarray, kind: np.ndarray, column: np.ndarray, n: int
+) -> tuple[np.ndarray, float, np.ndarray]:
+    """Damped Newton (short least-squares steps where singular; step halving) on the fixed-mode laws.
+
+    Returns the point, its largest residual and its contact forces (m, 3).
+    """
+    residual, jacobian, forces = system(J, b, mu, g, x, kind, column, n)
+    norm = np.max(np.abs(residual))
+    for _ in range(50):
+        if norm <= 1e-14:
+            break
+        step = _newton_step(jacobian, residual)
+        t = 1.0
+        improved = False
+        for _ in range(30):
+            trial = x + t * step
+            r_trial, j_trial, f_trial = system(J, b, mu, g, trial, kind, column, n)
+            n_trial = np.max(np.abs(r_trial))
+            if n_trial < norm:
+                x, residual, jacobian, forces, norm = trial, r_trial, j_trial, f_trial, n_trial
+                improved = True
+                break
+            t *= 0.5
+        if not improved:
+            break
+    return x, norm, forces
+
+
+@njit
+def _newton_step(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
+    """Newton step ``-J^-1 r``, as ``-(J^T J + lam I)^-1 J^T r`` with a tiny ``lam``.
+
+    The damping only matters where ``J`` is singular (indeterminate forces):
+    there it picks the short step across the free directions, as least squares would.
+    """
+    size = residual.shape[0]
+    normal = np.zeros((size, size))
+    gradient = np.zeros(size)
+    largest = 0.0
+    for i in range(size):
+        for k in range(size):
+            gradient[i] -= jacobian[k, i] * residual[k]
+            for j in range(size):
+                normal[i, j] += jacobian[k, i] * jacobian[k, j]
+        largest = max(largest, normal[i, i])
+    for i in range(size):
+        normal[i, i] += 1e-12 * (1.0 + largest)
+    _, step = _linear_solve(normal, gradient)
+    return step
+
+
+@njit
+def _edges(base: np.ndarray, offsets: np.ndarray, t: int) -> np.ndarray:
+    """Edge directions (f, K, t): the 2-D signs, or 3-D angles ``base + offset`` per contact."""
+    f, K = offsets.shape[0], base.shape[0]
+    edges = np.empty((f, K, t))
+    for a in range(f):
+        for k in range(K):
+            if t == 1:
+                edges[a, k, 0] = base[k]
+            else:
+                edges[a, k, 0] = np.cos(base[k] + offsets[a])
+                edges[a, k, 1] = np.sin(base[k] + offsets[a])
+    return edges
+
+
+@njit
+def _motion(z: np.ndarray, edges: np.ndarray, frictional: np.ndarray, m: int, d: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Twist ``q`` (n,) and contact-frame forces ``c`` (m, d) of ``z = [q+, q-, cn, beta, lam]``."""
+    f, K, t = edges.shape
+    q = z[:n] - z[n : 2 * n]
+    c = np.zeros((m, d))
+    for i in range(m):
+        c[i, d - 1] = z[2 * n + i]
+    start = 2 * n + m
+    for a in range(f):
+        for k in range(K):
+            beta = z[start + a * K + k]
+            for s in range(t):
+                c[frictional[a], s] += beta * edges[a, k, s]
+    return q, c
+
+
+@njit
+def _basis_solution(M: np.ndarray, q: np.ndarray, basis: np.ndarray, tol: float) -> tuple[bool, np.ndarray]:
+    """The LCP solution with the given complementary basis (``M_SS z_S = -q_S``), and whether it is feasible."""
+    N = q.shape[0]
+    basic = np.empty(N, dtype=np.int64)
+    count = 0
+    for i in range(N):
+        if N <= basis[i] < 2 * N:
+            basic[count] = basis[i] - N
+            count += 1
+    z = np.zeros(N)
+    if count:
+        A = np.empty((count, count))
+        rhs = np.empty(count)
+        for r in range(count):
+            rhs[r] = -q[basic[r]]
+            for s in range(count):
+                A[r, s] = M[basic[r], basic[s]]
+        regular, solution = _linear_solve(A, rhs)
+        if not regular:  # the basis does not carry over
+            return False, z
+        for r in range(count):
+            if solution[r] < -tol:
+                return False, z
+            z[basic[r]] = max(solution[r], 0.0)
+    for i in range(N):
+        w = q[i]
+        for j in range(N):
+            w += M[i, j] * z[j]
+        if w < -tol:
+            return False, z
+    return True, z
+
+
+@njit
+def _linear_solve(A: np.ndarray, rhs: np.ndarray) -> tuple[bool, np.ndarray]:
+    """``A x = rhs`` by Gaussian elimination with partial pivoting; False when ``A`` is singular.
+
+    Small dense systems; written out (rather than ``np.linalg.solve``) so that
+    the kernel compiles quickly and needs no exception handling.
+    """
+    n = rhs.shape[0]
+    U = A.copy()
+    x = rhs.copy()
+    scale = 0.0
+    for i in range(n):
+        for j in range(n):
+            scale = max(scale, abs(U[i, j]))
+    tiny = 1e-14 * max(scale, 1e-300)
+    for k in range(n):
+        p = k
+        for i in range(k + 1, n):
+            if abs(U[i, k]) > abs(U[p, k]):
+                p = i
+        if abs(U[p, k]) <= tiny:
+            return False, x
+        if p != k:
+            for j in range(n):
+                U[k, j], U[p, j] = U[p, j], U[k, j]
+            x[k], x[p] = x[p], x[k]
+        for i in range(k + 1, n):
+            factor = U[i, k] / U[k, k]
+            if factor != 0.0:
+                for j in range(k, n):
+                    U[i, j] -= factor * U[k, j]
+                x[i] -= factor * x[k]
+    for k in range(n - 1, -1, -1):
+        total = x[k]
+        for j in range(k + 1, n):
+            total -= U[k, j] * x[j]
+        x[k] = total / U[k, k]
+    return True, x
+
+
+@njit
+def _assemble(
+    Jn: np.ndarray,
+    Jt: np.ndarray,
+    bn: np.ndarray,
+    bt: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    edges: np.ndarray,
+    frictional: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """LCP matrix ``M`` (N, N) and vector ``q`` (N,) of the split-twist polyhedral laws.
+
+    ``Jn`` (m, n), ``bn`` (m,) for every contact; ``Jt`` (f, d-1, n), ``bt``
+    (f, d-1), ``mu`` (f,), ``edges`` (f, K, d-1) for the frictional ones, whose
+    contact indices are ``frictional`` (f,); ``g`` (n,) the load. Unknowns
+    ``z = [q+ (n), q- (n), cn (m), beta (f K), lam (f)]``.
+    """
+    m, n = Jn.shape
+    f, K, t = edges.shape
+    N = 2 * n + m + f * K + f
+    cn0 = 2 * n
+    b0 = cn0 + m
+    l0 = b0 + f * K
+    M = np.zeros((N, N))
+    q = np.zeros(N)
+    for i in range(n):
+        q[i] = -g[i]
+        q[n + i] = g[i]
+    for j in range(m):
+        q[cn0 + j] = -bn[j]
+        for i in range(n):
+            a = Jn[j, i]
+            M[cn0 + j, i] = a
+            M[cn0 + j, n + i] = -a
+            M[i, cn0 + j] = -a
+            M[n + i, cn0 + j] = a
+    for a in range(f):
+        row_l = l0 + a
+        M[row_l, cn0 + frictional[a]] = mu[a]
+        for k in range(K):
+            row = b0 + a * K + k
+            rhs = 0.0
+            for s in range(t):
+                rhs += edges[a, k, s] * bt[a, s]
+            q[row] = -rhs
+            for i in range(n):
+                value = 0.0
+                for s in range(t):
+                    value += edges[a, k, s] * Jt[a, s, i]
+                M[row, i] = value
+                M[row, n + i] = -value
+                M[i, row] = -value
+                M[n + i, row] = value
+            M[row, row_l] = 1.0
+            M[row_l, row] = -1.0
+    return M, q

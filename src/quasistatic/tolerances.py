@@ -1,0 +1,122 @@
+"""Every tolerance of the library, named, in one place.
+
+Assembly divides every quantity by the scene's own scales (length, force,
+velocity: :class:`quasistatic.model.scales.Scales`), so apart from the input
+checks below each tolerance is *scene-relative* and dimensionless: 1e-9 means
+"a billionth of the scene's largest load, speed or size", whether the scene is
+in millimetres and grams or in metres and kilograms.
+
+Grouped by who uses them: input checks, the audit and the report, the
+solvers' linear algebra and LPs, and the exact-cone refinements. A guard
+against division by zero (``max(x, 1e-300)``) is not a tolerance and stays
+where it is used.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "NORMAL_LENGTH",
+    "SMALLEST_LENGTH",
+    "AUDIT",
+    "MODE_SPEED",
+    "DISPLAY_ZERO",
+    "ZERO",
+    "SAME_TWIST",
+    "DISTINCT_TWIST",
+    "FORCE_RANK",
+    "MOTION_RANK",
+    "LP_FEASIBILITY",
+    "HIGHS_SMALLEST_ENTRY",
+    "PIVOT",
+    "BASIS_FEASIBILITY",
+    "LEMKE_PAIR",
+    "FRICTION_ALIGNMENT",
+    "FIXED_MODE_RESIDUAL",
+    "CONE_ROUNDOFF",
+    "FREE_TWIST_DIRECTION",
+    "SECTOR_ACTIVE",
+    "EXACT_SECTOR_FRICTION",
+    "POWER_GAP",
+    "RECOVERED_POWER_GAP",
+    "POLISHED_RESIDUAL",
+]
+
+# --------------------------------------------------------------------------- input (physical units)
+
+NORMAL_LENGTH = 1e-3
+"""|‖n‖ - 1| a contact normal may have before it is rejected [-]; within it the normal is normalised."""
+
+SMALLEST_LENGTH = 1e-150
+"""Smallest length scale [length unit]: its square (in moments) is still a normal float."""
+
+# --------------------------------------------------------------------------- audit and report
+
+AUDIT = 1e-6
+"""Default threshold on every residual of the audit (equilibrium, cone, complementarity, dissipation, power) [-]."""
+
+MODE_SPEED = 1e-6
+"""Relative speed (per velocity scale) below which a contact is not moving: rolling, not sliding or separating [-]."""
+
+DISPLAY_ZERO = 1e-12
+"""Entries below this fraction of a column's largest one are printed as 0 (round-off, not data) [-]."""
+
+# --------------------------------------------------------------------------- solvers: linear algebra and LPs
+
+ZERO = 1e-9
+"""A residual, velocity or force below this is zero (a contact is closed, a force carries nothing) [-]."""
+
+SAME_TWIST = 1e-7
+"""Two twists closer than this (largest entry) are the same motion, and an extreme this close to a point is that point [-]."""
+
+DISTINCT_TWIST = 1e-5
+"""The certified search excludes a found twist by a box this wide: the next motion differs by at least this [-]."""
+
+FORCE_RANK = 1e-10
+"""Singular values of the closed contacts' normals above this are independent: then the forces are unique [-]."""
+
+MOTION_RANK = 1e-9
+"""Singular values of the loaded contacts' normals above this fix the twist: then the motion is unique [-]."""
+
+LP_FEASIBILITY = 1e-7
+"""What HiGHS and SCIP meet constraints to; a certificate or range checked with their output uses the same [-]."""
+
+HIGHS_SMALLEST_ENTRY = 1e-12
+"""HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""
+
+PIVOT = 1e-11
+"""Lemke's pivot tolerance and tie width, relative to the entering column's largest entry [-]."""
+
+BASIS_FEASIBILITY = 1e-10
+"""Slack allowed when a complementary basis is reused after the pyramid's edges turned [-]."""
+
+LEMKE_PAIR = 1e-10
+"""Largest violation of the frictionless LP's optimality conditions a Lemke pair may have before HiGHS decides [-]."""
+
+# --------------------------------------------------------------------------- exact 3-D cones
+
+FRICTION_ALIGNMENT = 1e-9
+"""Distance of a sliding contact's friction from ``-mu cn slip/|slip|`` accepted as exact maximum dissipation [-]."""
+
+FIXED_MODE_RESIDUAL = 1e-10
+"""Largest residual of the fixed-mode exact laws (equilibrium, closed, rolling) at which Newton's method has converged [-]."""
+
+CONE_ROUNDOFF = 1e-12
+"""Round-off allowed on a force that must lie inside its exact cone, or have a non-negative normal part [-]."""
+
+FREE_TWIST_DIRECTION = 1e-6
+"""A null vector of the fixed-mode laws' Jacobian whose twist part exceeds this leaves the motion free (a continuum) [-]."""
+
+SECTOR_ACTIVE = 1e-9
+"""Size above which a part of the sector relaxation's convex hull is the one in use [-]."""
+
+EXACT_SECTOR_FRICTION = 1e-6
+"""A relaxed point whose friction is this close to the exact law's needs no finer sectors [-]."""
+
+POWER_GAP = 1e-8
+"""Power gap P_zc - P_c of the paper's program below which eq. 19 holds with equality: a motion [-]."""
+
+RECOVERED_POWER_GAP = 1e-7
+"""Power gap accepted when the paper's forces are recovered at a fixed twist (the twist carries SCIP's 1e-7) [-]."""
+
+POLISHED_RESIDUAL = 1e-12
+"""Largest residual of the fixed-mode laws at which the paper's SCIP point counts as polished [-]."""
