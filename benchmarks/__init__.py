@@ -1,5 +1,5 @@
 """Benchmarks of quasistatic: ``python -m benchmarks [--quick | --full] [--out DIR] [--repeat N]``.
 
-The families and the runner live in :mod:`quasistatic.bench`, so that the
+The families and the runner live in :mod:`quasistatic.tools.bench`, so that the
 installed ``quasistatic bench`` command runs the same code.
 """

@@ -13,6 +13,7 @@ import gc
 import multiprocessing
 import os
 import pickle
+import queue
 import sys
 import threading
 from collections.abc import Iterable, Sequence
@@ -134,8 +135,6 @@ def _solve_chunk(items: Sequence[Scene | Problem], offset: int, method: str, opt
 
 # --------------------------------------------------------------------------- forked workers
 
-_WORKER_ITEMS: list[Scene | Problem] = []  # in a forked worker only: the parent's items, set once at its start
-
 
 def _can_fork() -> bool:
     """Linux (macOS system libraries are not fork-safe), and no other Python thread could hold a lock across the fork."""
@@ -143,42 +142,77 @@ def _can_fork() -> bool:
 
 
 def _solve_forked(items: list[Scene | Problem], workers: int, chunks_per_job: int, method: str, options: dict[str, Any]) -> list[Solution]:
-    """Solve the first item here (imports, JIT code and caches are then inherited), the rest in forked workers."""
+    """Solve the first item here (imports, JIT code and caches are then inherited), the rest in forked workers.
+
+    Each worker is forked with the items as its argument (inherited, never
+    pickled) and takes blocks of indices from a queue until none is left;
+    only the solutions travel back.
+    """
     first = _solve_chunk(items[:1], 0, method, options)
     rest = len(items) - 1
     size = max(1, -(-rest // (workers * chunks_per_job)))
-    blocks = [(start, min(start + size, len(items)), method, options) for start in range(1, len(items), size)]
+    blocks = [(start, min(start + size, len(items))) for start in range(1, len(items), size)]
+    context = multiprocessing.get_context("fork")
+    tasks: Any = context.Queue()
+    done: Any = context.Queue()
+    count = min(workers, len(blocks))
     # Frozen objects are left out of garbage collection: the workers do not traverse (and so do not
     # copy) the heap they inherit, and neither process re-traverses it while solutions are pickled.
     gc.freeze()
     try:
-        # A forked worker's initializer arguments are inherited, not pickled.
-        with multiprocessing.get_context("fork").Pool(min(workers, len(blocks)), _adopt_items, (items,)) as pool:
-            results = pool.starmap(_solve_inherited, blocks, chunksize=1)
+        processes = [context.Process(target=_worker, args=(items, tasks, done, method, options), daemon=True) for _ in range(count)]
+        for process in processes:
+            process.start()
+        # Tasks go in after the fork: the queue's feeder thread must not exist when the workers are forked.
+        for index, block in enumerate(blocks):
+            tasks.put((index, *block))
+        for _ in range(count):
+            tasks.put(None)  # one stop sign per worker
+        answers = _collect(done, len(blocks), processes)
+        for process in processes:
+            process.join()
     finally:
         gc.unfreeze()
     solutions = list(first)
-    for ok, value in results:
+    for index in range(len(blocks)):
+        ok, value = answers[index]
         if not ok:
             raise value
         solutions += value
     return solutions
 
 
-def _adopt_items(items: list[Scene | Problem]) -> None:
-    """In a forked worker, at its start: keep the parent's items (inherited with the process, never pickled)."""
-    _WORKER_ITEMS[:] = items
+def _collect(done: Any, expected: int, processes: list[Any]) -> dict[int, tuple[bool, Any]]:
+    """Every block's answer from the workers; a worker that dies without answering is an error, not a hang."""
+    answers: dict[int, tuple[bool, Any]] = {}
+    while len(answers) < expected:
+        try:
+            index, answer = done.get(timeout=0.5)
+        except queue.Empty:
+            dead = [p.exitcode for p in processes if p.exitcode not in (None, 0)]
+            if dead:
+                raise QuasistaticError(f"a solve_many worker process died (exit code {dead[0]}) before answering") from None
+            continue
+        answers[index] = answer
+    return answers
 
 
-def _solve_inherited(start: int, stop: int, method: str, options: dict[str, Any]) -> tuple[bool, Any]:
-    """In a forked worker: solve ``items[start:stop]`` of the inherited list.
+def _worker(items: list[Scene | Problem], tasks: Any, done: Any, method: str, options: dict[str, Any]) -> None:
+    """In a forked worker: solve blocks of the inherited ``items`` until the stop sign."""
+    while (task := tasks.get()) is not None:
+        index, start, stop = task
+        done.put((index, _solve_block(items, start, stop, method, options)))
+
+
+def _solve_block(items: list[Scene | Problem], start: int, stop: int, method: str, options: dict[str, Any]) -> tuple[bool, Any]:
+    """Solve ``items[start:stop]``.
 
     Returns ``(True, solutions)``, or ``(False, exception)`` with the item's
     index in its notes; an exception that would not survive pickling is
     replaced by a QuasistaticError that names it.
     """
     try:
-        return True, _solve_chunk(_WORKER_ITEMS[start:stop], start, method, options)
+        return True, _solve_chunk(items[start:stop], start, method, options)
     except Exception as exc:
         try:
             pickle.loads(pickle.dumps(exc))

@@ -10,7 +10,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
-from .runner import BenchResult, Row, _fmt, _fmt_range, growth_exponents
+from .runner import BenchResult, Row, format_seconds, format_seconds_range, growth_exponents
 
 __all__ = ["render_result", "write_results", "write_scaling_plot", "markdown_tables", "SCALING_FAMILIES"]
 
@@ -66,7 +66,7 @@ def render_result(result: BenchResult, console: Console) -> None:
         if key != previous:
             if previous is not None and key[0] != previous[0]:
                 table.add_section()
-            table.add_row(row.family, str(row.size), str(row.contacts), "[dim](assemble)[/dim]", _fmt(row.assemble))
+            table.add_row(row.family, str(row.size), str(row.contacts), "[dim](assemble)[/dim]", format_seconds(row.assemble))
             previous = key
         if row.skipped:
             table.add_row("", "", "", row.method, "skipped", "", "", f"[dim]{row.skipped}[/dim]")
@@ -76,8 +76,8 @@ def render_result(result: BenchResult, console: Console) -> None:
             "",
             "",
             row.method,
-            _fmt(row.median),
-            _fmt_range(row.p25, row.p75),
+            format_seconds(row.median),
+            format_seconds_range(row.p25, row.p75),
             "-" if row.ratio is None else f"{row.ratio:.3g}",
             _statuses(row),
             "-" if row.worst_residual is None else f"{row.worst_residual:.1e}",
@@ -137,7 +137,9 @@ def markdown_tables(data: dict[str, Any]) -> str:
     for row in data["rows"]:
         key = (row["family"], row["size"])
         if key != previous:
-            lines.append(f"| **{row['family']}** | {row['size']} | {row['contacts']} | (assemble) | {_fmt(row['assemble'])} | | | | | |")
+            lines.append(
+                f"| **{row['family']}** | {row['size']} | {row['contacts']} | (assemble) | {format_seconds(row['assemble'])} | | | | | |"
+            )
             previous = key
         if row["skipped"]:
             lines.append(f"| | | | {row['method']} | skipped | | | {row['skipped']} | | |")
@@ -146,8 +148,9 @@ def markdown_tables(data: dict[str, Any]) -> str:
         ratio = "-" if row["ratio"] is None else f"{row['ratio']:.3g}"
         residual = "-" if row["worst_residual"] is None else f"{row['worst_residual']:.1e}"
         agree = "ref" if row["method"] == row["baseline"] else ("n/a" if not row["compared"] else f"{row['agree']}/{row['compared']}")
+        spread = format_seconds_range(row["p25"], row["p75"])
         lines.append(
-            f"| | | | {row['method']} | {_fmt(row['median'])} | {_fmt_range(row['p25'], row['p75'])} | {ratio} | {statuses} "
+            f"| | | | {row['method']} | {format_seconds(row['median'])} | {spread} | {ratio} | {statuses} "
             f"| {residual} | {agree} |"
         )
     if data.get("batch"):

@@ -284,14 +284,15 @@ def _skip_reason(method: str, problem: Problem, history: Sequence[tuple[int, flo
         return None
     contacts, warm, median = history[-1]
     if warm > config.cap:
-        return f"too slow: one solve took {_fmt(warm)} at {contacts} contacts (cap {_fmt(config.cap)})"
+        return f"too slow: one solve took {format_seconds(warm)} at {contacts} contacts (cap {format_seconds(config.cap)})"
     power = 2.0
     if len(history) >= 2 and history[-2][0] < contacts:
         before, _, before_median = history[-2]
         power = max(1.0, math.log(median / before_median) / math.log(contacts / before))
     predicted = median * (problem.n_contacts / max(contacts, 1)) ** power
     if predicted > config.cap:
-        return f"too slow: predicted ~{_fmt(predicted)} per solve (n^{power:.2g} from {_fmt(median)} at {contacts} contacts)"
+        growth = f"n^{power:.2g} from {format_seconds(median)} at {contacts} contacts"
+        return f"too slow: predicted ~{format_seconds(predicted)} per solve ({growth})"
     return None
 
 
@@ -533,7 +534,7 @@ def machine_info() -> dict[str, Any]:
     }
 
 
-def _fmt(seconds: float | None) -> str:
+def format_seconds(seconds: float | None) -> str:
     """A duration with a unit: 37 µs, 4.2 ms, 1.3 s."""
     if seconds is None or not math.isfinite(seconds):
         return "-"
@@ -544,7 +545,7 @@ def _fmt(seconds: float | None) -> str:
     return f"{seconds:.3g} s"
 
 
-def _fmt_range(low: float | None, high: float | None) -> str:
+def format_seconds_range(low: float | None, high: float | None) -> str:
     """Two durations in the unit of the larger: 82–138 µs, 1.22–1.27 ms."""
     if low is None or high is None:
         return "-"
@@ -556,4 +557,4 @@ def _progress_line(row: Row) -> str:
     what = f"{row.family} {row.size} {row.method}"
     if row.skipped:
         return f"{what}: skipped ({row.skipped})"
-    return f"{what}: median {_fmt(row.median)} over {row.samples} calls, {row.statuses}"
+    return f"{what}: median {format_seconds(row.median)} over {row.samples} calls, {row.statuses}"
