@@ -168,11 +168,21 @@ def test_no_module_keeps_mutable_state_at_module_level() -> None:
             for target in (node.targets if isinstance(node, ast.Assign) else [node.target])
             if isinstance(target, ast.Name) and isinstance(node.value, (ast.Dict, ast.List, ast.Set, ast.Call))
         }
-        for node in ast.walk(tree):
-            if isinstance(node, ast.Subscript) and isinstance(node.ctx, ast.Store) and isinstance(node.value, ast.Name):
-                if node.value.id in globals_:
-                    bad.append(f"{name}: {node.value.id}[...] = ...")
-            if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and isinstance(node.func.value, ast.Name):
-                if node.func.value.id in globals_ and node.func.attr in {"update", "clear", "append", "pop", "setdefault", "add"}:
-                    bad.append(f"{name}: {node.func.value.id}.{node.func.attr}(...)")
+        bad += [f"{name}: {mutation}" for mutation in _mutations(tree, globals_)]
     assert not bad, bad
+
+
+def _mutations(tree: ast.Module, names: set[str]) -> Iterator[str]:
+    """Writes into the module-level containers ``names``: ``x[...] = ...`` or ``x.update(...)`` and the like."""
+    mutators = {"update", "clear", "append", "pop", "setdefault", "add"}
+    for node in ast.walk(tree):
+        if (
+            isinstance(node, ast.Subscript)
+            and isinstance(node.ctx, ast.Store)
+            and isinstance(node.value, ast.Name)
+            and node.value.id in names
+        ):
+            yield f"{node.value.id}[...] = ..."
+        call = isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and isinstance(node.func.value, ast.Name)
+        if call and node.func.value.id in names and node.func.attr in mutators:  # type: ignore[attr-defined]
+            yield f"{node.func.value.id}.{node.func.attr}(...)"  # type: ignore[attr-defined]
