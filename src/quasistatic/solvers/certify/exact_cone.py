@@ -38,7 +38,7 @@ from ...laws.fixed_modes import FixedModeLaws
 from ...laws.polyhedral import aligned_edges, polyhedral_form
 from ...solution import Certificate, CertificateKind, Diagnosis
 from ...tolerances import CONE_ROUNDOFF, FIXED_MODE_RESIDUAL, FREE_TWIST_DIRECTION, FRICTION_ALIGNMENT, MODE_SPEED, SAME_TWIST
-from ..numerics.highs import solve_lp
+from ..numerics.forces import least_normal_forces
 from ..result import BackendResult, Options
 from .diagnose import diagnose, equilibrium_exists, no_motion
 from .min_power import solve_min_power
@@ -300,39 +300,8 @@ def _inside_cones(problem: Problem, c: np.ndarray, rolling: np.ndarray) -> bool:
 
 
 def _forces_at(problem: Problem, q: np.ndarray, masks: ModeMasks) -> np.ndarray | None:
-    """Least total normal force (m, 3) that balances the load at twist ``q`` with the given modes; None if none does.
-
-    Linear in the unknowns: a sliding contact's friction is ``-mu cn slip/|slip|``
-    (the slip is known), a rolling one's lies in a ``RANGE_EDGES``-gon inscribed
-    in its cone (so inside the exact cone), an open contact carries nothing.
-    """
-    closed, rolling, sliding = masks.closed, masks.rolling, masks.sliding
-    m, n = problem.n_contacts, problem.n_dof
-    edges = aligned_edges(problem, RANGE_EDGES)
-    slip = slips(problem, q)
-    direction = np.zeros((m, 2))
-    speed = np.linalg.norm(slip[sliding], axis=1, keepdims=True)
-    direction[sliding] = -problem.mu[sliding, None] * slip[sliding] / np.maximum(speed, 1e-300)
-    rows = np.flatnonzero(rolling)
-    # Columns: cn (m), then beta (len(rows) x K) for the rolling contacts.
-    K = RANGE_EDGES
-    normal_push = problem.Jn.T + np.einsum("mt,mtn->nm", direction, problem.Jt)
-    edge_push = np.einsum("rkt,rtn->nrk", edges[rows], problem.Jt[rows]).reshape(n, len(rows) * K)
-    bound = np.hstack([np.diag(problem.mu)[rows], -np.repeat(np.eye(len(rows)), K, axis=1)])  # mu cn - sum beta >= 0
-    A = np.vstack([np.hstack([normal_push, edge_push]), bound])
-    lower = np.r_[-problem.g, np.zeros(len(rows))]
-    upper = np.r_[-problem.g, np.full(len(rows), np.inf)]
-    col_upper = np.r_[np.where(closed, np.inf, 0.0), np.full(len(rows) * K, np.inf)]
-    cost = np.r_[np.ones(m), np.zeros(len(rows) * K)]
-    lp = solve_lp(cost, A, lower, upper, np.zeros(cost.size), col_upper)
-    if lp.status != "optimal":
-        return None
-    cn, beta = lp.x[:m], lp.x[m:].reshape(len(rows), K)
-    c = np.zeros((m, 3))
-    c[:, 2] = cn
-    c[:, :2] = direction * cn[:, None]
-    c[rows, :2] = np.einsum("rk,rkt->rt", beta, edges[rows])
-    return c
+    """Least total normal force (m, 3) that balances the load at twist ``q`` with the given modes; None if none does."""
+    return least_normal_forces(problem, q, masks, RANGE_EDGES)
 
 
 def _twist_is_free(jacobian: np.ndarray, n_twist: int) -> bool:

@@ -22,8 +22,9 @@ from ...laws import Problem, RawMotion, contact_modes
 from ...laws.polyhedral import LCPForm, polyhedral_form
 from ...solution import Diagnosis
 from ...tolerances import DISTINCT_TWIST, MODE_SPEED, SAME_TWIST
+from ..numerics.forces import force_ranges
 from ..numerics.highs import solve_lp
-from ..numerics.ranges import force_ranges, twist_extremes
+from ..numerics.ranges import twist_extremes
 from ..numerics.scip_model import linear, new_model, optimize
 from ..result import BackendResult, Options
 from .diagnose import MESSAGES, diagnose

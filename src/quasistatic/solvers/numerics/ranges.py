@@ -1,4 +1,4 @@
-"""Extents of polyhedra by LPs: twist extremes of a continuum, ranges of forces, trivial cones.
+"""Extents of polyhedra by LPs: twist extremes of a continuum, ranges of linear functions, trivial cones.
 
 Everything here is scene-relative, so absolute thresholds (from
 :mod:`quasistatic.tolerances`) mean the same in every scene.
@@ -8,13 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...laws import Problem
-from ...laws.polyhedral import force_polytope
 from ...tolerances import FORCE_RANK, LP_FEASIBILITY, MOTION_RANK, SAME_TWIST, ZERO
 from ..result import Range
 from .highs import INF, WarmLP, optimise_each, solve_lp
 
-__all__ = ["null_space", "cone_is_trivial", "twist_extremes", "value_ranges", "ranges_are_wide", "force_ranges"]
+__all__ = ["null_space", "cone_is_trivial", "twist_extremes", "value_ranges", "ranges_are_wide"]
 
 
 def null_space(A: np.ndarray, tol: float = MOTION_RANK) -> np.ndarray:
@@ -125,29 +123,3 @@ def _in_row_space(A: np.ndarray, targets: np.ndarray) -> np.ndarray:
 def ranges_are_wide(ranges: list[Range], tol: float = LP_FEASIBILITY) -> bool:
     """True when some range is unbounded or wider than ``tol`` (scene-relative)."""
     return any(hi is None or hi - lo > tol for lo, hi in ranges)
-
-
-def force_ranges(problem: Problem, edges: np.ndarray, q: np.ndarray) -> list[Range] | None:
-    """Normal-force ranges (scene-relative) over all forces consistent with twist ``q``; None when the forces are unique.
-
-    With the twist fixed, every contact's velocity is known and the laws on the
-    forces are linear: an opening contact carries nothing, a sliding one pushes
-    on the maximum-dissipation face of its friction polygon (``edges``, (m, K, d - 1)),
-    a rolling one anywhere in its polygon.
-    """
-    polytope = force_polytope(problem, edges)
-    m, K = polytope.m, polytope.K
-    u = problem.velocities(q)
-    drive = -np.einsum("mkt,mt->mk", edges, u[:, :-1])  # dissipation rate per unit edge force
-    best = drive.max(axis=1)
-    zero = np.zeros(polytope.A.shape[1], dtype=bool)
-    zero[polytope.normal] = u[:, -1] > ZERO * 10  # opening contacts carry no force
-    zero[polytope.beta] = (drive < best[:, None] - ZERO * 10).ravel() | np.repeat(problem.mu <= 0, K)  # only maximising edges
-    zero[polytope.slack] = best > ZERO * 10  # sliding: on the boundary of the polygon
-    A = np.vstack([polytope.A, np.eye(zero.size)[zero]])
-    b = np.r_[polytope.rhs, np.zeros(int(zero.sum()))]
-    free = ~zero
-    if np.linalg.matrix_rank(A[:, free], tol=FORCE_RANK) == int(free.sum()):
-        return None
-    ranges = value_ranges(A, b, np.eye(zero.size)[:m], np.zeros(zero.size))
-    return ranges if ranges_are_wide(ranges) else None

@@ -150,8 +150,7 @@ def markdown_tables(data: dict[str, Any]) -> str:
         agree = "ref" if row["method"] == row["baseline"] else ("n/a" if not row["compared"] else f"{row['agree']}/{row['compared']}")
         spread = format_seconds_range(row["p25"], row["p75"])
         lines.append(
-            f"| | | | {row['method']} | {format_seconds(row['median'])} | {spread} | {ratio} | {statuses} "
-            f"| {residual} | {agree} |"
+            f"| | | | {row['method']} | {format_seconds(row['median'])} | {spread} | {ratio} | {statuses} | {residual} | {agree} |"
         )
     if data.get("batch"):
         lines += [

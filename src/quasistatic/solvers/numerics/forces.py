@@ -1,0 +1,104 @@
+"""Contact forces consistent with a given twist: the one place that law is written for polyhedral cones.
+
+With the twist fixed, every contact's velocity is known and the laws on the
+forces are linear (Trinkle & Hunter's force formulation at a known motion):
+an open contact carries nothing, a sliding one pushes on the
+maximum-dissipation face of its friction polygon, a rolling one anywhere in
+its polygon, and together they balance the load. The set is a polytope; the
+certified search reports each normal force's range over it
+(:func:`force_ranges`), the exact-cone refinement picks its point of least
+total normal force (:func:`least_normal_forces`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...laws import ModeMasks, Problem, slips
+from ...laws.polyhedral import ForcePolytope, aligned_edges, force_polytope
+from ...tolerances import FORCE_RANK, ZERO
+from ..result import Range
+from .highs import solve_lp
+from .ranges import ranges_are_wide, value_ranges
+
+__all__ = ["ForcesAtTwist", "forces_at_twist", "force_ranges", "least_normal_forces"]
+
+_MOVING = ZERO * 10  # scene-relative speed or dissipation rate above which a contact opens or slides
+
+
+@dataclass(frozen=True)
+class ForcesAtTwist:
+    """The forces consistent with one twist: ``{x >= 0 : A x = rhs}`` with ``x`` the polytope's columns.
+
+    ``fixed`` marks the columns held at zero by the modes (they are also rows of ``A``).
+    """
+
+    polytope: ForcePolytope
+    edges: np.ndarray
+    A: np.ndarray
+    rhs: np.ndarray
+    fixed: np.ndarray
+
+    def contact_forces(self, x: np.ndarray) -> np.ndarray:
+        """Contact-frame forces (m, d) of the columns ``x``: tangential from the edges, then normal."""
+        p = self.polytope
+        beta = x[p.beta].reshape(p.m, p.K)
+        return np.column_stack([np.einsum("mk,mkt->mt", beta, self.edges), x[p.normal]])
+
+
+def forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: ModeMasks) -> ForcesAtTwist:
+    """The force polytope of ``edges`` (m, K, d - 1) restricted by the contact modes at twist ``q``.
+
+    Open contacts carry no normal force; a sliding contact uses only the edges
+    that dissipate most for its slip and sits on its polygon's boundary; a
+    frictionless contact has no edge force.
+    """
+    polytope = force_polytope(problem, edges)
+    K = polytope.K
+    drive = -np.einsum("mkt,mt->mk", edges, slips(problem, q))  # dissipation rate per unit edge force
+    best = drive.max(axis=1)
+    fixed = np.zeros(polytope.A.shape[1], dtype=bool)
+    fixed[polytope.normal] = ~masks.closed
+    weaker = drive < best[:, None] - _MOVING
+    fixed[polytope.beta] = (weaker & masks.sliding[:, None]).ravel() | np.repeat(problem.mu <= 0, K)
+    fixed[polytope.slack] = masks.sliding
+    A = np.vstack([polytope.A, np.eye(fixed.size)[fixed]])
+    rhs = np.r_[polytope.rhs, np.zeros(int(fixed.sum()))]
+    return ForcesAtTwist(polytope, edges, A, rhs, fixed)
+
+
+def _measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeMasks:
+    """Modes as the velocities at ``q`` show them: open beyond ``_MOVING``, sliding where some edge dissipates."""
+    u = problem.velocities(q)
+    drive = -np.einsum("mkt,mt->mk", edges, u[:, :-1])
+    closed = ~(u[:, -1] > _MOVING)
+    sliding = drive.max(axis=1) > _MOVING
+    return ModeMasks(closed, closed & ~sliding & (problem.mu > 0), sliding)
+
+
+def force_ranges(problem: Problem, edges: np.ndarray, q: np.ndarray) -> list[Range] | None:
+    """Normal-force ranges (scene-relative) over all forces consistent with twist ``q``; None when the forces are unique."""
+    forces = forces_at_twist(problem, edges, q, _measured_masks(problem, edges, q))
+    free = ~forces.fixed
+    if np.linalg.matrix_rank(forces.A[:, free], tol=FORCE_RANK) == int(free.sum()):
+        return None
+    columns = forces.fixed.size
+    ranges = value_ranges(forces.A, forces.rhs, np.eye(columns)[forces.polytope.normal], np.zeros(columns))
+    return ranges if ranges_are_wide(ranges) else None
+
+
+def least_normal_forces(problem: Problem, q: np.ndarray, masks: ModeMasks, edge_count: int) -> np.ndarray | None:
+    """Contact-frame forces (m, d) of least total normal force consistent with twist ``q`` and the modes; None if none.
+
+    Edges (``edge_count`` per contact) are turned so one opposes each slip: a
+    sliding contact's friction is then exactly ``-mu cn slip/|slip|``, and a
+    rolling one's lies in a polygon inscribed in its exact cone.
+    """
+    edges = aligned_edges(problem, edge_count, slips(problem, q))
+    forces = forces_at_twist(problem, edges, q, masks)
+    cost = np.zeros(forces.fixed.size)
+    cost[forces.polytope.normal] = 1.0
+    lp = solve_lp(cost, forces.A, forces.rhs, forces.rhs, np.zeros(cost.size))
+    return forces.contact_forces(lp.x) if lp.status == "optimal" else None
