@@ -39,6 +39,12 @@ __all__ = [
     "POWER_GAP",
     "RECOVERED_POWER_GAP",
     "POLISHED_RESIDUAL",
+    "AT_LOWER_BOUND",
+    "JACOBIAN_RANK",
+    "NEWTON_STOP",
+    "NEWTON_DAMPING",
+    "LEAST_SQUARES_STEP",
+    "JACOBI_ORTHOGONAL",
 ]
 
 # --------------------------------------------------------------------------- input (physical units)
@@ -120,3 +126,23 @@ RECOVERED_POWER_GAP = 1e-7
 
 POLISHED_RESIDUAL = 1e-12
 """Largest residual of the fixed-mode laws at which the paper's SCIP point counts as polished [-]."""
+
+# --------------------------------------------------------------------------- numerical methods (stopping rules, not physics)
+
+AT_LOWER_BOUND = 1e-12
+"""An LP variable within this of its lower bound is at it (a range's minimum is then known without an LP) [-]."""
+
+JACOBIAN_RANK = 1e-8
+"""Singular values of the fixed-mode laws' Jacobian below this fraction of the largest are zero [-]."""
+
+NEWTON_STOP = 1e-14
+"""The fast path's Newton iteration stops once the fixed-mode residual is below this [-]."""
+
+NEWTON_DAMPING = 1e-12
+"""Relative Levenberg damping of the fast path's Newton steps: only matters where the Jacobian is singular [-]."""
+
+LEAST_SQUARES_STEP = 1e-15
+"""scipy's least-squares stops on steps, cost changes or gradients below this: iterate to machine precision [-]."""
+
+JACOBI_ORTHOGONAL = 1e-15
+"""Two columns of a one-sided Jacobi SVD are orthogonal when their cosine is below this (working precision) [-]."""

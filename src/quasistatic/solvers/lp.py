@@ -22,7 +22,7 @@ import numpy as np
 from ..jit import njit
 from ..laws import Problem, RawMotion
 from ..solution import Certificate, CertificateKind, Diagnosis
-from ..tolerances import FORCE_RANK, LEMKE_PAIR, LP_FEASIBILITY, MODE_SPEED, MOTION_RANK, PIVOT, ZERO
+from ..tolerances import FORCE_RANK, JACOBI_ORTHOGONAL, LEMKE_PAIR, LP_FEASIBILITY, MODE_SPEED, MOTION_RANK, PIVOT, ZERO
 from .certify.diagnose import MESSAGES, kinematic_certificate
 from .numerics.highs import INF, solve_lp
 from .numerics.lcp import PIVOTS_PER_ROW, solve_split_lcp
@@ -188,7 +188,7 @@ def _singular_values(A: np.ndarray) -> np.ndarray:
                     alpha += W[i, p] * W[i, p]
                     beta += W[i, q] * W[i, q]
                     gamma += W[i, p] * W[i, q]
-                if gamma == 0.0 or abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
+                if gamma == 0.0 or abs(gamma) <= JACOBI_ORTHOGONAL * np.sqrt(alpha * beta):
                     continue
                 rotated = True
                 zeta = (beta - alpha) / (2.0 * gamma)

@@ -37,7 +37,16 @@ from ...laws import ModeMasks, Problem, RawMotion, contact_modes, slips
 from ...laws.fixed_modes import FixedModeLaws
 from ...laws.polyhedral import aligned_edges, polyhedral_form
 from ...solution import Certificate, CertificateKind, Diagnosis
-from ...tolerances import CONE_ROUNDOFF, FIXED_MODE_RESIDUAL, FREE_TWIST_DIRECTION, FRICTION_ALIGNMENT, MODE_SPEED, SAME_TWIST
+from ...tolerances import (
+    CONE_ROUNDOFF,
+    FIXED_MODE_RESIDUAL,
+    FREE_TWIST_DIRECTION,
+    FRICTION_ALIGNMENT,
+    JACOBIAN_RANK,
+    LEAST_SQUARES_STEP,
+    MODE_SPEED,
+    SAME_TWIST,
+)
 from ..numerics.forces import least_normal_forces
 from ..result import BackendResult, Options
 from .diagnose import diagnose, equilibrium_exists, no_motion
@@ -267,7 +276,7 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     masks = ModeMasks.of(problem, modes)  # a frictionless contact gets no slip equation
     laws = FixedModeLaws(problem, masks)
     x0 = laws.start(motion.q, motion.c)
-    options = {"xtol": 1e-15, "ftol": 1e-15, "gtol": 1e-15, "max_nfev": evaluations * x0.size}
+    options = {"xtol": LEAST_SQUARES_STEP, "ftol": LEAST_SQUARES_STEP, "gtol": LEAST_SQUARES_STEP, "max_nfev": evaluations * x0.size}
     fit = scipy.optimize.least_squares(laws.residual, x0, jac=laws.jacobian, bounds=(laws.lower_bounds(), np.inf), method="trf", **options)
     if np.max(np.abs(fit.fun), initial=0.0) > FIXED_MODE_RESIDUAL:
         # The bounded trust region can stall where unbounded Levenberg-Marquardt converges (a random
@@ -307,7 +316,7 @@ def _forces_at(problem: Problem, q: np.ndarray, masks: ModeMasks) -> np.ndarray 
 def _twist_is_free(jacobian: np.ndarray, n_twist: int) -> bool:
     """True when the equations' Jacobian has a null vector that moves the twist (a local continuum)."""
     _, sigma, vt = np.linalg.svd(np.asarray(jacobian), full_matrices=True)
-    rank = int(np.sum(sigma > 1e-8 * max(1.0, float(sigma[0]) if sigma.size else 1.0)))  # numerical rank, relative to the largest
+    rank = int(np.sum(sigma > JACOBIAN_RANK * max(1.0, float(sigma[0]) if sigma.size else 1.0)))  # numerical rank, relative to the largest
     return bool(np.any(np.linalg.norm(vt[rank:, :n_twist], axis=1) > FREE_TWIST_DIRECTION))
 
 

@@ -80,7 +80,7 @@ import scipy.optimize
 from ...laws import ModeMasks, Problem, RawMotion
 from ...laws.fixed_modes import FixedModeLaws
 from ...solution import Certificate, CertificateKind, Diagnosis
-from ...tolerances import MODE_SPEED, POLISHED_RESIDUAL, POWER_GAP, RECOVERED_POWER_GAP
+from ...tolerances import LEAST_SQUARES_STEP, MODE_SPEED, POLISHED_RESIDUAL, POWER_GAP, RECOVERED_POWER_GAP
 from ..numerics.scip_model import new_model, optimize
 from ..result import BackendResult, Options
 from .diagnose import kinematic_certificate, no_motion
@@ -177,7 +177,15 @@ def _refine(problem: Problem, q: np.ndarray, c: np.ndarray) -> np.ndarray | None
     if laws.size > POLISH_MAX:
         return None
     x0 = laws.start(q, c, nonnegative=False)
-    fit = scipy.optimize.least_squares(laws.residual, x0, jac=laws.jacobian, xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=100 * x0.size)
+    fit = scipy.optimize.least_squares(
+        laws.residual,
+        x0,
+        jac=laws.jacobian,
+        xtol=LEAST_SQUARES_STEP,
+        ftol=LEAST_SQUARES_STEP,
+        gtol=LEAST_SQUARES_STEP,
+        max_nfev=100 * x0.size,
+    )
     return laws.motion(fit.x)[0] if np.max(np.abs(laws.residual(fit.x)), initial=0.0) <= POLISHED_RESIDUAL else None
 
 

@@ -25,6 +25,7 @@ import numpy as np
 
 from ...jit import njit
 from ...laws.fixed_modes import columns, system
+from ...tolerances import CONE_ROUNDOFF, NEWTON_DAMPING, NEWTON_STOP
 from .lemke import SOLUTION, lemke
 
 __all__ = ["solve_split_lcp", "NOT_CONVERGED", "PIVOTS_PER_ROW"]
@@ -172,7 +173,7 @@ def _newton(
         ok = norm <= tol
         for i in range(m):
             if kind[i] == 1:
-                ok = ok and np.sqrt(forces[i, 0] ** 2 + forces[i, 1] ** 2) <= mu[i] * forces[i, 2] * (1.0 + 1e-12)
+                ok = ok and np.sqrt(forces[i, 0] ** 2 + forces[i, 1] ** 2) <= mu[i] * forces[i, 2] * (1.0 + CONE_ROUNDOFF)
         return ok, q, forces
     return False, q, forces
 
@@ -198,7 +199,7 @@ def _gauss_newton(
     residual, jacobian, forces = system(J, b, mu, g, x, kind, column, n)
     norm = np.max(np.abs(residual))
     for _ in range(50):
-        if norm <= 1e-14:
+        if norm <= NEWTON_STOP:
             break
         step = _newton_step(jacobian, residual)
         t = 1.0
@@ -235,7 +236,7 @@ def _newton_step(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
                 normal[i, j] += jacobian[k, i] * jacobian[k, j]
         largest = max(largest, normal[i, i])
     for i in range(size):
-        normal[i, i] += 1e-12 * (1.0 + largest)
+        normal[i, i] += NEWTON_DAMPING * (1.0 + largest)
     _, step = _linear_solve(normal, gradient)
     return step
 

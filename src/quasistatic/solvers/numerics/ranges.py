@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...tolerances import FORCE_RANK, LP_FEASIBILITY, MOTION_RANK, SAME_TWIST, ZERO
+from ...tolerances import AT_LOWER_BOUND, FORCE_RANK, LP_FEASIBILITY, MOTION_RANK, SAME_TWIST
 from ..result import Range
 from .highs import INF, WarmLP, optimise_each, solve_lp
 
@@ -93,13 +93,13 @@ def value_ranges(A_eq: np.ndarray, b_eq: np.ndarray, targets: np.ndarray, col_lo
             result = model.optimise(target)
             low = result.objective if result.status == "optimal" else None
             if result.status == "optimal":
-                at_bound |= result.x <= col_lower + ZERO * 1e-3
+                at_bound |= result.x <= col_lower + AT_LOWER_BOUND
         if fixed and low is not None:
             ranges.append((max(low, 0.0), low))
             continue
         result = model.optimise(target, maximize=True)
         if result.status == "optimal":
-            at_bound |= result.x <= col_lower + ZERO * 1e-3
+            at_bound |= result.x <= col_lower + AT_LOWER_BOUND
         ranges.append((max(low or 0.0, 0.0), result.objective if result.status == "optimal" else None))
     return ranges
 
