@@ -8,6 +8,8 @@ switches the simplex strategy, owns an instance of its own."""
 
 from __future__ import annotations
 
+import os
+import sys
 import threading
 from dataclasses import dataclass
 from typing import Literal
@@ -34,6 +36,32 @@ _STATUS: dict[highspy.HighsModelStatus, LPStatus] = {
 }
 
 _local = threading.local()
+
+
+def _silence_banner() -> None:
+    """Make the process's first HiGHS instance with stdout pointed at /dev/null.
+
+    HiGHS prints a two-line banner on stdout when its first instance is
+    created, before ``output_flag`` can be set; it is C++ output, so only the
+    file descriptor can stop it (``--json`` output must be JSON and nothing
+    else). Later instances print nothing.
+    """
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:  # no stdout at all: nothing to protect
+        highspy.Highs()
+        return
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+            highspy.Highs()
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+_silence_banner()
 _PRIMAL_SIMPLEX = 4  # HiGHS simplex_strategy value (its default, 1, is dual simplex)
 
 

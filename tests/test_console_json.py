@@ -1,0 +1,59 @@
+"""The real console script, run as a user runs it: ``--json`` prints JSON and nothing else.
+
+An in-process CLI runner cannot see what a C library (HiGHS, SCIP) writes to
+the process's stdout, so these tests run the installed ``quasistatic`` script
+in a subprocess and parse its stdout as a whole.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SCRIPT = Path(sys.executable).parent / "quasistatic"
+EXAMPLES = sorted((ROOT / "examples").glob("*.yaml")) + sorted((ROOT / "examples").glob("*.json"))
+
+# What each example's comment says it shows (README's table).
+EXPECTED = {
+    "two_finger_lift.yaml": "solved",
+    "robot_tip.yaml": "solved",
+    "robot_tip.json": "solved",
+    "squeeze.yaml": "solved",
+    "push_up_slope.yaml": "solved",
+    "puck_push_3d.yaml": "solved",
+    "box_push_3d.yaml": "ambiguous",
+    "push_into_wall.yaml": "jammed",
+    "topple.yaml": "unstable",
+}
+
+
+def _run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([str(SCRIPT), *args], capture_output=True, text=True, timeout=300, cwd=ROOT)
+
+
+def test_every_example_has_an_expectation() -> None:
+    assert {p.name for p in EXAMPLES} == set(EXPECTED)
+
+
+def test_demo_json_is_json_and_nothing_else() -> None:
+    out = _run("demo", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)  # the whole of stdout: a banner line would break this
+    assert data["status"] == "solved" and data["certified"] is True
+    assert out.stderr == ""
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.name)
+def test_example_json_is_json_and_nothing_else(path: Path) -> None:
+    out = _run("solve", str(path), "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["status"] == EXPECTED[path.name], data["message"]
+    assert out.stderr == ""  # no solver banner, warning or C-library line on success
+    if data["status"] in ("jammed", "unstable"):
+        assert data["certificate"] is not None and data["diagnosis"] is not None
