@@ -217,7 +217,10 @@ def _forces_at(problem: Problem, q: np.ndarray, time_limit: float) -> tuple[np.n
     is linear in c and each term is >= 0 inside the cones, so two convex
     solves suffice: the least gap (it must be at most ``RECOVERED_POWER_GAP``: the
     twist carries SCIP's tolerance), then the least total normal force
-    within that gap.
+    within that gap. The cones are the exact (second-order) ones of eq. 8,
+    not the polygons of :mod:`..numerics.forces`: this program is the
+    independent cross-check of the certified search, so it does not share
+    its polyhedral force code.
     """
     import pyscipopt
 
