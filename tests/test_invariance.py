@@ -105,9 +105,11 @@ def fixture_3d() -> dict[str, Any]:
 
 
 def friction_slope_2d() -> dict[str, Any]:
-    """Frictional: a block pushed up a 20 degree slope (mu = 0.5) by a frictional (mu = 0.3) finger.
+    """Frictional: a block pushed up a 20 degree slope (mu = 0.5) by a frictionless finger.
 
-    Both slope contacts slide and the finger rolls; the forces are unique.
+    Both slope contacts slide and the finger rolls; three normal forces meet three equations of
+    equilibrium, so the forces are unique. (With friction at the finger as well, its tangential force
+    would trade against the supports' normal forces: a one-parameter family, forces indeterminate.)
     """
     alpha = math.radians(20.0)
     t, n = [math.cos(alpha), math.sin(alpha)], [-math.sin(alpha), math.cos(alpha)]
@@ -121,7 +123,7 @@ def friction_slope_2d() -> dict[str, Any]:
         "contacts": [
             _c("block", "slope", at(-0.1, 0.0), n, mu=0.5),
             _c("block", "slope", at(0.1, 0.0), n, mu=0.5),
-            _c("block", "finger", at(-0.1, 0.03), t, mu=0.3),
+            _c("block", "finger", at(-0.1, 0.03), t),
         ],
     }
 

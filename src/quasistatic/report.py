@@ -75,7 +75,7 @@ def render_solution(solution: Solution, console: Console) -> None:
     status = Text(solution.status, style=_STATUS_STYLE.get(solution.status, "bold"))
     console.print(Text.assemble("status: ", status))
     console.print(Text(solution.message))
-    console.print(Text(f"method: {solution.method}   friction model: {solution.friction}"))
+    console.print(Text(f"method: {solution.method}   friction model: {solution.friction}   {_proof(solution)}"))
     if solution.certificate is not None:
         console.print(Text(f"certificate: {solution.certificate.text}"))
     motion = solution.motion
@@ -93,6 +93,15 @@ def render_solution(solution: Solution, console: Console) -> None:
     ):
         console.print()
         console.print(table)
+
+
+def _proof(solution: Solution) -> str:
+    """Whether the answer is proven, in words: an unproven answer says so in every output."""
+    if solution.status == "failed":
+        return "proof: none (failed)"
+    if solution.certified:
+        return "proof: certified"
+    return "proof: NOT certified (a motion found, not proven the only one; solve with certify=True)"
 
 
 def _twist_table(twists: Mapping[str, np.ndarray], title: str) -> Table:

@@ -30,8 +30,9 @@ def solve(
     scene: Scene | Problem,
     method: str = "auto",
     *,
+    certify: bool = True,
     modes: Sequence[Mode | None] | None = None,
-    all_solutions: bool = False,
+    all_solutions: bool | None = None,
     max_solutions: int = 16,
     tolerance: float = DEFAULT_TOLERANCE,
     time_limit: float = 60.0,
@@ -44,14 +45,20 @@ def solve(
         A validated scene (or one already assembled, to solve it again cheaply).
     method : str
         ``auto`` (default) or a backend name from :data:`METHODS`. ``auto``
-        solves frictionless scenes by LP (certified) and frictional ones by
-        the fast path first; when the fast path finds no audited motion, or
-        when ``all_solutions`` or ``modes`` are given, by the certified search.
+        solves frictionless scenes by LP and frictional ones by the certified
+        search (or, with ``certify=False``, by the fast path first, falling
+        back to the certified search when it finds no audited motion).
+    certify : bool
+        True (default): ``solved`` means proven unique and ``ambiguous`` lists
+        every motion. False: with ``method="auto"``, accept the first audited
+        motion the fast path finds; the Solution then says
+        ``certified=False``. An explicitly named method answers as it can,
+        and ``Solution.certified`` says whether that answer is proven.
     modes : sequence of {"rolling", "sliding", "separating", None}, optional
         Prescribe contact modes, one entry per contact (None leaves it free).
-    all_solutions : bool
-        Certify the answer: list every motion (``ambiguous`` when there are
-        several) instead of returning the first audited one the fast path finds.
+    all_solutions : bool, optional
+        The earlier name of ``certify``; when given it wins. True with a method
+        that finds one motion (``fast``, ``paper``) is an error.
     max_solutions : int
         Most distinct motions listed when the answer is ``ambiguous``.
     tolerance : float
@@ -68,7 +75,7 @@ def solve(
     problem = scene if isinstance(scene, Problem) else assemble(scene)
     checked = _check_modes(modes, problem)
     options = Options(max_solutions, checked, time_limit)
-    names = _choose(method, problem, checked is not None, all_solutions)
+    names = _choose(method, problem, checked is not None, certify if all_solutions is None else all_solutions, bool(all_solutions))
     tried: list[Attempt] = []
     for name in names:
         backend = get_backend(name)
@@ -84,18 +91,21 @@ def solve(
     raise AssertionError("unreachable: the last method always returns")
 
 
-def _choose(method: str, problem: Problem, modes_given: bool, all_solutions: bool) -> tuple[str, ...]:
-    """Methods to try in order; a later one runs only when the earlier one found no audited motion."""
+def _choose(method: str, problem: Problem, modes_given: bool, certify: bool, insist: bool) -> tuple[str, ...]:
+    """Methods to try in order; a later one runs only when the earlier one found no audited motion.
+
+    ``insist``: every motion was asked for by name (``all_solutions=True``), which a one-motion method refuses.
+    """
     if method != "auto":
         backend = get_backend(method)
         if modes_given and not backend.prescribes_modes:
             raise ValueError(f"modes: method {method!r} cannot prescribe contact modes; use method 'auto' or 'scip'")
-        if all_solutions and not (backend.lists_all_motions or not backend.frictional):
+        if insist and backend.frictional and not backend.lists_all_motions:
             raise ValueError(f"all_solutions: method {method!r} finds one motion; use method 'auto' or 'scip'")
         return (method,)
     if problem.is_frictionless and not modes_given:
         return ("lp",)
-    if modes_given or all_solutions:
+    if modes_given or certify:
         return ("scip",)
     return ("fast", "scip")
 

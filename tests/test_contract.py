@@ -1,0 +1,95 @@
+"""The status contract: ``solved`` from a default solve means proven unique; an unproven answer says so everywhere.
+
+Scenes where the fast path's first motion is not the only one (found by the
+benchmark and by hand) must come out ``ambiguous`` from ``qs.solve(scene)``;
+``certify=False`` still gives the fast path's motion, marked as not certified
+in the Solution, its JSON and its table.
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+from rich.console import Console
+
+import quasistatic as qs
+from quasistatic.report import render_solution
+from quasistatic.tools.bench.families import grasp_2d, grasp_3d
+from random_scenes import random_scene
+
+
+def stick_on_two_fingers() -> qs.Scene:
+    """A stick (1 kg, com midway) on two fingertips 1 m apart, mu = 0.4 each; the right finger slides
+    under it at 0.1 m/s, the left one stays.
+
+    By symmetry each finger carries m g / 2. Friction drags the stick right at the right finger and
+    holds it back at the left one. Any stick speed v in [0, 0.1] satisfies the laws: for 0 < v < 0.1
+    both contacts slide with opposite frictions mu m g / 2, which balance; at v = 0 the left contact
+    rolls and the right slides; at v = 0.1 the right rolls and the left slides. A continuum of motions:
+    the rigid model cannot say which happens.
+    """
+    return qs.load_scene(
+        {
+            "quasistatic": 1,
+            "dimension": 2,
+            "bodies": {"stick": {"mass": 1.0, "com": [0.0, 0.0]}},
+            "movers": {"left": None, "right": {"twist": [0.1, 0.0, 0.0]}},
+            "contacts": [
+                {"body": "stick", "other": "left", "point": [-0.5, 0.0], "normal": [0.0, 1.0], "mu": 0.4},
+                {"body": "stick", "other": "right", "point": [0.5, 0.0], "normal": [0.0, 1.0], "mu": 0.4},
+            ],
+        }
+    )
+
+
+def test_stick_sliding_on_two_fingers_is_ambiguous_by_default() -> None:
+    sol = qs.solve(stick_on_two_fingers())
+    assert sol.status == "ambiguous", sol.message
+    assert sol.certified
+    speeds = [float(m.twists["stick"][0]) for m in sol.solutions]
+    extremes = [float(e["stick"][0]) for m in sol.solutions for e in m.extreme_twists]
+    assert any(m.continuum for m in sol.solutions)
+    # Every listed speed, and every extreme of a continuum, lies in [0, 0.1]; the ends of the interval are reached.
+    assert all(-1e-9 <= v <= 0.1 + 1e-9 for v in speeds + extremes)
+    assert min(speeds + extremes) == pytest.approx(0.0, abs=1e-9) and max(speeds + extremes) == pytest.approx(0.1, abs=1e-9)
+
+
+def test_fast_first_motion_is_marked_not_certified() -> None:
+    """certify=False returns the fast path's one motion (here: at one end of the continuum), flagged in every output."""
+    sol = qs.solve(stick_on_two_fingers(), certify=False)
+    assert sol.status == "solved" and sol.method == "fast"
+    assert sol.certified is False
+    assert sol.to_dict()["certified"] is False and sol.details["uniqueness"] == "not checked"
+    buffer = io.StringIO()
+    render_solution(sol, Console(file=buffer, width=160))
+    assert "NOT certified" in buffer.getvalue()
+
+
+@pytest.mark.parametrize(("contacts", "instance"), [(4, 4), (6, 2), (6, 4)])
+def test_benchmark_grasps_with_several_motions_are_ambiguous_by_default(contacts: int, instance: int) -> None:
+    """grasp-2d scenes the fast path called solved: the certified search lists several motions."""
+    scene = grasp_2d(contacts, instance)
+    assert qs.solve(scene, certify=False).status == "solved"  # the fast path finds one of them
+    sol = qs.solve(scene)
+    assert sol.status == "ambiguous" and sol.certified, sol.message
+    assert len(sol.solutions) >= 2 or any(m.continuum for m in sol.solutions)
+
+
+@pytest.mark.slow
+def test_benchmark_3d_grasp_with_several_motions_is_ambiguous_by_default() -> None:
+    sol = qs.solve(grasp_3d(6, 1))
+    assert sol.status == "ambiguous", sol.message
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_a_default_answer_never_contradicts_the_certified_method(seed: int) -> None:
+    """Random 2-D scenes: the default answer has the certified method's status, and its twist when solved."""
+    scene = random_scene(2, 1000 + seed)
+    default, certified = qs.solve(scene), qs.solve(scene, method="scip")
+    assert default.status == certified.status
+    assert default.certified or default.status == "failed"
+    if default.status == "solved":
+        for name, twist in certified.twists.items():
+            np.testing.assert_allclose(default.twists[name], twist, atol=1e-7)
