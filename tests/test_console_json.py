@@ -57,3 +57,16 @@ def test_example_json_is_json_and_nothing_else(path: Path) -> None:
     assert out.stderr == ""  # no solver banner, warning or C-library line on success
     if data["status"] in ("jammed", "unstable"):
         assert data["certificate"] is not None and data["diagnosis"] is not None
+    # No round-off noise: these scenes' speeds, forces and powers are 1e-3 and up, so a nonzero
+    # value below 1e-12 can only be round-off (audit residuals and power residuals are measurements).
+    noise = [(where, x) for where, x in _numbers(data) if x != 0.0 and abs(x) < 1e-12 and "audit" not in where and "residual" not in where]
+    assert not noise, noise
+
+
+def _numbers(value: object, where: str = "") -> list[tuple[str, float]]:
+    """Every float in a JSON value with its path."""
+    if isinstance(value, dict):
+        return [item for key, v in value.items() for item in _numbers(v, f"{where}.{key}")]
+    if isinstance(value, list):
+        return [item for i, v in enumerate(value) for item in _numbers(v, f"{where}[{i}]")]
+    return [(where, value)] if isinstance(value, float) else []

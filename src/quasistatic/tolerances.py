@@ -19,6 +19,7 @@ __all__ = [
     "SMALLEST_LENGTH",
     "AUDIT",
     "MODE_SPEED",
+    "ROUNDOFF",
     "DISPLAY_ZERO",
     "ZERO",
     "SAME_TWIST",
@@ -62,6 +63,9 @@ AUDIT = 1e-6
 
 MODE_SPEED = 1e-6
 """Relative speed (per velocity scale) below which a contact is not moving: rolling, not sliding or separating [-]."""
+
+ROUNDOFF = 1e-12
+"""Reported twists, forces, velocities and powers below this fraction of the scene's own scale are round-off: shown as 0 [-]."""
 
 DISPLAY_ZERO = 1e-12
 """Entries below this fraction of a column's largest one are printed as 0 (round-off, not data) [-]."""

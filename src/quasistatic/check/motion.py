@@ -2,7 +2,10 @@
 
 The audit runs at once; each contact's mode and result (:class:`ContactResult`)
 are made from the audit's own arrays when first read, so a mode is always
-what the audit measured, never what a solver claimed.
+what the audit measured, never what a solver claimed. Values below
+``ROUNDOFF`` of the scene's own scale (a 1e-17 twist entry next to 0.01 m/s
+motions) are reported as 0: they are round-off, not physics, and changing
+them moves no residual by more than that.
 """
 
 from __future__ import annotations
@@ -12,8 +15,8 @@ from typing import Any
 import numpy as np
 
 from ..model import Scales, Scene
-from ..solution import ContactResult, Mode, Motion
-from ..tolerances import AUDIT, MODE_SPEED
+from ..solution import ContactResult, Mode, Motion, PowerBalance
+from ..tolerances import AUDIT, MODE_SPEED, ROUNDOFF
 from .audit import AuditGeometry, audit_arrays
 
 __all__ = ["audited_motion", "ContactTable", "MotionGeometry"]
@@ -32,6 +35,12 @@ class MotionGeometry:
         self.names = tuple(b.name for b in scene.bodies)
         self.pairs = tuple((c.body, c.other) for c in scene.contacts)
         self.threshold = MODE_SPEED * scales.velocity
+        self.twist_roundoff = ROUNDOFF * scales.twist_units(scene.dimension)
+        # Per column of a contact's (normal velocity, slip speed, normal force).
+        self.contact_roundoff = ROUNDOFF * np.array([scales.velocity, scales.velocity, scales.force])
+        self.force_roundoff, self.speed_roundoff, self.power_roundoff = (
+            ROUNDOFF * x for x in (scales.force, scales.velocity, scales.power)
+        )
 
     @classmethod
     def of(cls, scene: Scene, scales: Scales) -> MotionGeometry:
@@ -62,9 +71,27 @@ def audited_motion(
         Physical normal-force ranges, when the forces are indeterminate [force].
     """
     audit, power, evaluation = audit_arrays(geometry.audit, twists, forces, scales, tolerance)
-    table = ContactTable(geometry.pairs, forces, evaluation.slips, evaluation.normal, geometry.threshold, ranges)
-    named = dict(zip(geometry.names, twists, strict=True))
-    return Motion(named, table, power, audit, continuum, extreme_twists, unbounded)
+    table = ContactTable(
+        geometry.pairs,
+        _clean(forces, geometry.force_roundoff),
+        _clean(evaluation.slips, geometry.speed_roundoff),
+        _clean(evaluation.normal, geometry.contact_roundoff),
+        geometry.threshold,
+        ranges,
+    )
+    named = dict(zip(geometry.names, _clean(twists, geometry.twist_roundoff), strict=True))
+    return Motion(named, table, _clean_power(power, geometry.power_roundoff), audit, continuum, extreme_twists, unbounded)
+
+
+def _clean(values: np.ndarray, roundoff: float | np.ndarray) -> np.ndarray:
+    """``values`` with entries within ``roundoff`` of zero set to 0 (``roundoff`` broadcast over the last axis)."""
+    return np.where(np.abs(values) <= roundoff, 0.0, values)
+
+
+def _clean_power(power: PowerBalance, roundoff: float) -> PowerBalance:
+    """Round-off powers shown as 0; the residual is a measurement and stays as it is."""
+    supplied, raised, dissipated = (0.0 if abs(x) <= roundoff else x for x in (power.input, power.gravity, power.dissipation))
+    return PowerBalance(supplied, raised, dissipated, power.residual)
 
 
 class ContactTable:
