@@ -70,3 +70,22 @@ def _numbers(value: object, where: str = "") -> list[tuple[str, float]]:
     if isinstance(value, list):
         return [item for i, v in enumerate(value) for item in _numbers(v, f"{where}[{i}]")]
     return [(where, value)] if isinstance(value, float) else []
+
+
+def test_jammed_names_its_blocking_contacts() -> None:
+    """push_into_wall: the finger (#4) pushes the box into the wall's two corners (#2, #3); the floor (#0, #1) does not block."""
+    out = _run("solve", str(ROOT / "examples" / "push_into_wall.yaml"))
+    assert out.returncode == 0, out.stderr
+    assert "blocking contacts: #2, #3, #4 " in out.stdout
+    assert "units: those of the scene file" in out.stdout
+
+
+def test_unstable_names_the_direction_of_the_fall() -> None:
+    """topple: the weight acts left of the fingertip (x = 0.03 > com x = 0), so the box turns counter-clockwise (+z)."""
+    out = _run("solve", str(ROOT / "examples" / "topple.yaml"), "--json")
+    data = json.loads(out.stdout)
+    assert data["certificate"]["kind"] == "ray"
+    vx, vy, wz = data["certificate"]["data"]
+    assert wz > 0 and max(abs(vx), abs(vy), abs(wz)) == 1.0
+    text = _run("solve", str(ROOT / "examples" / "topple.yaml")).stdout
+    assert "falls or accelerates along the twist" in text

@@ -15,7 +15,7 @@ from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
-from .solution import ContactResult, Motion, Solution
+from .solution import Certificate, CertificateKind, ContactResult, Motion, Solution
 from .tolerances import DISPLAY_ZERO
 
 __all__ = ["render_solution", "make_console", "format_float", "format_vector"]
@@ -76,8 +76,12 @@ def render_solution(solution: Solution, console: Console) -> None:
     console.print(Text.assemble("status: ", status))
     console.print(Text(solution.message))
     console.print(Text(f"method: {solution.method}   friction model: {solution.friction}   {_proof(solution)}"))
+    console.print(Text("units: those of the scene file (forces, lengths and times as given there)"))
     if solution.certificate is not None:
         console.print(Text(f"certificate: {solution.certificate.text}"))
+        explanation = _explain(solution.certificate)
+        if explanation:
+            console.print(Text(explanation))
     motion = solution.motion
     if motion is None:
         return
@@ -93,6 +97,18 @@ def render_solution(solution: Solution, console: Console) -> None:
     ):
         console.print()
         console.print(table)
+
+
+def _explain(certificate: Certificate) -> str:
+    """What a certificate says a person should look at: the blocking contacts, or the direction of the fall."""
+    if certificate.kind is CertificateKind.FARKAS:
+        weights = np.asarray(certificate.data)
+        blocking = np.flatnonzero(weights > 1e-9 * max(float(weights.max(initial=0.0)), 1e-300))
+        listed = ", ".join(f"#{i}" for i in blocking)
+        return f"blocking contacts: {listed} (the commanded motion would push the movers into the bodies there)"
+    if certificate.kind is CertificateKind.RAY:
+        return f"it falls or accelerates along the twist (v, ω of each body, largest entry 1): {format_vector(certificate.data)}"
+    return ""
 
 
 def _proof(solution: Solution) -> str:

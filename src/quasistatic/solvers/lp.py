@@ -235,8 +235,12 @@ def _verdict(problem: Problem, status: str) -> BackendResult:
     # Unstable: a twist d with Jn d >= 0 and g.d > 0 does unbounded work; box |d| <= 1 keeps the LP bounded.
     ray = solve_lp(g, Jn, np.zeros(m), np.full(m, INF), np.full(n, -1.0), np.full(n, 1.0), maximize=True)
     if ray.status == "optimal" and ray.objective > LP_FEASIBILITY and np.all(Jn @ ray.x >= -LP_FEASIBILITY * ray.objective):
-        direction = ray.x / ray.objective
-        certificate = Certificate(CertificateKind.RAY, "a twist along which the load does unbounded work", tuple(direction.tolist()))
+        # In physical units (v, omega per body, in scene order), scaled to a unit largest entry: a direction, not a speed.
+        units = np.tile(problem.scales.twist_units(problem.dimension), len(problem.scene.bodies))
+        physical = ray.x * units
+        direction = physical / np.max(np.abs(physical))
+        text = "a twist along which the load does unbounded work (v, omega of each body, largest entry 1)"
+        certificate = Certificate(CertificateKind.RAY, text, tuple(direction.tolist()))
         return BackendResult("unstable", _UNSTABLE_RAY, diagnosis=Diagnosis.NO_EQUILIBRIUM, certificate=certificate)
     return BackendResult("failed", f"failed: HiGHS reported {status} but no certificate could be checked")
 
