@@ -89,3 +89,12 @@ def test_unstable_names_the_direction_of_the_fall() -> None:
     assert wz > 0 and max(abs(vx), abs(vy), abs(wz)) == 1.0
     text = _run("solve", str(ROOT / "examples" / "topple.yaml")).stdout
     assert "falls or accelerates along the twist" in text
+
+
+def test_unbounded_continuum_names_its_free_directions() -> None:
+    """box_push_3d (frictionless): gravity pins vz, wx, wy; the finger at the -x face's middle requires
+    vx >= 0.01 (a spin about z moves that point along y only), and nothing bounds vx above, vy or wz."""
+    out = _run("solve", str(ROOT / "examples" / "box_push_3d.yaml"), "--json")
+    motion = json.loads(out.stdout)["solutions"][0]
+    assert motion["unbounded"] is True
+    assert set(motion["free_directions"]) == {"box v_x +", "box v_y +", "box v_y -", "box omega_z +", "box omega_z -"}

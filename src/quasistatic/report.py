@@ -216,7 +216,8 @@ def _render_solutions(motions: Sequence[Motion], console: Console) -> None:
         modes = ", ".join(motion.modes)
         kind = ""
         if motion.continuum:
-            kind = " continuum (unbounded)" if motion.unbounded else " continuum (bounded)"
+            free = ", ".join(motion.free_directions)
+            kind = f" continuum (unbounded: {free})" if motion.unbounded else " continuum (bounded)"
         console.print(Text(f"  motion {number}:{kind} modes [{modes}]"))
         for name, twist in motion.twists.items():
             console.print(Text(f"    {name}: twist {format_vector(twist)}"))

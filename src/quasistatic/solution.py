@@ -249,6 +249,9 @@ class Motion:
         True when this motion stands for a continuum of motions with the same
         contact modes; ``extreme_twists`` then lists its extreme motions along
         each twist coordinate and ``unbounded`` says whether it extends to infinity.
+    free_directions : tuple of str
+        For an unbounded continuum: the twist entries that grow (``+``) or fall (``-``)
+        without bound, e.g. ``("box v_x +",)``.
     """
 
     twists: dict[str, np.ndarray]
@@ -258,6 +261,7 @@ class Motion:
     continuum: bool = False
     extreme_twists: tuple[dict[str, np.ndarray], ...] = ()
     unbounded: bool = False
+    free_directions: tuple[str, ...] = ()
 
     def __getstate__(self) -> dict[str, Any]:
         # Twists as floats in lists: pickling small arrays costs more than the numbers in them.
@@ -290,6 +294,7 @@ class Motion:
         if self.continuum:
             out["continuum"] = True
             out["unbounded"] = self.unbounded
+            out["free_directions"] = list(self.free_directions)
             out["extreme_twists"] = [{n: _floats(t) for n, t in e.items()} for e in self.extreme_twists]
         return out
 

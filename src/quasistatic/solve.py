@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
 from .errors import QuasistaticError
-from .laws import Problem, RawMotion, assemble, physical_twists, to_world
+from .laws import Problem, RawMotion, assemble, free_directions, physical_twists, to_world
 from .model import Scene
 from .solution import Attempt, Mode, Motion, Solution
 from .solvers import BACKENDS, BackendResult, Options, Range, get_backend
@@ -142,6 +142,7 @@ def audited_raw_motion(problem: Problem, raw: RawMotion, ranges: list[Range] | N
         extreme_twists=extremes,
         continuum=raw.continuum,
         unbounded=raw.unbounded,
+        free_directions=free_directions(problem, raw.free_axes),
         tolerance=tolerance,
     )
 

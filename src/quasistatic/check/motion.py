@@ -57,6 +57,7 @@ def audited_motion(
     extreme_twists: tuple[dict[str, np.ndarray], ...] = (),
     continuum: bool = False,
     unbounded: bool = False,
+    free_directions: tuple[str, ...] = (),
     tolerance: float = AUDIT,
 ) -> Motion:
     """Audit one motion on the original scene data and name each contact's mode.
@@ -80,7 +81,8 @@ def audited_motion(
         ranges,
     )
     named = dict(zip(geometry.names, _clean(twists, geometry.twist_roundoff), strict=True))
-    return Motion(named, table, _clean_power(power, geometry.power_roundoff), audit, continuum, extreme_twists, unbounded)
+    power = _clean_power(power, geometry.power_roundoff)
+    return Motion(named, table, power, audit, continuum, extreme_twists, unbounded, free_directions)
 
 
 def _clean(values: np.ndarray, roundoff: float | np.ndarray) -> np.ndarray:

@@ -6,6 +6,6 @@ type aliases) only. Every solver builds on these; the audit never does.
 
 from .assemble import Problem, assemble
 from .modes import ModeMasks, contact_modes, slips
-from .motion import RawMotion, physical_twists, to_world
+from .motion import RawMotion, free_directions, physical_twists, to_world
 
-__all__ = ["ModeMasks", "Problem", "RawMotion", "assemble", "contact_modes", "physical_twists", "slips", "to_world"]
+__all__ = ["ModeMasks", "Problem", "RawMotion", "assemble", "contact_modes", "free_directions", "physical_twists", "slips", "to_world"]

@@ -10,7 +10,7 @@ from ..jit import HAVE_NUMBA, njit
 from ..model import FloatArray
 from .assemble import Problem
 
-__all__ = ["RawMotion", "WorldLayout", "to_world", "physical_twists"]
+__all__ = ["RawMotion", "WorldLayout", "to_world", "physical_twists", "free_directions"]
 
 
 @dataclass(frozen=True)
@@ -27,12 +27,15 @@ class RawMotion:
         For a continuum of motions: its extreme twists.
     unbounded : bool
         For a continuum: it extends to infinity.
+    free_axes : tuple of int
+        For an unbounded continuum: ``+(j + 1)`` where twist entry ``j`` grows without bound, ``-(j + 1)`` where it falls.
     """
 
     q: FloatArray
     c: FloatArray
     extremes: tuple[FloatArray, ...] = ()
     unbounded: bool = False
+    free_axes: tuple[int, ...] = ()
 
     @property
     def continuum(self) -> bool:
@@ -92,3 +95,11 @@ def _to_world_kernel(q: FloatArray, c: FloatArray, frames: FloatArray, units: Fl
                 total += c[i, s] * frames[i, s, j]
             forces[i, j] = total * force
     return T, forces
+
+
+def free_directions(problem: Problem, free_axes: tuple[int, ...]) -> tuple[str, ...]:
+    """Names of the signed twist directions of an unbounded continuum, e.g. ``"box v_x +"``, ``"box omega_z -"``."""
+    components = ("v_x", "v_y", "omega_z") if problem.dimension == 2 else ("v_x", "v_y", "v_z", "omega_x", "omega_y", "omega_z")
+    names = _layout(problem).names
+    k = len(components)
+    return tuple(f"{names[(abs(a) - 1) // k]} {components[(abs(a) - 1) % k]} {'+' if a > 0 else '-'}" for a in free_axes)

@@ -61,9 +61,9 @@ def solve_frictionless(problem: Problem, options: Options) -> BackendResult:
     _, slack, support, tight, closed, motion_unique, forces_unique = analysis
     # {d : Jn_S d = 0, Jn_T d >= 0} is only the origin at once when Jn_S has full column rank.
     if not motion_unique and not cone_is_trivial(Jn[support], Jn[tight]):
-        extremes, unbounded = twist_extremes(q.size, Jn[support], bn[support], Jn[~support], bn[~support])
-        motion = RawMotion(q, c, tuple(extremes), unbounded)
-        return BackendResult("ambiguous", _ambiguous_message(unbounded), (motion,))
+        extremes, free = twist_extremes(q.size, Jn[support], bn[support], Jn[~support], bn[~support])
+        motion = RawMotion(q, c, tuple(extremes), bool(free), free)
+        return BackendResult("ambiguous", _ambiguous_message(bool(free)), (motion,))
     # Forces are unique when the closed contacts' normals are independent.
     ranges = None if forces_unique else _force_ranges(Jn, g, slack)
     if ranges is not None:

@@ -299,7 +299,7 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
             return None
         c = recovered
     if motion.continuum and _twist_is_free(laws.jacobian(fit.x), problem.n_dof):
-        return RawMotion(q, c, motion.extremes, motion.unbounded)
+        return RawMotion(q, c, motion.extremes, motion.unbounded, motion.free_axes)
     return RawMotion(q, c)
 
 

@@ -209,7 +209,8 @@ def _pattern_motion(form: LCPForm, x: np.ndarray, z: np.ndarray, options: Option
     A_in, b_in = form.W[z == 1], form.r[z == 1]
     A_eq, b_eq, A_in, b_in = _with_prescribed_modes(form, options, A_eq, b_eq, A_in, b_in)
     lower = np.r_[np.full(form.n_q, -np.inf), np.zeros(N - form.n_q)]
-    extremes, unbounded = twist_extremes(form.n_q, A_eq, b_eq, A_in, b_in, lower)
+    extremes, free = twist_extremes(form.n_q, A_eq, b_eq, A_in, b_in, lower)
+    unbounded = bool(free)
     q = x[: form.n_q]
     continuum = unbounded or any(np.max(np.abs(e - q)) > SAME_TWIST for e in extremes)
     if not continuum:
@@ -218,7 +219,7 @@ def _pattern_motion(form: LCPForm, x: np.ndarray, z: np.ndarray, options: Option
     # every inequality as slack as it can be, the pairs' own variables (slip speeds) included.
     free_pairs = np.eye(N)[cols[z == 0]]
     x = relative_interior_point(A_eq, b_eq, np.vstack([A_in, free_pairs]), np.r_[b_in, np.zeros(len(free_pairs))], lower, x)
-    return RawMotion(x[: form.n_q], form.forces(x), tuple(extremes), unbounded)
+    return RawMotion(x[: form.n_q], form.forces(x), tuple(extremes), unbounded, free)
 
 
 def relative_interior_point(

@@ -49,27 +49,29 @@ def twist_extremes(
     A_in: np.ndarray,
     b_in: np.ndarray,
     col_lower: np.ndarray | None = None,
-) -> tuple[list[np.ndarray], bool]:
+) -> tuple[list[np.ndarray], tuple[int, ...]]:
     """Extreme points of a polyhedron along each of its first ``n_twist`` coordinates.
 
     Polyhedron: ``A_eq x = b_eq, A_in x >= b_in`` (columns free unless
-    ``col_lower``). Returns the distinct finite extremes and whether the twist
-    projection is unbounded.
+    ``col_lower``). Returns the distinct finite extremes and the directions
+    along which the twist projection is unbounded: ``+(j + 1)`` for coordinate
+    ``j`` growing without bound, ``-(j + 1)`` for it falling without bound.
     """
     A = np.vstack([A_eq, A_in])
     lower = np.r_[b_eq, b_in]
     upper = np.r_[b_eq, np.full(b_in.size, INF)]
     points: list[np.ndarray] = []
-    unbounded = False
-    objectives = [(sign * np.eye(1, A.shape[1], j)[0], False) for j in range(n_twist) for sign in (1.0, -1.0)]
-    for lp in optimise_each(objectives, A, lower, upper, col_lower):
+    free: list[int] = []
+    axes = [(j, sign) for j in range(n_twist) for sign in (1, -1)]
+    objectives = [(sign * np.eye(1, A.shape[1], j)[0], False) for j, sign in axes]
+    for (j, sign), lp in zip(axes, optimise_each(objectives, A, lower, upper, col_lower), strict=True):
         if lp.status == "optimal":
             q = lp.x[:n_twist]
             if not any(np.max(np.abs(q - p)) <= SAME_TWIST for p in points):
                 points.append(q)
-        else:
-            unbounded = True
-    return points, unbounded
+        else:  # minimising sign * x_j is unbounded: x_j runs to -sign infinity
+            free.append(-sign * (j + 1))
+    return points, tuple(free)
 
 
 def value_ranges(A_eq: np.ndarray, b_eq: np.ndarray, targets: np.ndarray, col_lower: np.ndarray) -> list[Range]:
