@@ -93,3 +93,33 @@ def test_a_default_answer_never_contradicts_the_certified_method(seed: int) -> N
     if default.status == "solved":
         for name, twist in certified.twists.items():
             np.testing.assert_allclose(default.twists[name], twist, atol=1e-7)
+
+
+def test_forces_indeterminate_inside_an_ambiguous_answer() -> None:
+    """Two level fingers (mu = 0.5) lift a 0.5 kg box between them at 0.01 m/s.
+
+    Two motions satisfy the laws: the lift (both rolling) and the slip down (both sliding). In the lift
+    each finger carries half the weight by friction, so the squeeze N must satisfy mu N >= m g / 2:
+    N >= 4.905 N, with no upper bound: that motion's forces are indeterminate, N in [4.905, inf).
+    """
+    up = {"twist": [0.0, 0.01, 0.0]}
+    scene = qs.load_scene(
+        {
+            "quasistatic": 1,
+            "dimension": 2,
+            "bodies": {"block": {"mass": 0.5, "com": [0.0, 0.0]}},
+            "movers": {"left": up, "right": up},
+            "contacts": [
+                {"body": "block", "other": "left", "point": [-0.05, 0.0], "normal": [1.0, 0.0], "mu": 0.5},
+                {"body": "block", "other": "right", "point": [0.05, 0.0], "normal": [-1.0, 0.0], "mu": 0.5},
+            ],
+        }
+    )
+    sol = qs.solve(scene)
+    assert sol.status == "ambiguous", sol.message
+    lift = next(m for m in sol.solutions if m.modes == ("rolling", "rolling"))
+    assert lift.forces_indeterminate and lift.to_dict()["forces_indeterminate"] is True
+    for contact in lift.contacts:
+        assert contact.normal_force_range is not None
+        low, high = contact.normal_force_range
+        assert low == pytest.approx(0.5 * 9.81 / 2 / 0.5, rel=1e-6) and high is None

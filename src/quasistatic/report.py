@@ -221,6 +221,9 @@ def _render_solutions(motions: Sequence[Motion], console: Console) -> None:
         console.print(Text(f"  motion {number}:{kind} modes [{modes}]"))
         for name, twist in motion.twists.items():
             console.print(Text(f"    {name}: twist {format_vector(twist)}"))
+        if motion.forces_indeterminate:
+            ranges = ", ".join(_format_range(c.normal_force_range) for c in motion.contacts)
+            console.print(Text(f"    forces indeterminate; normal-force ranges: {ranges}"))
         if motion.continuum and motion.extreme_twists:
             console.print(Text("    extreme twists:"))
             for extreme in motion.extreme_twists:

@@ -219,6 +219,8 @@ class ContactSource(Protocol):
 
     def modes(self) -> tuple[Mode, ...]: ...
 
+    def forces_indeterminate(self) -> bool: ...
+
 
 @dataclass(frozen=True)
 class ContactList:
@@ -231,6 +233,9 @@ class ContactList:
 
     def modes(self) -> tuple[Mode, ...]:
         return tuple(c.mode for c in self.contacts)
+
+    def forces_indeterminate(self) -> bool:
+        return any(c.normal_force_range is not None for c in self.contacts)
 
 
 @dataclass(frozen=True)
@@ -283,6 +288,11 @@ class Motion:
     def modes(self) -> tuple[Mode, ...]:
         return self.source.modes()
 
+    @property
+    def forces_indeterminate(self) -> bool:
+        """The motion is determined but its contact forces are not: each contact carries ``normal_force_range``."""
+        return self.source.forces_indeterminate()
+
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {
             "bodies": {name: {"twist": _floats(t)} for name, t in self.twists.items()},
@@ -290,6 +300,7 @@ class Motion:
             "contacts": [c.to_dict() for c in self.contacts],
             "power": self.power.to_dict(),
             "audit": self.audit.to_dict(),
+            "forces_indeterminate": self.forces_indeterminate,
         }
         if self.continuum:
             out["continuum"] = True
@@ -318,8 +329,9 @@ class Solution:
         Every distinct motion when ``ambiguous`` (a continuum is one entry with
         ``continuum`` set); otherwise empty.
     forces_indeterminate : bool
-        The motion is determined but the contact forces are not; each contact
-        then carries ``normal_force_range``.
+        The reported motion is determined but its contact forces are not; each
+        contact then carries ``normal_force_range``. (For ``ambiguous``, each
+        listed motion says the same of itself.)
     certified : bool
         The verdict is proven: ``solved`` means the only motion, ``ambiguous``
         lists motions that all satisfy the laws, ``jammed``/``unstable`` carry a

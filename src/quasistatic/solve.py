@@ -18,7 +18,7 @@ from .errors import QuasistaticError
 from .laws import Problem, RawMotion, assemble, free_directions, physical_twists, to_world
 from .model import Scene
 from .solution import Attempt, Mode, Motion, Solution
-from .solvers import BACKENDS, BackendResult, Options, Range, get_backend
+from .solvers import BACKENDS, BackendResult, Options, get_backend
 
 __all__ = ["solve", "METHODS", "audited_raw_motion"]
 
@@ -126,11 +126,12 @@ def _check_modes(modes: Sequence[Mode | None] | None, problem: Problem) -> tuple
     return modes
 
 
-def audited_raw_motion(problem: Problem, raw: RawMotion, ranges: list[Range] | None, tolerance: float) -> Motion:
+def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFAULT_TOLERANCE) -> Motion:
     """A backend's raw motion in physical units, audited on the original scene data."""
     scales = problem.scales
     geometry = problem.derived("motion_geometry", lambda p: MotionGeometry(p.scene, p.scales))
     T, forces = to_world(problem, raw.q, raw.c)
+    ranges = raw.force_ranges
     physical_ranges = None if ranges is None else [(lo * scales.force, None if hi is None else hi * scales.force) for lo, hi in ranges]
     extremes = tuple(physical_twists(problem, e) for e in raw.extremes)
     return audited_motion(
@@ -151,8 +152,7 @@ def _audited(
     problem: Problem, result: BackendResult, method: str, tolerance: float, options: Options, fallback: tuple[Attempt, ...], started: float
 ) -> Solution:
     """Turn raw motions into audited ones; a motion that fails its audit is never a success."""
-    ranges = result.force_ranges if len(result.motions) == 1 else None
-    motions = [audited_raw_motion(problem, raw, ranges, tolerance) for raw in result.motions]
+    motions = [audited_raw_motion(problem, raw, tolerance) for raw in result.motions]
     solution = Solution(
         result.status,
         result.message,
@@ -160,7 +160,7 @@ def _audited(
         str(problem.friction),
         motion=motions[0] if motions else None,
         solutions=tuple(motions) if result.status == "ambiguous" else (),
-        forces_indeterminate=result.force_ranges is not None and result.status == "solved",
+        forces_indeterminate=bool(result.motions) and result.motions[0].force_ranges is not None and result.status != "failed",
         certified=result.certified and result.status != "failed",
         diagnosis=result.diagnosis,
         certificate=result.certificate,

@@ -132,6 +132,9 @@ class ContactTable:
         self.pairs, self.threshold, self.ranges = state[:3]
         self.forces, self.slips, self.normal = (np.array(values, dtype=float).reshape(shape) for shape, values in state[3:])
 
+    def forces_indeterminate(self) -> bool:
+        return self.ranges is not None
+
     def modes(self) -> tuple[Mode, ...]:
         threshold = self.threshold
         return tuple(_mode(u_n, speed, threshold) for u_n, speed, _ in self.normal.tolist())

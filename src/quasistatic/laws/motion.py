@@ -29,6 +29,9 @@ class RawMotion:
         For a continuum: it extends to infinity.
     free_axes : tuple of int
         For an unbounded continuum: ``+(j + 1)`` where twist entry ``j`` grows without bound, ``-(j + 1)`` where it falls.
+    force_ranges : tuple of (lo, hi) or None
+        When the motion is determined but its forces are not: each contact's normal-force
+        range over every force distribution consistent with it (``hi`` None when unbounded).
     """
 
     q: FloatArray
@@ -36,6 +39,7 @@ class RawMotion:
     extremes: tuple[FloatArray, ...] = ()
     unbounded: bool = False
     free_axes: tuple[int, ...] = ()
+    force_ranges: tuple[tuple[float, float | None], ...] | None = None
 
     @property
     def continuum(self) -> bool:

@@ -67,7 +67,8 @@ def solve_frictionless(problem: Problem, options: Options) -> BackendResult:
     # Forces are unique when the closed contacts' normals are independent.
     ranges = None if forces_unique else _force_ranges(Jn, g, slack)
     if ranges is not None:
-        return BackendResult("solved", "solved: one motion; the contact forces are indeterminate", (RawMotion(q, c),), ranges)
+        motion = RawMotion(q, c, force_ranges=tuple(ranges))
+        return BackendResult("solved", "solved: one motion; the contact forces are indeterminate", (motion,))
     return BackendResult("solved", "solved: one motion with unique contact forces", (RawMotion(q, c),))
 
 

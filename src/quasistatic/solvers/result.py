@@ -63,9 +63,8 @@ class BackendResult:
         One sentence a person can act on.
     motions : tuple of RawMotion
         One motion for ``solved``, every distinct one for ``ambiguous``, none otherwise
-        (a ``failed`` answer may attach the motion it could not certify).
-    force_ranges : list of Range or None
-        Scene-relative normal-force ranges when the single motion's forces are indeterminate.
+        (a ``failed`` answer may attach the motion it could not certify). A motion whose
+        forces are indeterminate carries its normal-force ranges.
     certified : bool
         True when the verdict is proven: ``solved`` unique, ``ambiguous`` with every listed
         motion a motion, ``jammed`` and ``unstable`` with a certificate.
@@ -82,7 +81,6 @@ class BackendResult:
     status: Status
     message: str
     motions: tuple[RawMotion, ...] = ()
-    force_ranges: list[Range] | None = None
     certified: bool = True
     diagnosis: Diagnosis | None = None
     certificate: Certificate | None = None

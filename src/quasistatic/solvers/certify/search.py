@@ -12,6 +12,7 @@ whose twist extent is measured by LPs: a single twist, or a continuum.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -54,10 +55,11 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
             "before proving it unique; raise time_limit"
         )
         return BackendResult("failed", message, tuple(motions), certified=False, search_complete=False)
+    motions = [_with_force_ranges(form, motion) for motion in motions]
     if len(motions) == 1 and not motions[0].continuum:
-        ranges = force_ranges(form.problem, form.edges, motions[0].q)
-        message = "solved: one motion" + ("; the contact forces are indeterminate" if ranges else " with unique contact forces")
-        return BackendResult("solved", message, tuple(motions), ranges, search_complete=True)
+        indeterminate = motions[0].force_ranges is not None
+        message = "solved: one motion" + ("; the contact forces are indeterminate" if indeterminate else " with unique contact forces")
+        return BackendResult("solved", message, tuple(motions), search_complete=True)
     kinds = "a continuum of motions" if len(motions) == 1 else f"{len(motions)} distinct motions"
     more = "" if complete else " (the list may be incomplete)"
     return BackendResult(
@@ -66,6 +68,14 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
         tuple(motions),
         search_complete=complete,
     )
+
+
+def _with_force_ranges(form: LCPForm, motion: RawMotion) -> RawMotion:
+    """A single motion with its normal-force ranges when its forces are indeterminate (a continuum's forces vary along it)."""
+    if motion.continuum:
+        return motion
+    ranges = force_ranges(form.problem, form.edges, motion.q)
+    return motion if ranges is None else dataclasses.replace(motion, force_ranges=tuple(ranges))
 
 
 @dataclass

@@ -69,7 +69,7 @@ def solve_naive(problem: Problem) -> NaiveResult:
 
 def to_solution(problem: Problem, result: NaiveResult, tolerance: float = DEFAULT_TOLERANCE) -> Solution:
     """A Solution with each motion audited on the original scene (as ``solve`` does)."""
-    motions = tuple(audited_raw_motion(problem, raw, None, tolerance) for raw in result.motions)
+    motions = tuple(audited_raw_motion(problem, raw, tolerance) for raw in result.motions)
     status: Status = result.status
     if any(not m.audit.passed for m in motions):
         status = "failed"
