@@ -14,11 +14,11 @@ import time
 from collections.abc import Sequence
 
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
-from .errors import QuasistaticError
+from .errors import QuasistaticError, SolverError
 from .laws import Problem, RawMotion, assemble, free_directions, physical_twists, to_world
 from .model import Scene
 from .solution import Attempt, Mode, Motion, Solution
-from .solvers import BACKENDS, BackendResult, Options, get_backend
+from .solvers import BACKENDS, Backend, BackendResult, Options, get_backend
 
 __all__ = ["solve", "METHODS", "audited_raw_motion"]
 
@@ -84,11 +84,26 @@ def solve(
                 f"method {name!r} is frictionless but contacts {_frictional(problem)} have mu > 0; "
                 "use method 'auto', or set 'friction: none' to drop friction on purpose"
             )
-        solution = _audited(problem, backend.solver(problem, options), name, tolerance, options, tuple(tried), started)
+        solution = _audited(problem, _run(backend, problem, options), name, tolerance, options, tuple(tried), started)
         if solution.ok or name == names[-1]:
             return solution
         tried.append(Attempt(name, solution.message))
     raise AssertionError("unreachable: the last method always returns")
+
+
+def _run(backend: Backend, problem: Problem, options: Options) -> BackendResult:
+    """A backend's answer; anything a library underneath raises becomes a :class:`SolverError` naming the method.
+
+    Backends report statuses and raise only when something crashed (SCIP or HiGHS on
+    extreme numbers, a numerical library's internal error): the user gets the library's
+    own exception, with the original chained as its cause.
+    """
+    try:
+        return backend.solver(problem, options)
+    except QuasistaticError:
+        raise
+    except Exception as exc:
+        raise SolverError(backend.name, f"{type(exc).__name__}: {exc}") from exc
 
 
 def _choose(method: str, problem: Problem, modes_given: bool, certify: bool, insist: bool) -> tuple[str, ...]:

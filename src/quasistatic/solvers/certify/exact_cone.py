@@ -194,8 +194,25 @@ def _refined_result(problem: Problem, motions: list[RawMotion], complete: bool, 
 
 
 def _summary(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, note: str) -> BackendResult:
+    """Exact motions refined from a pyramid search. Completeness holds for the pyramid only, so: one motion is
+    ``solved`` (certified) only once the exact cones are proven to allow no other; a list is marked incomplete."""
     range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motions[0].q)))
-    return summarise(range_form, motions, complete, options).with_notes(exact_cone=note)
+    if len(motions) == 1 and not motions[0].continuum and complete:
+        return _unique_for_the_pyramid(summarise(range_form, motions, True, options)).with_notes(exact_cone=note)
+    return summarise(range_form, motions, False, options).with_notes(exact_cone=note)
+
+
+def _unique_for_the_pyramid(result: BackendResult) -> BackendResult:
+    """The pyramid's only motion, refined: an exact motion, but other exact motions are not excluded by proof.
+
+    (A sector relaxation that excludes a box around the motion cannot close the gap: its looseness,
+    about width^2/8 of a sector, exceeds the box long before sectors reach their finest.)
+    """
+    message = (
+        f"solved: one motion found; it is the only one of the {SEARCH_EDGES}-edge pyramid, but for the exact cones "
+        "its uniqueness is not proven (use friction 'pyramid:K' for a certified answer on a pyramid)"
+    )
+    return dataclasses.replace(result, message=message, certified=False, search_complete=False)
 
 
 def _free_motions_with_modes(problem: Problem, options: Options) -> BackendResult:
@@ -205,7 +222,8 @@ def _free_motions_with_modes(problem: Problem, options: Options) -> BackendResul
     matching = [motion for motion in free.motions if _keeps_prescribed(problem, motion, options)]
     if matching and free.status in ("solved", "ambiguous"):
         note = "the motions with the prescribed modes among every motion of the free search (its exact refinement)"
-        return _summary(problem, matching, bool(free.search_complete), options, note)
+        pyramid_complete = free.status == "solved" or bool(free.search_complete)  # a free solve's one motion was complete for the pyramid
+        return _summary(problem, matching, pyramid_complete, options, note)
     return BackendResult(
         "failed",
         f"failed: no motion with the prescribed contact modes exists for {SEARCH_EDGES}- and {WIDER_SEARCH_EDGES}-edge pyramids inscribed "
@@ -298,9 +316,18 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
         if recovered is None:
             return None
         c = recovered
-    if motion.continuum and _twist_is_free(laws.jacobian(fit.x), problem.n_dof):
-        return RawMotion(q, c, motion.extremes, motion.unbounded, motion.free_axes)
+    if motion.continuum and _twist_is_free(_jacobian_at(problem, q, c, new_modes), problem.n_dof):
+        # The pyramid's extremes are motions of the pyramid; only those that are motions of the exact
+        # cones are listed, and the refined point stands for the continuum when none is.
+        extremes = tuple(e for e in motion.extremes if _is_exact_motion(problem, e))
+        return RawMotion(q, c, extremes or (q,), motion.unbounded, motion.free_axes)
     return RawMotion(q, c)
+
+
+def _jacobian_at(problem: Problem, q: np.ndarray, c: np.ndarray, modes: np.ndarray) -> np.ndarray:
+    """The fixed-mode laws' Jacobian at a motion, for the modes it has (a sliding contact that came to rest rolls)."""
+    laws = FixedModeLaws(problem, ModeMasks.of(problem, modes))
+    return laws.jacobian(laws.start(q, c))
 
 
 def _inside_cones(problem: Problem, c: np.ndarray, rolling: np.ndarray) -> bool:

@@ -26,7 +26,7 @@ from ...tolerances import DISTINCT_TWIST, MODE_SPEED, SAME_TWIST
 from ..numerics.forces import force_ranges
 from ..numerics.highs import solve_lp
 from ..numerics.ranges import twist_extremes
-from ..numerics.scip_model import linear, new_model, optimize
+from ..numerics.scip_model import exclude_box, linear, new_model, optimize
 from ..result import BackendResult, Options
 from .diagnose import MESSAGES, diagnose
 
@@ -174,7 +174,7 @@ def _enumerate(form: LCPForm, options: Options, sos1: bool) -> tuple[list[RawMot
         if motion.continuum:
             _exclude_polyhedron(scip, model, zs, form)
         else:
-            _exclude_twist(scip, model.x[: form.n_q], xs[: form.n_q])
+            exclude_box(scip, model.x[: form.n_q], xs[: form.n_q], DISTINCT_TWIST)
 
 
 def _pattern(x: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -193,20 +193,6 @@ def _exclude_polyhedron(scip: Any, model: _Model, pattern: np.ndarray, form: LCP
         scip.addConsIndicator(-var <= -DISTINCT_TWIST, flag)
         leave.append(flag)
     scip.addCons(pyscipopt.quicksum(leave) >= 1)
-
-
-def _exclude_twist(scip: Any, q: list[Any], center: np.ndarray) -> None:
-    """Require some twist entry to differ from ``center`` by at least DISTINCT_TWIST."""
-    import pyscipopt
-
-    choices = []
-    for j, (var, value) in enumerate(zip(q, center, strict=True)):
-        up = scip.addVar(vtype="B", name=f"up{j}_{id(center)}")
-        down = scip.addVar(vtype="B", name=f"down{j}_{id(center)}")
-        scip.addConsIndicator(-var <= -(value + DISTINCT_TWIST), up)
-        scip.addConsIndicator(var <= value - DISTINCT_TWIST, down)
-        choices += [up, down]
-    scip.addCons(pyscipopt.quicksum(choices) >= 1)
 
 
 def _pattern_motion(form: LCPForm, x: np.ndarray, z: np.ndarray, options: Options) -> RawMotion:

@@ -9,7 +9,7 @@ import numpy as np
 from ...errors import SolverError
 from ...tolerances import LP_FEASIBILITY
 
-__all__ = ["new_model", "linear", "optimize"]
+__all__ = ["new_model", "linear", "optimize", "exclude_box"]
 
 
 def new_model(time_limit: float) -> Any:
@@ -39,3 +39,18 @@ def optimize(scip: Any, method: str) -> str:
     except Exception as exc:  # SCIP raises bare Exceptions on internal failures
         raise SolverError(method, f"SCIP failed: {exc}") from exc
     return str(scip.getStatus())
+
+
+def exclude_box(scip: Any, q: list[Any], center: np.ndarray, distance: float) -> None:
+    """Require some entry of the variables ``q`` to differ from ``center`` by at least ``distance`` (indicator constraints, no big-M)."""
+    import pyscipopt
+
+    choices = []
+    tag = len(scip.getVars())  # unique names within the model
+    for j, (var, value) in enumerate(zip(q, center, strict=True)):
+        up = scip.addVar(vtype="B", name=f"up{j}_{tag}")
+        down = scip.addVar(vtype="B", name=f"down{j}_{tag}")
+        scip.addConsIndicator(-var <= -(float(value) + distance), up)
+        scip.addConsIndicator(var <= float(value) - distance, down)
+        choices += [up, down]
+    scip.addCons(pyscipopt.quicksum(choices) >= 1)
