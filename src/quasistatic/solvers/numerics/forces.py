@@ -58,7 +58,7 @@ def forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: M
     polytope = force_polytope(problem, edges)
     K = polytope.K
     drive = -np.einsum("mkt,mt->mk", edges, slips(problem, q))  # dissipation rate per unit edge force
-    best = drive.max(axis=1)
+    best = drive.max(axis=1, initial=0.0)  # no edges (frictionless): nothing dissipates
     fixed = np.zeros(polytope.A.shape[1], dtype=bool)
     fixed[polytope.normal] = ~masks.closed
     weaker = drive < best[:, None] - _MOVING
@@ -74,7 +74,7 @@ def _measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeM
     u = problem.velocities(q)
     drive = -np.einsum("mkt,mt->mk", edges, u[:, :-1])
     closed = ~(u[:, -1] > _MOVING)
-    sliding = drive.max(axis=1) > _MOVING
+    sliding = drive.max(axis=1, initial=0.0) > _MOVING
     return ModeMasks(closed, closed & ~sliding & (problem.mu > 0), sliding)
 
 
