@@ -2,13 +2,15 @@
 
 Exit codes: 0 when the library gave an answer (``solved``, ``ambiguous``,
 ``jammed`` or ``unstable``: a diagnosis is an answer), 1 when the solve
-``failed``, 2 for bad input (an unreadable or invalid scene, an unknown
-method, malformed ``--modes``).
+``failed`` or a solver crashed (:class:`SolverError`), 2 for bad input (an
+unreadable or invalid scene, an unknown method or option, malformed
+``--modes``). Every error is one ``error:`` line on stderr, never a traceback.
 """
 
 from __future__ import annotations
 
 import json
+import sys
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
@@ -16,7 +18,7 @@ from typing import Annotated, NoReturn, TypeVar
 
 import typer
 
-from .errors import QuasistaticError
+from .errors import QuasistaticError, SolverError
 from .model import Scene, load_scene
 from .report import make_console, render_solution
 from .solution import Mode, Solution
@@ -62,7 +64,7 @@ def solve_command(
         str | None,
         typer.Option(help="Prescribed contact modes, one per contact in order: rolling, sliding, separating or free."),
     ] = None,
-    max_solutions: Annotated[int, typer.Option(min=1, help="Most distinct motions listed when ambiguous.")] = 16,
+    max_solutions: Annotated[int, typer.Option(help="Most distinct motions listed when ambiguous (at least 1).")] = 16,
     all_solutions: Annotated[
         bool,
         typer.Option(
@@ -72,6 +74,8 @@ def solve_command(
     ] = True,
 ) -> None:
     """Solve a scene file: twists, contact forces and modes, power balance and audit."""
+    if max_solutions < 1:
+        _fail(f"--max-solutions must be at least 1 (got {max_solutions})")
     scene = _guarded(lambda: load_scene(scene_file))
     prescribed = _guarded(lambda: _parse_modes(modes)) if modes is not None else None
     certify = all_solutions and method in ("auto", "scip")
@@ -105,8 +109,45 @@ def validate(
 
 
 def main() -> None:
-    """Entry point of the ``quasistatic`` command."""
-    app()
+    """Entry point of the ``quasistatic`` command: every failure is one ``error:`` line on stderr.
+
+    Usage errors (an unknown option, a missing argument, a bad option value) exit 2 like bad
+    input; an error nobody expected exits 1 with its type and message, not a traceback.
+    """
+    try:
+        code = app(standalone_mode=False)
+    except _USAGE_ERROR as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError":  # the help is the answer to no arguments
+            _echo_help(exc)
+            sys.exit(2)
+        _print_error(_usage_message(exc))
+        sys.exit(2)
+    except typer.Abort:
+        _print_error("aborted")
+        sys.exit(1)
+    except Exception as exc:  # a bug or a crash below the library: still one line
+        _print_error(f"internal error, please report it: {type(exc).__name__}: {exc}")
+        sys.exit(1)
+    sys.exit(code if isinstance(code, int) else 0)
+
+
+# typer vendors click in recent versions: the click exception class is found through typer's own public subclass.
+_USAGE_ERROR: type[Exception] = next(k for k in typer.BadParameter.__mro__ if k.__name__ == "ClickException")
+
+
+def _usage_message(exc: Exception) -> str:
+    """Click's message for a usage error, and where the command's help is."""
+    message = str(getattr(exc, "format_message", lambda: str(exc))()).rstrip(".")
+    context = getattr(exc, "ctx", None)
+    command = getattr(context, "command_path", None) or "quasistatic"
+    return f"{message} (see '{command} --help')"
+
+
+def _echo_help(exc: Exception) -> None:
+    """Print the help that click put in a no-arguments error, unless typer's rich output printed it already."""
+    text = str(getattr(exc, "format_message", lambda: "")())
+    if text.strip():
+        typer.echo(text)
 
 
 def _parse_modes(text: str) -> list[Mode | None]:
@@ -118,21 +159,35 @@ def _parse_modes(text: str) -> list[Mode | None]:
 
 
 def _guarded(action: Callable[[], _T]) -> _T:
-    """Run a library call; bad input becomes one ``error:`` line on stderr and exit code 2."""
+    """Run a library call; bad input becomes one ``error:`` line on stderr and exit code 2, a solver crash exit code 1."""
     try:
         return action()
+    except SolverError as exc:
+        _fail(str(exc), code=1)
     except (QuasistaticError, ValueError) as exc:
         _fail(str(exc))
 
 
-def _fail(message: str) -> NoReturn:
-    typer.echo(f"error: {' '.join(message.split())}", err=True)
-    raise typer.Exit(2)
+def _fail(message: str, code: int = 2) -> NoReturn:
+    _print_error(message)
+    raise typer.Exit(code)
+
+
+def _print_error(message: str) -> None:
+    """One ``error:`` line on stderr: whitespace runs become one space, other control characters are escaped."""
+    line = " ".join(message.split())
+    if not line.isprintable():
+        line = "".join(c if c.isprintable() else repr(c)[1:-1] for c in line)
+    typer.echo(f"error: {line}", err=True)
 
 
 def _report(solution: Solution, as_json: bool) -> None:
     if as_json:
-        typer.echo(json.dumps(solution.to_dict(), indent=2))
+        try:
+            text = json.dumps(solution.to_dict(), indent=2, allow_nan=False)
+        except ValueError:  # strict JSON has no Infinity or NaN: such an answer is a bug, not output
+            _fail("the answer holds a number that is not finite; JSON cannot carry it (please report it)", code=1)
+        typer.echo(text)
     else:
         render_solution(solution, make_console())
     raise typer.Exit(1 if solution.status == "failed" else 0)

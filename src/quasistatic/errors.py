@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 __all__ = [
@@ -27,6 +28,9 @@ class SceneError(QuasistaticError, ValueError):
         The offending value as given.
     reason : str
         What is wrong with it, in words.
+
+    The message shows at most 80 characters of the value and 120 of the field,
+    however large or deeply nested the value is.
     """
 
     def __init__(self, field: str, value: Any, reason: str) -> None:
@@ -34,7 +38,7 @@ class SceneError(QuasistaticError, ValueError):
         self.value = value
         self.reason = reason
         shown = _short_repr(value)
-        where = f"{field}: " if field else ""
+        where = f"{_short_text(field, _FIELD_LIMIT)}: " if field else ""
         super().__init__(f"{where}{reason} (got {shown})" if shown else f"{where}{reason}")
 
 
@@ -55,11 +59,66 @@ class BackendUnavailableError(QuasistaticError, ImportError):
         super().__init__(f"solver {backend!r} is not available: {install_hint}")
 
 
-def _short_repr(value: Any, limit: int = 80) -> str:
+_FIELD_LIMIT = 120
+_REPR_LIMIT = 80
+_CONTAINERS: dict[type, tuple[str, str]] = {list: ("[", "]"), tuple: ("(", ")"), set: ("{", "}"), frozenset: ("frozenset({", "})")}
+
+
+def _short_repr(value: Any, limit: int = _REPR_LIMIT) -> str:
+    """``repr(value)`` cut to ``limit`` characters, built piece by piece: a huge or deeply nested value costs no more."""
     if value is _MISSING:
         return ""
-    text = repr(value)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
+    text = ""
+    for piece in _pieces(value, limit):
+        text += piece
+        if len(text) > limit:
+            return text[: limit - 3] + "..."
+    return text
+
+
+def _pieces(value: Any, limit: int) -> Iterator[str]:
+    """The pieces of ``repr(value)`` in order, lazily: the caller stops reading once it has enough."""
+    kind = next((base for base in _CONTAINERS if isinstance(value, base)), None)
+    if kind is not None and value:
+        opening, closing = _CONTAINERS[kind]
+        yield opening
+        for index, item in enumerate(value):
+            yield ", " if index else ""
+            yield from _pieces(item, limit)
+        yield ",)" if kind is tuple and len(value) == 1 else closing
+    elif isinstance(value, dict) and value:
+        yield "{"
+        for index, (key, item) in enumerate(value.items()):
+            yield ", " if index else ""
+            yield from _pieces(key, limit)
+            yield ": "
+            yield from _pieces(item, limit)
+        yield "}"
+    else:
+        yield _leaf_repr(value, limit)
+
+
+def _leaf_repr(value: Any, limit: int) -> str:
+    """``repr`` of one value, never longer than needed: long text is cut first, huge integers are described."""
+    if isinstance(value, (str, bytes, bytearray)) and len(value) > limit:
+        return repr(value[:limit])
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 4 * limit:
+        return f"<an integer of about {int(value.bit_length() * 0.30103) + 1} digits>"
+    size = getattr(value, "size", None)
+    if isinstance(size, int) and size > limit and hasattr(value, "shape"):
+        return f"<array of shape {tuple(value.shape)}>"
+    try:
+        return repr(value)
+    except Exception:  # a broken __repr__ must not hide the error being reported
+        return f"<{type(value).__name__}>"
+
+
+def _short_text(text: str, limit: int) -> str:
+    """``text`` cut to ``limit`` characters, with non-printable characters escaped (a path may hold any key)."""
+    shown = text[: limit + 1]
+    if not shown.isprintable():
+        shown = "".join(c if c.isprintable() else repr(c)[1:-1] for c in shown)
+    return shown if len(shown) <= limit and len(text) <= limit else shown[: limit - 3] + "..."
 
 
 class _Missing:

@@ -46,6 +46,13 @@ __all__ = [
     "NEWTON_DAMPING",
     "LEAST_SQUARES_STEP",
     "JACOBI_ORTHOGONAL",
+    "MAX_MAGNITUDE",
+    "MAX_FRICTION",
+    "MAX_PYRAMID_EDGES",
+    "MAX_NAME_LENGTH",
+    "MAX_DEPTH",
+    "MAX_VALUES",
+    "MAX_FILE_BYTES",
 ]
 
 # --------------------------------------------------------------------------- input (physical units)
@@ -150,3 +157,49 @@ LEAST_SQUARES_STEP = 1e-15
 
 JACOBI_ORTHOGONAL = 1e-15
 """Two columns of a one-sided Jacobi SVD are orthogonal when their cosine is below this (working precision) [-]."""
+
+# --------------------------------------------------------------------------- input limits (what a scene may hold at all)
+
+MAX_MAGNITUDE = 1e30
+"""Largest |x| of any number in a scene [any unit]: the numerics' range, whatever the units.
+
+Assembly multiplies inputs before it scales them: a force is mass x gravity, a moment force x length, a
+power force x velocity (itself twist x length), and a norm squares each of these. Up to eight factors of
+1e30 stay finite (1e240 < 1e308). Measured on the examples: every input x 1e75 still gives the same
+answer; x 1e100 overflows the force scale's norm (NaN in the audit and Infinity in the JSON). 1e30 is
+also beyond what a manipulated object holds in any unit system (the Earth's mass is 6e27 g).
+"""
+
+MAX_FRICTION = 1e3
+"""Largest friction coefficient mu [-]. Measured coefficients stay below 10, and mu = 1e3 already grips
+like infinite friction. SCIP meets constraints to 1e-7 of the scene's forces, which friction multiplies
+by mu: on the examples mu = 1e4 still solves cleanly, mu = 1e5 gives SCIP "unresolved numerical
+troubles" (ERROR lines on stderr, a 25 s search) and mu = 1e308 an exception while the model is built.
+"""
+
+MAX_PYRAMID_EDGES = 64
+"""Most edges K of a ``pyramid:K`` friction model: its largest error is 1 - cos(pi/K) = 0.12 % of the
+cone at K = 64 (use ``exact`` for better); measured, the five-contact puck takes 40 s at K = 32 and runs
+out of the 60 s search at K = 64, and K = 1e8 would allocate gigabytes before the search starts.
+"""
+
+MAX_NAME_LENGTH = 256
+"""Most characters in a body, mover or robot name: names are printed in tables and error messages,
+and compared for "did you mean" hints, whose cost grows with their length.
+"""
+
+MAX_DEPTH = 64
+"""Most levels of nested lists and mappings in a scene: the format needs 5 (the scene, its contacts, a
+contact, its jacobian, a row); deeper input is rejected before anything recursive walks it.
+"""
+
+MAX_VALUES = 1_000_000
+"""Most values (numbers, strings, lists, mappings) a scene may hold once YAML aliases are expanded: a
+10,000-contact scene holds about 150,000; a few hundred bytes of nested aliases ("billion laughs")
+would otherwise expand to billions.
+"""
+
+MAX_FILE_BYTES = 16 * 1024 * 1024
+"""Largest scene file read [bytes]: about 100 times a 10,000-contact scene. Reading stops one byte past it,
+whatever the file claims to hold (``/dev/zero`` has no end).
+"""

@@ -3,13 +3,21 @@
 The file's structure is checked by a pydantic schema (unknown keys, missing
 keys and wrong types are reported with their path and a suggestion); the
 values are then checked by the :class:`Scene` they build.
+
+Hostile input costs little: a file is read up to :data:`MAX_FILE_BYTES` only;
+YAML is composed by a loader that counts what its aliases expand to
+(:data:`MAX_VALUES`), limits nesting (:data:`MAX_DEPTH`) and rejects duplicate
+keys as it goes, so a "billion laughs" file never expands in memory; and any
+data (JSON or a dict) is walked once without recursion for the same limits
+before pydantic or numpy look at it.
 """
 
 from __future__ import annotations
 
 import difflib
 import json
-from collections.abc import Mapping, Sequence
+import re
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -17,11 +25,17 @@ import pydantic
 import yaml
 
 from ..errors import MISSING, SceneError
+from ..tolerances import MAX_DEPTH, MAX_FILE_BYTES, MAX_VALUES
 from .scene import Body, Contact, Mover, Robot, Scene
 
 __all__ = ["load_scene", "FORMAT_VERSION"]
 
 FORMAT_VERSION = 1
+
+_LONGEST_INTEGER = 300  # digits: longer integers exceed any allowed magnitude; they are read as inf (Python's int() refuses > 4300)
+_SNIPPET = 40  # characters of the source shown for a value rejected while it is parsed
+_MERGE_TAG = "tag:yaml.org,2002:merge"
+_YAML_EVENTS: type = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's parser when built with it: 3x faster
 
 
 def _not_bool_or_text(value: Any) -> Any:
@@ -64,7 +78,7 @@ class _ContactFile(_FileModel):
 
 
 class _SceneFile(_FileModel):
-    quasistatic: int
+    quasistatic: pydantic.StrictInt
     dimension: Literal[2, 3] = 3
     gravity: list[_Number] | None = None
     friction: str = "exact"
@@ -80,14 +94,14 @@ def load_scene(source: str | Path | Mapping[str, Any]) -> Scene:
     Raises
     ------
     SceneError
-        Naming the field path and the offending value.
+        Naming the field path and the offending value; also for a file too large, nested too deep,
+        expanding past :data:`MAX_VALUES` values, or holding a key twice.
     """
     data = _read(source) if isinstance(source, (str, Path)) else source
     if not isinstance(data, Mapping):
         raise SceneError("", type(data).__name__, "a scene must be a mapping of keys (quasistatic, bodies, contacts, ...)")
-    version = data.get("quasistatic")
-    if "quasistatic" in data and version != FORMAT_VERSION:
-        raise SceneError("quasistatic", version, f"unsupported format version; this library reads version {FORMAT_VERSION}")
+    _check_structure(data)
+    _check_version(data)
     try:
         parsed = _SceneFile.model_validate(dict(data))
     except pydantic.ValidationError as exc:
@@ -103,6 +117,18 @@ def load_scene(source: str | Path | Mapping[str, Any]) -> Scene:
     )
 
 
+def _check_version(data: Mapping[str, Any]) -> None:
+    """The format version, if given, is the integer 1: not ``true`` (which equals 1), ``1.0`` or ``"1"``."""
+    if "quasistatic" not in data:
+        return  # the schema reports it missing
+    version = data["quasistatic"]
+    reason = f"unsupported format version; this library reads version {FORMAT_VERSION}"
+    if isinstance(version, bool) or not isinstance(version, int):
+        raise SceneError("quasistatic", version, f"{reason}, written as the integer {FORMAT_VERSION}")
+    if version != FORMAT_VERSION:
+        raise SceneError("quasistatic", version, reason)
+
+
 def _contact(entry: _ContactFile, index: int) -> Contact:
     """A contact of the file; an error in it names the contact by its index."""
     try:
@@ -111,25 +137,268 @@ def _contact(entry: _ContactFile, index: int) -> Contact:
         raise SceneError(exc.field.replace("contact", f"contacts[{index}]", 1), exc.value, exc.reason) from None
 
 
+# --------------------------------------------------------------------------- files
+
+
 def _read(path: str | Path) -> Any:
+    """The data of a scene file: JSON for ``.json``, YAML otherwise."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise SceneError("", str(path), f"cannot read the scene file: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise SceneError("", str(path), "the scene file is not UTF-8 text") from None
+    text = _read_text(path)
     try:
         if path.suffix.lower() == ".json":
-            return json.loads(text)
-        return yaml.safe_load(text)
+            return _parse_json(text)
+        return _SceneYamlLoader(text).load()
+    except SceneError:
+        raise
     except json.JSONDecodeError as exc:
         raise SceneError("", str(path), f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         raise SceneError("", str(path), f"not valid YAML{where}: {getattr(exc, 'problem', None) or exc}") from None
+    except RecursionError:  # a parser's own recursion (e.g. a YAML merge chain); nesting is limited before it
+        raise SceneError("", str(path), f"nested deeper than {MAX_DEPTH} levels") from None
+    except (ValueError, TypeError, OverflowError) as exc:  # a YAML tag's constructor, e.g. !!timestamp 2001-13-45
+        raise SceneError("", str(path), f"not valid {'JSON' if path.suffix.lower() == '.json' else 'YAML'}: {exc}") from None
 
+
+def _read_text(path: Path) -> str:
+    """The file's text, read up to one byte past :data:`MAX_FILE_BYTES` (a device or pipe may never end)."""
+    try:
+        with path.open("rb") as stream:
+            raw = stream.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise SceneError("", str(path), f"cannot read the scene file: {exc.strerror or exc}") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise SceneError("", str(path), f"the scene file is larger than {MAX_FILE_BYTES // 2**20} MiB")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise SceneError("", str(path), "the scene file is not UTF-8 text") from None
+
+
+def _huge_integer(text: str) -> float | None:
+    """``inf`` (signed) for an integer literal too long for Python's ``int()``, None otherwise: the Scene rejects it by field."""
+    if len(text) <= _LONGEST_INTEGER:
+        return None
+    return float("-inf") if text.lstrip().startswith("-") else float("inf")
+
+
+# --------------------------------------------------------------------------- JSON
+
+
+class _DuplicateKey(dict[str, Any]):
+    """A JSON object that gave ``key`` twice; :func:`_check_structure` reports it with its path."""
+
+    key: str = ""
+
+
+def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """``object_pairs_hook``: a dict, marked when a key came twice (the path is known only later)."""
+    result = dict(pairs)
+    if len(result) == len(pairs):
+        return result
+    marked = _DuplicateKey(result)
+    marked.key = _first_repeated(key for key, _ in pairs)
+    return marked
+
+
+def _first_repeated(keys: Iterable[str]) -> str:
+    """The first key that was seen before (there is one)."""
+    seen: set[str] = set()
+    for key in keys:
+        if key in seen:
+            return key
+        seen.add(key)
+    raise AssertionError("unreachable: the caller found a repeated key")
+
+
+def _json_integer(text: str) -> int | float:
+    """``parse_int``: Python's int, or inf for a literal too long for it."""
+    huge = _huge_integer(text)
+    return int(text) if huge is None else huge
+
+
+def _parse_json(text: str) -> Any:
+    """JSON with duplicate keys marked and huge integers read as inf; nesting past the parser's recursion names its path."""
+    try:
+        return json.loads(text, object_pairs_hook=_json_object, parse_int=_json_integer)
+    except RecursionError:
+        path, start = _json_too_deep(text)
+        raise SceneError(_format_path(path), _snippet(text, start), f"nested deeper than {MAX_DEPTH} levels") from None
+
+
+_JSON_TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"\s*:?|[\[\]{},]')
+
+
+def _json_too_deep(text: str) -> tuple[list[Any], int]:
+    """The path (keys and indices) to the first container of JSON text nested deeper than :data:`MAX_DEPTH`, and
+    where it starts: a flat scan of the text, for when the parser's own recursion gave up."""
+    stack: list[Any] = []  # per open container: its current index (array) or key (object)
+    for match in _JSON_TOKEN.finditer(text):
+        token = match.group()
+        if token in ("[", "{"):
+            if len(stack) >= MAX_DEPTH:
+                return stack, match.start()
+            stack.append(0 if token == "[" else "")
+        elif token in ("]", "}") and stack:
+            stack.pop()
+        elif token == "," and stack and isinstance(stack[-1], int):
+            stack[-1] += 1
+        elif token.endswith(":") and stack:
+            stack[-1] = json.loads(token[:-1].rstrip())
+    return stack, 0
+
+
+def _snippet(text: str, start: int) -> str:
+    """The source text from ``start`` to the end of its line, at most ``_SNIPPET`` characters: what the file wrote there."""
+    line = text[start : start + _SNIPPET + 1].split("\n", 1)[0]
+    return line if len(line) <= _SNIPPET else line[:_SNIPPET] + "..."
+
+
+# --------------------------------------------------------------------------- YAML
+
+
+class _SceneYamlLoader(yaml.composer.Composer, yaml.constructor.SafeConstructor, yaml.resolver.Resolver):
+    """PyYAML's safe loading, composed by hand from parser events with the limits checked per node.
+
+    Every composed node records how many values it holds once its aliases are expanded (an alias
+    costs its anchor's count, not its text), so an expansion past :data:`MAX_VALUES` is rejected
+    before anything is built. Nesting deeper than :data:`MAX_DEPTH`, an alias inside its own
+    anchor and a key given twice in one mapping are rejected too, each naming its path.
+    """
+
+    def __init__(self, text: str) -> None:
+        yaml.composer.Composer.__init__(self)
+        yaml.constructor.SafeConstructor.__init__(self)
+        yaml.resolver.Resolver.__init__(self)
+        self._text = text
+        self._events: Iterator[Any] = yaml.parse(text, Loader=_YAML_EVENTS)
+        self._next: Any = None
+        self._sizes: dict[Any, int] = {}  # node -> values it holds, aliases expanded; absent while it is composed
+        self._path: list[Any] = []
+
+    def load(self) -> Any:
+        """The document's data (None for an empty file)."""
+        return self.get_single_data()
+
+    # The event source PyYAML's Composer reads (its Parser's three methods).
+    def check_event(self, *choices: type) -> bool:
+        event = self.peek_event()
+        return event is not None and (not choices or isinstance(event, choices))
+
+    def peek_event(self) -> Any:
+        if self._next is None:
+            self._next = next(self._events, None)
+        return self._next
+
+    def get_event(self) -> Any:
+        event = self.peek_event()
+        self._next = None
+        return event
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        """Compose one node as PyYAML does, with its path, depth, expanded size and keys checked."""
+        if parent is not None:
+            self._path.append(_yaml_part(parent, index))
+        try:
+            return self._checked_node(parent, index)
+        finally:
+            if parent is not None:
+                self._path.pop()
+
+    def _checked_node(self, parent: Any, index: Any) -> Any:
+        """The node PyYAML composes, once its limits are checked (its path is already on ``_path``)."""
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent):
+            node = super().compose_node(parent, index)
+            if node not in self._sizes:
+                raise SceneError(_format_path(self._path), f"*{event.anchor}", "an alias cannot refer to a value that contains it")
+            return node
+        start = event.start_mark.index
+        collection = isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent))
+        if collection and len(self._path) >= MAX_DEPTH:
+            raise SceneError(_format_path(self._path), _snippet(self._text, start), f"nested deeper than {MAX_DEPTH} levels")
+        node = super().compose_node(parent, index)
+        size = 1 + sum(self._sizes[child] for child in _yaml_children(node))
+        if size > MAX_VALUES:
+            reason = f"holds more than {MAX_VALUES:,} values once its aliases are expanded; a scene needs far fewer"
+            raise SceneError(_format_path(self._path), _snippet(self._text, start), reason)
+        self._sizes[node] = size
+        if isinstance(node, yaml.MappingNode):
+            self._check_keys(node)
+        return node
+
+    def _check_keys(self, node: Any) -> None:
+        """No key twice in one mapping (YAML's ``<<`` merge keys may be overridden, as YAML intends)."""
+        seen: set[Any] = set()
+        for key_node, _ in node.value:
+            if not isinstance(key_node, yaml.ScalarNode) or key_node.tag == _MERGE_TAG:
+                continue
+            key = self.construct_object(key_node)
+            if key in seen:
+                raise SceneError(_format_path([*self._path, key]), key, "key given twice in the same mapping; give it once")
+            seen.add(key)
+
+    def construct_yaml_int(self, node: Any) -> int | float:
+        """PyYAML's integers, with a literal too long for ``int()`` read as inf (rejected by its field)."""
+        huge = _huge_integer(self.construct_scalar(node))
+        return super().construct_yaml_int(node) if huge is None else huge
+
+
+_SceneYamlLoader.add_constructor("tag:yaml.org,2002:int", _SceneYamlLoader.construct_yaml_int)
+
+
+def _yaml_part(parent: Any, index: Any) -> Any:
+    """The path part of a child node: its index in a sequence, its key's text in a mapping (``?`` for a key itself)."""
+    if isinstance(parent, yaml.SequenceNode):
+        return index
+    return index.value if isinstance(index, yaml.ScalarNode) else "?"
+
+
+def _yaml_children(node: Any) -> Iterator[Any]:
+    """The nodes a node holds: a sequence's items, a mapping's keys and values."""
+    if isinstance(node, yaml.SequenceNode):
+        yield from node.value
+    elif isinstance(node, yaml.MappingNode):
+        for key, value in node.value:
+            yield key
+            yield value
+
+
+# --------------------------------------------------------------------------- any data
+
+
+def _check_structure(data: Any) -> None:
+    """Depth, size and duplicate keys of any data, walked once with a stack (no recursion, shared values counted per use).
+
+    Raises
+    ------
+    SceneError
+        Past :data:`MAX_DEPTH` levels or :data:`MAX_VALUES` values, or for a JSON key given twice; naming the path.
+    """
+    stack: list[tuple[Any, tuple[Any, ...]]] = [(data, ())]
+    count = 1
+    while stack:
+        value, path = stack.pop()
+        if not isinstance(value, _CONTAINERS):
+            continue
+        if len(path) >= MAX_DEPTH:
+            raise SceneError(_format_path(path), value, f"nested deeper than {MAX_DEPTH} levels")
+        if isinstance(value, _DuplicateKey):
+            raise SceneError(_format_path([*path, value.key]), value.key, "key given twice in the same mapping; give it once")
+        count += len(value)
+        if count > MAX_VALUES:
+            reason = f"holds more than {MAX_VALUES:,} values (a shared list counts each time it is used); a scene needs far fewer"
+            raise SceneError(_format_path(path), value, reason)
+        items = value.items() if isinstance(value, Mapping) else enumerate(value)
+        stack.extend((child, (*path, key)) for key, child in items)
+
+
+_CONTAINERS = (Mapping, list, tuple, set, frozenset)
+
+
+# --------------------------------------------------------------------------- pydantic's errors in the library's words
 
 _MODELS_BY_DEPTH: dict[str, type[pydantic.BaseModel]] = {
     "": _SceneFile,
@@ -138,31 +407,60 @@ _MODELS_BY_DEPTH: dict[str, type[pydantic.BaseModel]] = {
     "robots": _RobotFile,
     "contacts": _ContactFile,
 }
+_MODEL_NAMES = {model.__name__ for model in _MODELS_BY_DEPTH.values()}
+_WORDS = {
+    "list_type": "expected a list",
+    "dict_type": "expected a mapping of names to entries",
+    "string_type": "expected a string",
+    "float_type": "expected a number",
+    "float_parsing": "expected a number",
+    "finite_number": "expected a finite number",
+    "int_type": "expected an integer",
+    "literal_error": "must be 2 or 3",
+}
 
 
 def _scene_error(exc: pydantic.ValidationError) -> SceneError:
+    """The first of pydantic's errors as a SceneError in this library's words (never its internal class names)."""
     errors = exc.errors()
     # A misspelt key shows as both "missing" and "extra": report the extra one, with a hint.
     error = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
-    loc = [part for part in error["loc"] if part not in ("_MoverFile",)]
-    path = _format_path(loc)
+    loc = [part for part in error["loc"] if part not in _MODEL_NAMES]
     kind = error["type"]
+    if loc and loc[-1] == "[key]":
+        return SceneError(_format_path(loc[:-2]), loc[-2], "names (keys) must be strings")
+    path = _format_path(loc)
+    model = _MODELS_BY_DEPTH.get(str(loc[0]) if len(loc) > 1 else "", _SceneFile)
     if kind == "extra_forbidden":
-        key = str(loc[-1])
-        model = _MODELS_BY_DEPTH.get(str(loc[0]) if len(loc) > 1 else "", _SceneFile)
-        close = difflib.get_close_matches(key, list(model.model_fields), n=1)
-        hint = f"; did you mean {close[0]!r}?" if close else f"; allowed: {', '.join(model.model_fields)}"
-        return SceneError(path, key, f"unknown key{hint}")
+        return SceneError(path, loc[-1], f"unknown key{_key_hint(str(loc[-1]), model)}")
     if kind == "missing":
         return SceneError(path, MISSING, "required key is missing")
-    return SceneError(path, error.get("input"), error["msg"].lower())
+    if kind == "model_type":
+        return SceneError(path, error.get("input"), f"expected a mapping with keys {', '.join(model.model_fields)}")
+    return SceneError(path, error.get("input"), _WORDS.get(kind) or _plain(error["msg"]))
+
+
+def _key_hint(key: str, model: type[pydantic.BaseModel]) -> str:
+    """'; did you mean ...?' for a misspelt key, else the allowed keys (no fuzzy matching of a huge key)."""
+    close = difflib.get_close_matches(key, list(model.model_fields), n=1) if len(key) <= 100 else []
+    return f"; did you mean {close[0]!r}?" if close else f"; allowed: {', '.join(model.model_fields)}"
+
+
+def _plain(message: str) -> str:
+    """pydantic's message without its 'Value error, ' prefix or class names, starting in lower case."""
+    message = re.sub(r"^value error, ", "", message, flags=re.IGNORECASE)
+    message = re.sub(r"\b_\w+File\b", "mapping", message)
+    return message[:1].lower() + message[1:]
 
 
 def _format_path(loc: Sequence[Any]) -> str:
+    """``bodies.box.com``, ``contacts[1].normal``; a key that is not plain printable text is shown quoted."""
     text = ""
     for part in loc:
-        if isinstance(part, int):
+        if isinstance(part, int) and not isinstance(part, bool):
             text += f"[{part}]"
+        elif isinstance(part, str) and part.isprintable() and part:
+            text += f".{part}" if text else part
         else:
-            text += f".{part}" if text else str(part)
+            text += f"[{part!r}]"
     return text

@@ -20,16 +20,21 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import SceneError
-from ..tolerances import NORMAL_LENGTH
+from ..tolerances import MAX_FRICTION, MAX_MAGNITUDE, MAX_NAME_LENGTH, MAX_PYRAMID_EDGES, NORMAL_LENGTH
 from .friction import FrictionModel, parse_friction
 
 __all__ = ["Body", "Mover", "Robot", "Contact", "Scene", "FloatArray"]
 
 FloatArray = npt.NDArray[np.float64]
 
+_TOO_LARGE = "larger numbers overflow the solvers' products; choose other units"
+_MU_TOO_LARGE = "beyond the solvers' precision; mu = 1000 already grips like infinite friction"
+_SHOWN_NAMES = 10  # known names listed when a name names nothing
+_FRICTION_TEXT_LENGTH = 40  # longer text is no friction model ("pyramid:" and a thousand digits)
+
 
 def _array(value: Any, path: str, ndim: int = 1) -> FloatArray:
-    """A read-only float array of ``ndim`` dimensions, every entry finite."""
+    """A read-only float array of ``ndim`` dimensions, every entry finite and within :data:`MAX_MAGNITUDE`."""
     what = "a list of numbers" if ndim == 1 else "a matrix (list of rows) of numbers"
     if isinstance(value, (str, bytes, bool)):
         raise SceneError(path, value, f"expected {what}")
@@ -41,24 +46,37 @@ def _array(value: Any, path: str, ndim: int = 1) -> FloatArray:
         raise SceneError(path, value, f"expected {what}")
     if not np.all(np.isfinite(array)):
         raise SceneError(path, value, "every entry must be a finite number (no NaN or inf)")
+    if array.size and float(np.max(np.abs(array))) > MAX_MAGNITUDE:
+        raise SceneError(path, value, f"every entry must be at most {MAX_MAGNITUDE:g} in magnitude ({_TOO_LARGE})")
     array.setflags(write=False)
     return array
 
 
-def _number(value: Any, path: str, minimum: float | None = None) -> float:
+def _number(value: Any, path: str, minimum: float | None = None, maximum: float = MAX_MAGNITUDE, why: str = "") -> float:
+    """A finite float in ``[minimum, maximum]`` (and within :data:`MAX_MAGNITUDE`); ``why`` explains the maximum."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
         raise SceneError(path, value, "expected a number")
-    number = float(value)
+    try:
+        number = float(value)
+    except OverflowError:
+        raise SceneError(path, value, f"must be at most {maximum:g} in magnitude ({why or _TOO_LARGE})") from None
     if not math.isfinite(number):
         raise SceneError(path, value, "must be a finite number (no NaN or inf)")
     if minimum is not None and number < minimum:
         raise SceneError(path, value, f"must be >= {minimum:g}")
+    if abs(number) > maximum:
+        raise SceneError(path, value, f"must be at most {maximum:g} in magnitude ({why or _TOO_LARGE})")
     return number
 
 
 def _name(value: Any, path: str) -> str:
+    """A name: non-empty printable text of at most :data:`MAX_NAME_LENGTH` characters (it is printed in tables)."""
     if not isinstance(value, str) or not value:
         raise SceneError(path, value, "names must be non-empty strings")
+    if len(value) > MAX_NAME_LENGTH:
+        raise SceneError(path, value, f"names must be at most {MAX_NAME_LENGTH} characters long (this one has {len(value)})")
+    if not value.isprintable():
+        raise SceneError(path, value, "names must be printable text: no newlines, tabs, escape or other control characters")
     return value
 
 
@@ -89,10 +107,10 @@ class Body:
     wrench: FloatArray | None
 
     def __init__(self, name: str, mass: float, com: npt.ArrayLike, wrench: npt.ArrayLike | None = None) -> None:
-        path = f"bodies.{name}"
+        path = f"bodies.{_name(name, 'bodies')}"
         _assign(
             self,
-            name=_name(name, "bodies"),
+            name=name,
             mass=_number(mass, f"{path}.mass", minimum=0.0),
             com=_array(com, f"{path}.com"),
             wrench=None if wrench is None else _array(wrench, f"{path}.wrench"),
@@ -122,15 +140,15 @@ class Mover:
     def __init__(
         self, name: str, twist: npt.ArrayLike | None = None, origin: npt.ArrayLike | None = None, robot: str | None = None
     ) -> None:
-        path = f"movers.{name}"
+        path = f"movers.{_name(name, 'movers')}"
         if robot is not None and not isinstance(robot, str):
             raise SceneError(f"{path}.robot", robot, "expected a robot's name")
         _assign(
             self,
-            name=_name(name, "movers"),
+            name=name,
             twist=None if twist is None else _array(twist, f"{path}.twist"),
             origin=None if origin is None else _array(origin, f"{path}.origin"),
-            robot=robot,
+            robot=None if robot is None else _name(robot, f"{path}.robot"),
         )
 
 
@@ -192,7 +210,7 @@ class Contact:
             other=_name(other, "contact.other"),
             point=_array(point, "contact.point"),
             normal=_array(normal, "contact.normal"),
-            mu=_number(mu, "contact.mu", minimum=0.0),
+            mu=_number(mu, "contact.mu", minimum=0.0, maximum=MAX_FRICTION, why=_MU_TOO_LARGE),
             jacobian=None if jacobian is None else _array(jacobian, "contact.jacobian", ndim=2),
         )
 
@@ -231,8 +249,9 @@ class Scene:
         gravity: npt.ArrayLike | None = None,
         friction: FrictionModel | str = "exact",
     ) -> None:
-        if isinstance(dimension, bool) or dimension not in (2, 3):
+        if isinstance(dimension, bool) or not isinstance(dimension, (int, np.integer)) or dimension not in (2, 3):
             raise SceneError("dimension", dimension, "must be 2 or 3")
+        dimension = int(dimension)
         model = _friction(friction, dimension)
         default_gravity = [0.0, -9.81] if dimension == 2 else [0.0, 0.0, -9.81]
         gravity_vector = _sized(_array(default_gravity if gravity is None else gravity, "gravity"), dimension, "gravity")
@@ -277,12 +296,29 @@ class Scene:
 
 
 def _friction(friction: FrictionModel | str, dimension: int) -> FrictionModel:
-    model = parse_friction(friction) if isinstance(friction, str) else friction
+    """The friction model, parsed from text if need be; a pyramid has at most :data:`MAX_PYRAMID_EDGES` edges, in 3-D only."""
+    model = _parse_friction(friction) if isinstance(friction, str) else friction
     if not isinstance(model, FrictionModel):
         raise SceneError("friction", friction, "expected 'exact', 'none' or 'pyramid:K'")
     if model.kind == "pyramid" and dimension == 2:
         raise SceneError("friction", str(model), "pyramid:K is for 3-D; the 2-D cone is already exact")
+    if model.kind == "pyramid" and not 3 <= model.edges <= MAX_PYRAMID_EDGES:
+        reason = f"a pyramid has 3 to {MAX_PYRAMID_EDGES} edges; for a finer cone use 'exact'"
+        raise SceneError("friction", str(model), reason)
     return model
+
+
+def _parse_friction(text: str) -> FrictionModel:
+    """:func:`parse_friction`, for any text: too long to be a model (ten thousand digits) or with digits
+    ``int()`` refuses (``pyramid:²``), it is a SceneError too."""
+    if len(text) > _FRICTION_TEXT_LENGTH:
+        raise SceneError("friction", text, "expected 'exact', 'none' or 'pyramid:K'")
+    try:
+        return parse_friction(text)
+    except SceneError:
+        raise
+    except ValueError:
+        raise SceneError("friction", text, "pyramid needs an integer number of edges K >= 3, e.g. 'pyramid:8'") from None
 
 
 def _sized(vector: FloatArray, length: int, path: str) -> FloatArray:
@@ -398,7 +434,9 @@ def _check_unique_names(bodies: tuple[Body, ...], movers: tuple[Mover, ...], rob
 
 
 def _unknown(kind: str, name: Any, known: Collection[str] | Mapping[str, Any]) -> str:
+    """The reason for a name that names nothing: the closest known name, or the first few known ones."""
     names = sorted(known)
     close = difflib.get_close_matches(str(name), names, n=1)
-    hint = f"; did you mean {close[0]!r}?" if close else f"; known: {', '.join(map(repr, names)) or 'none'}"
+    shown = ", ".join(map(repr, names[:_SHOWN_NAMES])) + (f", ... ({len(names)} in all)" if len(names) > _SHOWN_NAMES else "")
+    hint = f"; did you mean {close[0]!r}?" if close else f"; known: {shown or 'none'}"
     return f"no {kind} of that name{hint}"
