@@ -19,6 +19,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import quasistatic as qs
+from catalogue import laws_hold
 
 G = 9.81
 ALPHA = math.radians(30.0)
@@ -175,6 +176,7 @@ def test_base_scene_is_solved_with_unique_forces(name: str, reference: dict[str,
     assert sol.status == "solved", sol.message
     assert not sol.forces_indeterminate
     assert sol.audit is not None and sol.audit.passed
+    laws_hold(qs.load_scene(BASES[name]()), sol.motion)  # the reference obeys the laws, checked from the scene alone
     assert np.all(normal_forces(sol) > 0.1)  # every contact loaded: the answer is not near a mode switch
     assert any(np.any(np.abs(t) > 1e-3) for t in twists(sol).values())  # it moves
 

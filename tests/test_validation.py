@@ -8,6 +8,7 @@ reason, so a fix shows up as an unexpected pass.
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 from pathlib import Path
 
@@ -161,18 +162,18 @@ def test_extruded_case_compares_pair_sums() -> None:
 
 def test_a_wrong_expectation_fails_with_a_reason() -> None:
     case = next(c for c in CASES if c.id == "slope-block-20")
-    wrong = Case(**{**case.__dict__, "expect": {**case.expect, "normal_forces": [5.0, 3.770388]}})
+    wrong = dataclasses.replace(case, expect={**case.expect, "normal_forces": [5.0, 3.770388]})
     result = run_case(wrong)
     assert not result.passed
     assert "normal forces" in result.failures[0]
-    wrong_status = Case(**{**case.__dict__, "expect": {"status": "unstable"}})
+    wrong_status = dataclasses.replace(case, expect={"status": "unstable"})
     assert "expected unstable" in run_case(wrong_status).failures[0]
 
 
 def test_render_results_prints_every_case(tmp_path: Path) -> None:
     results = run_validation(FOLDER, include_slow=False, select=lambda c: c.id == "slope-block-20")
     case = next(c for c in CASES if c.id == "grasp-level")
-    results.append(run_case(Case(**{**case.__dict__, "expect": {"status": "unstable"}})))  # a wrong expectation
+    results.append(run_case(dataclasses.replace(case, expect={"status": "unstable"})))  # a wrong expectation
     console = Console(record=True, width=200)
     render_results(results, console)
     text = console.export_text()
