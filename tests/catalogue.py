@@ -1447,12 +1447,6 @@ assert len(BY_NAME) == len(CASES)
 
 # (case, method id): a library bug the pair exposes, run as a strict xfail with the evidence (the exception it raises).
 KNOWN_BUGS: dict[tuple[str, str], tuple[type[BaseException], str]] = {
-    ("unsupported-block", "scip"): (
-        AssertionError,
-        "scip calls a box with no contact at all 'jammed' (diagnosis wedged, certificate 'equilibrium exists; no motion "
-        "found by the complete search') though no force can hold its weight: lp and paper say unstable; already so before "
-        "the restructure (6d29918); qs.solve's default sends contact-free scenes to lp, so only method='scip' shows it",
-    ),
     ("puck-slip-off-axis-3d", "paper"): (
         AssertionError,
         "paper's sliding friction forces are up to 2.6e-4 rad off the slip direction (3.1e-4 N across the slip, 3e-5 of "

@@ -115,7 +115,7 @@ def _choose(method: str, problem: Problem, modes_given: bool, certify: bool, ins
         backend = get_backend(method)
         if modes_given and not backend.prescribes_modes:
             raise ValueError(f"modes: method {method!r} cannot prescribe contact modes; use method 'auto' or 'scip'")
-        if insist and backend.frictional and not backend.lists_all_motions:
+        if insist and not backend.lists_all_motions:
             raise ValueError(f"all_solutions: method {method!r} finds one motion; use method 'auto' or 'scip'")
         return (method,)
     if problem.is_frictionless and not modes_given:

@@ -36,9 +36,11 @@ class Backend:
     frictional : bool
         Handles contacts with ``mu > 0`` (else every contact must be frictionless).
     certifies : bool
-        Its ``solved`` is proven unique, its ``jammed``/``unstable`` proven.
+        Its ``solved`` is proven unique, its ``jammed``/``unstable`` proven (for ``scip``
+        with exact 3-D cones, ``solved`` is unique for the searched pyramid only:
+        each Solution's ``certified`` says which).
     lists_all_motions : bool
-        Enumerates every motion (``all_solutions`` may be asked of it).
+        Reports every motion, a continuum as one entry (``all_solutions`` may be asked of it).
     prescribes_modes : bool
         Takes prescribed contact modes (the mode-specified solve).
     requires : str or None
@@ -88,6 +90,7 @@ BACKENDS: dict[str, Backend] = {
             "solve_frictionless",
             "frictionless LP, the paper's velocity/force formulation (Lemke's method on small problems, HiGHS otherwise)",
             frictional=False,
+            lists_all_motions=True,
         ),
         Backend(
             "scip",

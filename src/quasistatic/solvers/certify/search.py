@@ -50,9 +50,9 @@ def certified_polyhedral(problem: Problem, edges: np.ndarray, options: Options) 
 def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: Options) -> BackendResult:
     """One motion: solved (with force ranges); several or a continuum: ambiguous."""
     if len(motions) == 1 and not motions[0].continuum and not complete:
+        limit = "max_solutions (1)" if options.max_solutions <= 1 else "the time limit"
         message = (
-            "failed: one motion was found (audited, reported as the motion), but the search hit the time limit "
-            "before proving it unique; raise time_limit"
+            f"failed: one motion was found (audited, reported as the motion), but the search hit {limit} before proving it unique; raise it"
         )
         return BackendResult("failed", message, tuple(motions), certified=False, search_complete=False)
     motions = [_with_force_ranges(form, motion) for motion in motions]

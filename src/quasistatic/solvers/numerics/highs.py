@@ -104,8 +104,16 @@ def solve_lp(
 
     Columns are free unless bounds are given. Infinite bounds use ``float('inf')``.
     """
+    if cost.size == 0:  # HiGHS calls a model without columns "empty" whatever its rows demand
+        return _without_columns(row_lower, row_upper)
     solver = _load(_thread_highs(), cost, A, row_lower, row_upper, col_lower, col_upper, maximize)
     return _run(solver, cost, maximize)
+
+
+def _without_columns(row_lower: np.ndarray, row_upper: np.ndarray) -> LPResult:
+    """An LP with no unknowns: feasible exactly when every row's range holds 0 (each row is 0)."""
+    feasible = bool(np.all(np.asarray(row_lower) <= 0.0) and np.all(np.asarray(row_upper) >= 0.0))
+    return LPResult("optimal" if feasible else "infeasible", np.zeros(0), np.zeros(len(row_lower)), 0.0 if feasible else float("nan"))
 
 
 def optimise_each(
