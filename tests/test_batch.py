@@ -175,3 +175,14 @@ def test_failing_item_is_named_by_a_worker() -> None:
     with pytest.raises(qs.QuasistaticError, match="frictionless") as info:
         qs.solve_many(scenes, method="lp", n_jobs=2, chunks_per_job=1)
     assert "while solving problems[3]" in info.value.__notes__
+
+
+def test_forked_workers_leave_no_thread_behind() -> None:
+    """A thread left running (a queue's feeder) would keep the next call from forking: it would fall back to
+    joblib, which pickles every item (measured 6x slower on the benchmark's batch)."""
+    import threading
+
+    items = [qs.assemble(grasp_2d(3, i)) for i in range(12)]
+    before = threading.active_count()
+    qs.solve_many(items, method="fast", n_jobs=2, chunks_per_job=2)
+    assert threading.active_count() == before

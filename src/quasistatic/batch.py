@@ -176,6 +176,10 @@ def _solve_forked(items: list[Scene | Problem], workers: int, chunks_per_job: in
             process.join()
     finally:
         gc.unfreeze()
+        # The task queue's feeder thread must end with this call: a thread left running would keep
+        # the next call from forking (it falls back to joblib, which pickles every item).
+        tasks.close()
+        tasks.join_thread()
     solutions = list(first)
     for index in range(len(blocks)):
         ok, value = answers[index]

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ..jit import njit
 from ..model import Scales, Scene
 from ..solution import ContactResult, Mode, Motion, PowerBalance
 from ..tolerances import AUDIT, MODE_SPEED, ROUNDOFF
@@ -37,14 +38,11 @@ class MotionGeometry:
         self.threshold = MODE_SPEED * scales.velocity
         self.twist_roundoff = ROUNDOFF * scales.twist_units(scene.dimension)
         # Per column of a contact's (normal velocity, slip speed, normal force).
-        self.contact_roundoff = ROUNDOFF * np.array([scales.velocity, scales.velocity, scales.force])
-        self.force_roundoff, self.speed_roundoff, self.power_roundoff = (
-            ROUNDOFF * x for x in (scales.force, scales.velocity, scales.power)
-        )
-
-    @classmethod
-    def of(cls, scene: Scene, scales: Scales) -> MotionGeometry:
-        return cls(scene, scales)
+        d = scene.dimension
+        # Per column of a contact's force (d), slip (d) and (normal velocity, slip speed, normal force).
+        force, speed = np.full(d, ROUNDOFF * scales.force), np.full(d, ROUNDOFF * scales.velocity)
+        self.roundoff = (force, speed, ROUNDOFF * np.array([scales.velocity, scales.velocity, scales.force]))
+        self.power_roundoff = ROUNDOFF * scales.power
 
 
 def audited_motion(
@@ -72,27 +70,26 @@ def audited_motion(
         Physical normal-force ranges, when the forces are indeterminate [force].
     """
     audit, power, evaluation = audit_arrays(geometry.audit, twists, forces, scales, tolerance)
-    table = ContactTable(
-        geometry.pairs,
-        _clean(forces, geometry.force_roundoff),
-        _clean(evaluation.slips, geometry.speed_roundoff),
-        _clean(evaluation.normal, geometry.contact_roundoff),
-        geometry.threshold,
-        ranges,
-    )
-    named = dict(zip(geometry.names, _clean(twists, geometry.twist_roundoff), strict=True))
-    power = _clean_power(power, geometry.power_roundoff)
-    return Motion(named, table, power, audit, continuum, extreme_twists, unbounded, free_directions)
+    table = ContactTable(geometry.pairs, forces, evaluation.slips, evaluation.normal, geometry.threshold, ranges, geometry.roundoff)
+    named = dict(zip(geometry.names, _drop_roundoff(np.array(twists, dtype=float), geometry.twist_roundoff), strict=True))
+    return Motion(named, table, _clean_power(power, geometry.power_roundoff), audit, continuum, extreme_twists, unbounded, free_directions)
 
 
-def _clean(values: np.ndarray, roundoff: float | np.ndarray) -> np.ndarray:
-    """``values`` with entries within ``roundoff`` of zero set to 0 (``roundoff`` broadcast over the last axis)."""
-    return np.where(np.abs(values) <= roundoff, 0.0, values)
+@njit
+def _drop_roundoff(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray:
+    """``values`` (rows, c) with entries within ``roundoff[j]`` of zero set to 0, in place (one compiled loop: small arrays)."""
+    for i in range(values.shape[0]):
+        for j in range(values.shape[1]):
+            if abs(values[i, j]) <= roundoff[j]:
+                values[i, j] = 0.0
+    return values
 
 
 def _clean_power(power: PowerBalance, roundoff: float) -> PowerBalance:
     """Round-off powers shown as 0; the residual is a measurement and stays as it is."""
-    supplied, raised, dissipated = (0.0 if abs(x) <= roundoff else x for x in (power.input, power.gravity, power.dissipation))
+    supplied = 0.0 if abs(power.input) <= roundoff else power.input
+    raised = 0.0 if abs(power.gravity) <= roundoff else power.gravity
+    dissipated = 0.0 if abs(power.dissipation) <= roundoff else power.dissipation
     return PowerBalance(supplied, raised, dissipated, power.residual)
 
 
@@ -107,9 +104,12 @@ class ContactTable:
     normal : (m, 3) normal velocity, slip speed and normal force of each contact
     threshold : speed below which a contact is not moving [length/time]
     ranges : physical normal-force ranges, or None
+    roundoff : per-column magnitudes below which forces, slips and the normal columns are reported as 0
+
+    The arrays are kept as the audit measured them; round-off is dropped when results are made.
     """
 
-    __slots__ = ("pairs", "forces", "slips", "normal", "threshold", "ranges")
+    __slots__ = ("pairs", "forces", "slips", "normal", "threshold", "ranges", "roundoff")
 
     def __init__(
         self,
@@ -119,18 +119,27 @@ class ContactTable:
         normal: np.ndarray,
         threshold: float,
         ranges: list[Range] | None,
+        roundoff: tuple[np.ndarray, np.ndarray, np.ndarray],
     ) -> None:
         self.pairs, self.forces, self.slips, self.normal = pairs, forces, slips, normal
-        self.threshold, self.ranges = threshold, ranges
+        self.threshold, self.ranges, self.roundoff = threshold, ranges, roundoff
 
     def __getstate__(self) -> tuple[object, ...]:
         # Floats in lists: pickling a few small arrays costs more than the numbers in them.
         arrays = (self.forces, self.slips, self.normal)
-        return (self.pairs, self.threshold, self.ranges, *((a.shape, a.ravel().tolist()) for a in arrays))
+        return (
+            self.pairs,
+            self.threshold,
+            self.ranges,
+            tuple(r.tolist() for r in self.roundoff),
+            *((a.shape, a.ravel().tolist()) for a in arrays),
+        )
 
     def __setstate__(self, state: tuple[Any, ...]) -> None:
         self.pairs, self.threshold, self.ranges = state[:3]
-        self.forces, self.slips, self.normal = (np.array(values, dtype=float).reshape(shape) for shape, values in state[3:])
+        force, speed, normal = (np.array(r, dtype=float) for r in state[3])
+        self.roundoff = (force, speed, normal)
+        self.forces, self.slips, self.normal = (np.array(values, dtype=float).reshape(shape) for shape, values in state[4:])
 
     def forces_indeterminate(self) -> bool:
         return self.ranges is not None
@@ -141,6 +150,10 @@ class ContactTable:
 
     def results(self) -> tuple[ContactResult, ...]:
         ranges: list[Range | None] = list(self.ranges) if self.ranges else [None] * len(self.pairs)
+        force_roundoff, speed_roundoff, normal_roundoff = self.roundoff
+        forces = _drop_roundoff(self.forces.copy(), force_roundoff)
+        slips = _drop_roundoff(self.slips.copy(), speed_roundoff)
+        normal = _drop_roundoff(self.normal.copy(), normal_roundoff)
         return tuple(
             ContactResult(
                 body=body,
@@ -153,7 +166,7 @@ class ContactTable:
                 normal_force_range=range_i,
             )
             for (body, other), (u_n, speed, f_n), force, slip, range_i in zip(
-                self.pairs, self.normal.tolist(), self.forces, self.slips, ranges, strict=True
+                self.pairs, normal.tolist(), forces, slips, ranges, strict=True
             )
         )
 

@@ -103,6 +103,8 @@ def _to_world_kernel(q: FloatArray, c: FloatArray, frames: FloatArray, units: Fl
 
 def free_directions(problem: Problem, free_axes: tuple[int, ...]) -> tuple[str, ...]:
     """Names of the signed twist directions of an unbounded continuum, e.g. ``"box v_x +"``, ``"box omega_z -"``."""
+    if not free_axes:
+        return ()
     components = ("v_x", "v_y", "omega_z") if problem.dimension == 2 else ("v_x", "v_y", "v_z", "omega_x", "omega_y", "omega_z")
     names = _layout(problem).names
     k = len(components)

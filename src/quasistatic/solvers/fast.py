@@ -85,9 +85,10 @@ def solve_fast(problem: Problem, options: Options) -> BackendResult:
     )
     if status != SOLUTION:
         return _failed(int(status), int(stage), int(pivots))
-    result = BackendResult("solved", _SOLVED, (RawMotion(q, c),), certified=False)
-    result = result.with_notes(method="lemke", pivots=int(pivots), realignments=int(realignments))
-    return result.with_notes(exact_cone=_EXACT_STAGES[int(stage)]) if data.exact else result
+    notes: tuple[tuple[str, object], ...] = (("method", "lemke"), ("pivots", int(pivots)), ("realignments", int(realignments)))
+    if data.exact:
+        notes += (("exact_cone", _EXACT_STAGES[int(stage)]),)
+    return BackendResult("solved", _SOLVED, (RawMotion(q, c),), certified=False, notes=notes)
 
 
 class _Inputs:
