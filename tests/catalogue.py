@@ -1447,11 +1447,5 @@ assert len(BY_NAME) == len(CASES)
 
 # (case, method id): a library bug the pair exposes, run as a strict xfail with the evidence (the exception it raises).
 KNOWN_BUGS: dict[tuple[str, str], tuple[type[BaseException], str]] = {
-    ("puck-slip-off-axis-3d", "paper"): (
-        AssertionError,
-        "paper's sliding friction forces are up to 2.6e-4 rad off the slip direction (3.1e-4 N across the slip, 3e-5 of "
-        "the weight), so maximum dissipation fails at 1e-6; its audit passes (dissipation residual 1.7e-7) because the "
-        "shortfall mu f_n |u_t| + f_t . u_t grows with the square of that angle: the audit admits ~1e-3 rad",
-    ),
 }
 assert {case for case, _ in KNOWN_BUGS} <= {c.name for c in CASES}

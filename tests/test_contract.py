@@ -123,3 +123,34 @@ def test_forces_indeterminate_inside_an_ambiguous_answer() -> None:
         assert contact.normal_force_range is not None
         low, high = contact.normal_force_range
         assert low == pytest.approx(0.5 * 9.81 / 2 / 0.5, rel=1e-6) and high is None
+
+
+def test_audit_measures_friction_direction_linearly() -> None:
+    """Maximum dissipation on exact 3-D cones: a sliding contact's friction must be -mu f_n slip/|slip|.
+
+    Turning each sliding support's friction of the pushed puck by 1e-4 rad about its normal leaves the
+    dissipated power short by only mu f_n |slip| (1 - cos 1e-4) ~ 5e-9 of it, which a power measure
+    passes; the force is off by |f_t| 1e-4, which the audit must see (its residual is per force scale).
+    """
+    from quasistatic.check import audit_motion
+
+    scene = qs.load_scene(str(_example("puck_push_3d.yaml")))
+    problem = qs.assemble(scene)
+    sol = qs.solve(problem, certify=False)
+    assert sol.status == "solved" and sol.audit is not None and sol.audit.passed
+    forces = np.array([c.force for c in sol.contacts])
+    angle = 1e-4
+    for i, contact in enumerate(sol.contacts):
+        if contact.mode == "sliding":
+            n = np.asarray(scene.contacts[i].normal)
+            f_n = forces[i] @ n * n
+            f_t = forces[i] - f_n
+            forces[i] = f_n + f_t * np.cos(angle) + np.cross(n, f_t) * np.sin(angle)
+    audit, _ = audit_motion(scene, sol.twists, forces, problem.scales)
+    assert audit.dissipation > 10 * audit.tolerance
+
+
+def _example(name: str) -> object:
+    from pathlib import Path
+
+    return Path(__file__).resolve().parents[1] / "examples" / name

@@ -175,7 +175,9 @@ class Audit:
     complementarity : float
         Largest penetration velocity or normal force times normal velocity.
     dissipation : float
-        Largest shortfall from maximum dissipation at a sliding contact.
+        Largest shortfall from maximum dissipation at a sliding contact (per power scale)
+        and, for exact 3-D cones, largest distance of a sliding contact's friction from
+        ``-mu f_n slip/|slip|`` (per force scale): an error in its direction counts linearly.
     power : float
         Power-balance residual per power scale.
     tolerance : float

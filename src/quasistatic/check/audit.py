@@ -29,7 +29,7 @@ import numpy as np
 from ..jit import HAVE_NUMBA, njit
 from ..model import Contact, Mover, Scales, Scene
 from ..solution import Audit, PowerBalance
-from ..tolerances import AUDIT
+from ..tolerances import AUDIT, MODE_SPEED
 
 __all__ = [
     "AuditGeometry",
@@ -181,6 +181,7 @@ _SUPPLIED = 6  # power the movers put in
 _DISSIPATED = 7  # power lost to friction
 _RAISED = 8  # power against gravity and applied wrenches
 _CHECK = 9  # sum of every velocity, force and net wrench: not finite when any of them is not
+_MISALIGN = 10  # exact 3-D cones: largest distance of a sliding contact's friction from -mu f_n slip/|slip| [force]
 
 
 @dataclass(frozen=True)
@@ -201,25 +202,27 @@ class Evaluation:
     normal: np.ndarray
 
 
-def _evaluate(geometry: AuditGeometry, T: np.ndarray, forces: np.ndarray) -> Evaluation:
+def _evaluate(geometry: AuditGeometry, T: np.ndarray, forces: np.ndarray, slide_speed: float = np.inf) -> Evaluation:
     """Run the law kernel on twists ``T`` (bodies, k) and world forces ``forces`` (m, d), physical units."""
     T = np.ascontiguousarray(T, dtype=float)
     forces = np.ascontiguousarray(forces, dtype=float)
     if HAVE_NUMBA:
         arrays = geometry.arrays
         kernel = _laws_2d if geometry.dimension == 2 else _laws_3d
-        return Evaluation(*kernel(arrays[0], arrays[1], arrays[2], T, forces, arrays[3], arrays[4], geometry.facet_scale))
+        return Evaluation(*kernel(arrays[0], arrays[1], arrays[2], T, forces, arrays[3], arrays[4], geometry.facet_scale, slide_speed))
     # Plain Python: the same kernel reads nested lists faster than numpy scalars.
     kernel = _laws_2d if geometry.dimension == 2 else _laws_3d
     lists = geometry.lists
     assert lists is not None
-    sums, u, slips, normal = kernel(lists[0], lists[1], lists[2], T.tolist(), forces.tolist(), lists[3], lists[4], geometry.facet_scale)
+    sums, u, slips, normal = kernel(
+        lists[0], lists[1], lists[2], T.tolist(), forces.tolist(), lists[3], lists[4], geometry.facet_scale, slide_speed
+    )
     return Evaluation(np.asarray(sums), np.asarray(u), np.asarray(slips), np.asarray(normal))
 
 
 @njit
 def _allocate(m: int, d: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    return np.zeros(10), np.empty((m, d)), np.empty((m, d)), np.empty((m, 3))
+    return np.zeros(11), np.empty((m, d)), np.empty((m, d)), np.empty((m, 3))
 
 
 @njit
@@ -232,6 +235,7 @@ def _laws_2d(
     facets: np.ndarray,
     directions: np.ndarray,
     facet_scale: float,
+    slide_speed: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Velocities, net wrenches and the per-contact laws of a planar motion, in one loop over the contacts.
 
@@ -299,6 +303,7 @@ def _laws_3d(
     facets: np.ndarray,
     directions: np.ndarray,
     facet_scale: float,
+    slide_speed: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """:func:`_laws_2d` in space: ``contacts`` (m, 19), ``T`` (bodies, 6), ``f`` (m, 3).
 
@@ -307,6 +312,7 @@ def _laws_3d(
     m = len(links)
     nb = len(loads)
     pyramid = len(facets) > 0
+    misalign = 0.0
     sums, u, slips, normal = _allocate(m, 3)
     totals = np.zeros((nb, 6))
     for a in range(nb):
@@ -360,6 +366,9 @@ def _laws_3d(
         else:
             outside = np.sqrt(f_1 * f_1 + f_2 * f_2) - radius
             support = np.sqrt(u_1 * u_1 + u_2 * u_2)
+            if support > slide_speed:  # sliding: the friction must be -mu f_n slip/|slip| exactly (linear in its error)
+                e_1, e_2 = f_1 + radius * u_1 / support, f_2 + radius * u_2 / support
+                misalign = max(misalign, np.sqrt(e_1 * e_1 + e_2 * e_2))
         cone = max(cone, -f_n, outside)
         penetration = max(penetration, -u_n)
         normal_power = max(normal_power, abs(f_n * u_n))
@@ -372,6 +381,7 @@ def _laws_3d(
         normal[i][0], normal[i][1], normal[i][2] = u_n, np.sqrt(px * px + py * py + pz * pz), f_n
     _finish(sums, totals, loads, T, 3, check)
     sums[_CONE], sums[_PENETRATION], sums[_NORMAL_POWER], sums[_SHORTFALL] = cone, penetration, normal_power, shortfall
+    sums[_MISALIGN] = misalign
     sums[_SUPPLIED], sums[_DISSIPATED] = supplied, dissipated
     return sums, u, slips, normal
 
@@ -440,7 +450,8 @@ def audit_motion_velocities(
 ) -> tuple[Audit, PowerBalance, list[tuple[float, ...]]]:
     """:func:`audit_motion`, plus the relative contact velocities it measured (m tuples of d) [length/time]."""
     geometry = AuditGeometry.of(scene)
-    audit, power, evaluation = _audit(_evaluate(geometry, _twist_array(geometry, twists), forces), scales, tolerance)
+    sliding = MODE_SPEED * scales.velocity
+    audit, power, evaluation = _audit(_evaluate(geometry, _twist_array(geometry, twists), forces, sliding), scales, tolerance)
     return audit, power, [tuple(u) for u in evaluation.velocities.tolist()]
 
 
@@ -452,7 +463,7 @@ def audit_arrays(
     The evaluation carries each contact's relative velocity, slip, normal
     velocity and normal force [physical units], for the report.
     """
-    return _audit(_evaluate(geometry, twists, forces), scales, tolerance)
+    return _audit(_evaluate(geometry, twists, forces, MODE_SPEED * scales.velocity), scales, tolerance)
 
 
 def _audit(evaluation: Evaluation, scales: Scales, tolerance: float) -> tuple[Audit, PowerBalance, Evaluation]:
@@ -466,7 +477,7 @@ def _audit(evaluation: Evaluation, scales: Scales, tolerance: float) -> tuple[Au
         equilibrium,
         max(0.0, sums[_CONE] / F),
         max(sums[_PENETRATION] / V, sums[_NORMAL_POWER] / (F * V)),
-        sums[_SHORTFALL] / (F * V),
+        max(sums[_SHORTFALL] / (F * V), sums[_MISALIGN] / F),
         abs(power.residual) / (F * V),
         tolerance,
     )

@@ -211,13 +211,20 @@ def _infeasible(problem: Problem, time_limit: float) -> BackendResult:
 
 
 def _forces_at(problem: Problem, q: np.ndarray, time_limit: float) -> tuple[np.ndarray, float] | None:
+    """:func:`_recovered_forces` with each sliding contact's friction exactly ``-mu cn slip/|slip|``, else without that."""
+    return _recovered_forces(problem, q, time_limit, exact_sliding=True) or _recovered_forces(problem, q, time_limit, exact_sliding=False)
+
+
+def _recovered_forces(problem: Problem, q: np.ndarray, time_limit: float, exact_sliding: bool) -> tuple[np.ndarray, float] | None:
     """Forces (m, d) meeting the laws at twist ``q`` and their power gap; None if the laws fail.
 
     With q fixed the power gap ``sum c_n u_n + sum (mu c_n ||u_t|| + c_t.u_t)``
     is linear in c and each term is >= 0 inside the cones, so two convex
     solves suffice: the least gap (it must be at most ``RECOVERED_POWER_GAP``: the
     twist carries SCIP's tolerance), then the least total normal force
-    within that gap. The cones are the exact (second-order) ones of eq. 8,
+    within that gap. With ``exact_sliding``, a sliding contact's friction is
+    pinned to ``-mu cn slip/|slip|`` (maximum dissipation to the letter, not
+    only to the gap's tolerance). The cones are the exact (second-order) ones of eq. 8,
     not the polygons of :mod:`..numerics.forces`: this program is the
     independent cross-check of the certified search, so it does not share
     its polyhedral force code.
@@ -234,6 +241,9 @@ def _forces_at(problem: Problem, q: np.ndarray, time_limit: float) -> tuple[np.n
         terms = []
         for i, c_i in enumerate(c):
             speed = float(np.linalg.norm(u[i, :-1]))
+            if exact_sliding and problem.mu[i] > 0 and speed > MODE_SPEED:
+                for k in range(problem.dimension - 1):
+                    scip.addCons(c_i[k] == -float(problem.mu[i] * u[i, k] / speed) * c_i[-1])
             terms.append((max(u[i, -1], 0.0) + problem.mu[i] * speed) * c_i[-1])
             terms += [float(u[i, k]) * c_i[k] for k in range(problem.dimension - 1) if problem.mu[i] > 0]
         gap = pyscipopt.quicksum(terms)
