@@ -1446,6 +1446,5 @@ BY_NAME: dict[str, Case] = {c.name: c for c in CASES}
 assert len(BY_NAME) == len(CASES)
 
 # (case, method id): a library bug the pair exposes, run as a strict xfail with the evidence (the exception it raises).
-KNOWN_BUGS: dict[tuple[str, str], tuple[type[BaseException], str]] = {
-}
+KNOWN_BUGS: dict[tuple[str, str], tuple[type[BaseException], str]] = {}
 assert {case for case, _ in KNOWN_BUGS} <= {c.name for c in CASES}
