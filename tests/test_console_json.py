@@ -98,3 +98,12 @@ def test_unbounded_continuum_names_its_free_directions() -> None:
     motion = json.loads(out.stdout)["solutions"][0]
     assert motion["unbounded"] is True
     assert set(motion["free_directions"]) == {"box v_x +", "box v_y +", "box v_y -", "box omega_z +", "box omega_z -"}
+
+
+def test_time_limit_is_honoured_and_said() -> None:
+    """A certified search cut short by --time-limit says so (exit 1: not an answer); a non-positive limit is bad input."""
+    out = _run("solve", str(ROOT / "examples" / "puck_push_3d.yaml"), "--time-limit", "0.05")
+    assert out.returncode == 1 and "time limit" in out.stdout
+    bad = _run("solve", str(ROOT / "examples" / "puck_push_3d.yaml"), "--time-limit", "0")
+    assert bad.returncode == 2 and bad.stdout == ""
+    assert bad.stderr.startswith("error: --time-limit") and len(bad.stderr.splitlines()) == 1

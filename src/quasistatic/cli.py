@@ -17,12 +17,15 @@ from pathlib import Path
 from typing import Annotated, NoReturn, TypeVar
 
 import typer
+from rich.console import Console
+from rich.status import Status
 
 from .errors import QuasistaticError, SolverError
 from .model import Scene, load_scene
 from .report import make_console, render_solution
 from .solution import Mode, Solution
 from .solve import METHODS, solve
+from .solvers import SearchProgress
 
 __all__ = ["app", "main"]
 
@@ -72,15 +75,56 @@ def solve_command(
             help="Certify: list every motion (default), or stop at the first audited one the fast path finds.",
         ),
     ] = True,
+    time_limit: Annotated[float, typer.Option(help="Seconds the certified search may take; it says so when it stops early.")] = 60.0,
 ) -> None:
     """Solve a scene file: twists, contact forces and modes, power balance and audit."""
     if max_solutions < 1:
         _fail(f"--max-solutions must be at least 1 (got {max_solutions})")
+    if not 0.0 < time_limit < float("inf"):
+        _fail(f"--time-limit must be a positive number of seconds (got {time_limit})")
     scene = _guarded(lambda: load_scene(scene_file))
     prescribed = _guarded(lambda: _parse_modes(modes)) if modes is not None else None
     certify = all_solutions and method in ("auto", "scip")
-    solution = _guarded(lambda: solve(scene, method=method, modes=prescribed, all_solutions=certify, max_solutions=max_solutions))
+    with _StatusLine(enabled=not as_json) as status:
+        solution = _guarded(
+            lambda: solve(
+                scene,
+                method=method,
+                modes=prescribed,
+                all_solutions=certify,
+                max_solutions=max_solutions,
+                time_limit=time_limit,
+                progress=status.update,
+            )
+        )
     _report(solution, as_json)
+
+
+class _StatusLine:
+    """A rich status line on stderr for a certified search that runs longer than a second (terminals only)."""
+
+    def __init__(self, enabled: bool) -> None:
+        console = Console(stderr=True)
+        self.enabled = enabled and console.is_terminal
+        self.console = console
+        self.status: Status | None = None
+
+    def __enter__(self) -> _StatusLine:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.status is not None:
+            self.status.stop()
+
+    def update(self, progress: SearchProgress) -> None:
+        if not self.enabled or progress.seconds < 1.0:
+            return
+        text = f"certified search: {progress.motions} motions found, {progress.nodes} nodes, {progress.seconds:.1f} s"
+        if self.status is None:
+            self.status = self.console.status(text)
+            self.status.start()
+        else:
+            self.status.update(text)
 
 
 @app.command()

@@ -11,14 +11,14 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
 from .errors import QuasistaticError, SolverError
 from .laws import Problem, RawMotion, assemble, free_directions, physical_twists, to_world
 from .model import Scene
 from .solution import Attempt, Mode, Motion, Solution
-from .solvers import BACKENDS, Backend, BackendResult, Options, get_backend
+from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, get_backend
 
 __all__ = ["solve", "METHODS", "audited_raw_motion"]
 
@@ -36,6 +36,7 @@ def solve(
     max_solutions: int = 16,
     tolerance: float = DEFAULT_TOLERANCE,
     time_limit: float = 60.0,
+    progress: Callable[[SearchProgress], None] | None = None,
 ) -> Solution:
     """Predict the quasi-static motion of the free bodies of a scene.
 
@@ -65,6 +66,9 @@ def solve(
         Audit threshold on every scene-relative residual [-].
     time_limit : float
         Seconds a certified search may take [s].
+    progress : callable, optional
+        Called with a :class:`~quasistatic.solvers.SearchProgress` (motions found, nodes,
+        seconds) after each step of the certified search, e.g. to show a status line.
 
     Returns
     -------
@@ -74,7 +78,7 @@ def solve(
     started = time.perf_counter()
     problem = scene if isinstance(scene, Problem) else assemble(scene)
     checked = _check_modes(modes, problem)
-    options = Options(max_solutions, checked, time_limit)
+    options = Options(max_solutions, checked, time_limit, progress=progress)
     names = _choose(method, problem, checked is not None, certify if all_solutions is None else all_solutions, bool(all_solutions))
     tried: list[Attempt] = []
     for name in names:

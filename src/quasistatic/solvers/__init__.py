@@ -9,6 +9,6 @@ never ``check`` (the judge stays independent) nor anything above.
 """
 
 from .registry import BACKENDS, Backend, Solver, get_backend
-from .result import BackendResult, Options, Range
+from .result import BackendResult, Options, Range, SearchProgress
 
-__all__ = ["BACKENDS", "Backend", "BackendResult", "Options", "Range", "Solver", "get_backend"]
+__all__ = ["BACKENDS", "Backend", "BackendResult", "Options", "Range", "SearchProgress", "Solver", "get_backend"]

@@ -4,16 +4,26 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 from ..laws import RawMotion
 from ..solution import Certificate, Diagnosis, Mode, Status
 
-__all__ = ["Options", "BackendResult", "Range"]
+__all__ = ["Options", "BackendResult", "Range", "SearchProgress"]
 
 Range = tuple[float, float | None]
 """A value's range ``(lo, hi)``; ``hi`` None when unbounded."""
+
+
+@dataclass(frozen=True)
+class SearchProgress:
+    """How far a certified search has got: motions found, branch-and-bound nodes, seconds since it started."""
+
+    motions: int
+    nodes: int
+    seconds: float
 
 
 @dataclass(frozen=True)
@@ -32,12 +42,15 @@ class Options:
     started : float or None
         ``time.monotonic()`` when the backend started its clock
         (:meth:`start_clock`); None before.
+    progress : callable or None
+        Called with a :class:`SearchProgress` after each step of a long search (for a status line).
     """
 
     max_solutions: int = 16
     modes: tuple[Mode | None, ...] | None = None
     time_limit: float = 60.0
     started: float | None = field(default=None, compare=False)
+    progress: Callable[[SearchProgress], None] | None = field(default=None, compare=False)
 
     def start_clock(self) -> Options:
         """These options with the time limit counting from now, unless it already runs (a backend calls it on entry).
@@ -46,6 +59,12 @@ class Options:
         program) passes its running clock on: the time limit is for the whole solve.
         """
         return self if self.started is not None else dataclasses.replace(self, started=time.monotonic())
+
+    def report(self, motions: int, nodes: int) -> None:
+        """Tell the ``progress`` callback, if any, how far the search has got."""
+        if self.progress is not None:
+            elapsed = 0.0 if self.started is None else time.monotonic() - self.started
+            self.progress(SearchProgress(motions, nodes, elapsed))
 
     def remaining(self) -> float:
         """Seconds left of ``time_limit`` [s] (negative once it has passed; all of it before the clock starts)."""

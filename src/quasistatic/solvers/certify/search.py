@@ -157,6 +157,7 @@ def _enumerate(form: LCPForm, options: Options, sos1: bool) -> tuple[list[RawMot
             return motions, False
         scip.setParam("limits/time", options.remaining())
         status = optimize(scip, "scip")
+        options.report(len(motions), int(scip.getNNodes()))
         if status == "infeasible":
             return motions, True
         if scip.getNSols() == 0:
