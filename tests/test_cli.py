@@ -154,9 +154,19 @@ def test_modes_and_options_are_passed_to_solve(monkeypatch: pytest.MonkeyPatch) 
         return real_solve(scene, method=kwargs["method"], max_solutions=kwargs["max_solutions"])
 
     monkeypatch.setattr(cli, "solve", spy)
-    result = invoke("solve", DEMO, "--modes", "rolling, rolling,free,SLIDING", "--method", "lp", "--max-solutions", "3")
+    args = ("--modes", "rolling, rolling,free,SLIDING", "--method", "lp", "--max-solutions", "3", "--time-limit", "7.5")
+    result = invoke("solve", DEMO, *args)
     assert result.exit_code == 0, result.output
-    assert seen == {"method": "lp", "modes": ["rolling", "rolling", None, "sliding"], "max_solutions": 3, "all_solutions": False}
+    progress = seen.pop("progress")
+    assert callable(progress)
+    expected = {
+        "method": "lp",
+        "modes": ["rolling", "rolling", None, "sliding"],
+        "max_solutions": 3,
+        "all_solutions": False,
+        "time_limit": 7.5,
+    }
+    assert seen == expected
     invoke("solve", DEMO)
     assert seen["all_solutions"] is True  # the command line certifies by default
     invoke("solve", DEMO, "--first-solution")

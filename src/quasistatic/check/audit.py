@@ -61,7 +61,7 @@ class AuditGeometry:
           ``(normal (d), tangents (d each), arm_body (d), arm_other (d), mover_velocity (d), mu)``
           where ``arm_body``/``arm_other`` run from the body's (other free body's) com to
           the point (zero for a mover), ``mover_velocity`` is the velocity of the mover's
-          point (zero for a free body), the tangents are ``contact_frame``'s and ``mu`` is
+          point (zero for a free body), the tangents are ``contact_frames``'s and ``mu`` is
           zero under ``friction: none``
         - loads (bodies, k): gravity plus applied wrench of each body
         - facets, directions (K, 2): 3-D pyramid only (else K = 0): facet normals and
@@ -144,7 +144,7 @@ def _floats(vector: object) -> list[float]:
 
 
 def _tangents(n: list[float]) -> list[float]:
-    """The tangent rows of :func:`~quasistatic.model.kinematics.contact_frame` (recomputed) for the unit normal ``n``, flattened."""
+    """The tangent rows of :func:`~quasistatic.model.kinematics.contact_frames` (recomputed) for the unit normal ``n``, flattened."""
     if len(n) == 2:
         return [n[1], -n[0]]
     x, y, z = n

@@ -15,7 +15,7 @@ from typing import Any, TypeVar, cast
 import numpy as np
 
 from ..model import FloatArray, FrictionModel, Scales, Scene, scene_scales
-from ..model.kinematics import contact_frame, mover_point_velocity, point_velocity_map
+from ..model.kinematics import contact_frames, mover_point_velocities
 
 __all__ = ["Problem", "assemble"]
 
@@ -121,29 +121,41 @@ class Problem:
 
 
 def assemble(scene: Scene) -> Problem:
-    """Build the scene-relative matrices of the contact laws."""
-    dim = scene.dimension
-    scales = scene_scales(scene)
+    """Build the scene-relative matrices of the contact laws (all contacts at once)."""
+    dim, k = scene.dimension, scene.twist_size
+    movers = mover_point_velocities(scene)
+    scales = scene_scales(scene, movers)
     L, V = scales.length, scales.velocity
-    k = scene.twist_size
-    n_dof = k * len(scene.bodies)
-    m = len(scene.contacts)
-    frames = np.empty((m, dim, dim))
-    J = np.zeros((m, dim, n_dof))
-    b = np.zeros((m, dim))
-    coms = {body.name: (body.com - scales.origin) / L for body in scene.bodies}
-    for i, contact in enumerate(scene.contacts):
-        frames[i] = contact_frame(contact.normal)
-        point = (contact.point - scales.origin) / L
-        world = np.zeros((dim, n_dof))
-        a = scene.body_index(contact.body)
-        world[:, a * k : (a + 1) * k] += point_velocity_map(point - coms[contact.body])
-        if contact.other in coms:
-            o = scene.body_index(contact.other)
-            world[:, o * k : (o + 1) * k] -= point_velocity_map(point - coms[contact.other])
-        else:
-            b[i] = frames[i] @ mover_point_velocity(scene, contact) / V
-        J[i] = frames[i] @ world
+    m, n_bodies = len(scene.contacts), len(scene.bodies)
+    index = {body.name: i for i, body in enumerate(scene.bodies)}
+    coms = (np.array([body.com for body in scene.bodies], dtype=float).reshape(n_bodies, dim) - scales.origin) / L
+    points = (np.array([c.point for c in scene.contacts], dtype=float).reshape(m, dim) - scales.origin) / L
+    frames = contact_frames(np.array([c.normal for c in scene.contacts], dtype=float).reshape(m, dim))
+    J = np.zeros((m, dim, k * n_bodies))
+    rows = np.arange(m)
+    body = np.array([index[c.body] for c in scene.contacts], dtype=int)
+    _add_blocks(J, rows, body, _twist_rows(frames, points - coms[body]), k)
+    other = np.array([index.get(c.other, -1) for c in scene.contacts], dtype=int)
+    pair = other >= 0  # a contact between two free bodies: the other body's motion counts against
+    _add_blocks(J, rows[pair], other[pair], -_twist_rows(frames[pair], points[pair] - coms[other[pair]]), k)
+    b = np.einsum("mst,mt->ms", frames, movers) / V
     g = np.concatenate([scene.load(body) / scales.wrench_units(dim) for body in scene.bodies])
     mu = np.array([c.mu for c in scene.contacts]) if scene.friction.kind != "none" else np.zeros(m)
     return Problem(scene, frames, J, b, g, mu, scene.friction, scales)
+
+
+def _twist_rows(frames: FloatArray, arms: FloatArray) -> FloatArray:
+    """Each frame row's velocity per unit body twist, for contacts at ``arms`` from the com: (m, d, k).
+
+    A row ``f`` of a frame measures ``f . (v + omega x r) = f . v + omega . (r x f)``.
+    """
+    if frames.shape[-1] == 2:
+        spin = arms[:, None, 0] * frames[:, :, 1] - arms[:, None, 1] * frames[:, :, 0]
+        return np.concatenate([frames, spin[:, :, None]], axis=2)
+    return np.concatenate([frames, np.cross(arms[:, None, :], frames)], axis=2)
+
+
+def _add_blocks(J: FloatArray, rows: np.ndarray, bodies: np.ndarray, blocks: FloatArray, k: int) -> None:
+    """``J[row, :, body block] += block`` for each contact."""
+    for row, body, block in zip(rows, bodies, blocks, strict=True):
+        J[row, :, body * k : (body + 1) * k] += block

@@ -11,26 +11,7 @@ import numpy as np
 
 from .scene import Contact, FloatArray, Scene
 
-__all__ = ["contact_frame", "point_velocity_map", "mover_point_velocity"]
-
-
-def contact_frame(normal: FloatArray) -> FloatArray:
-    """Rows: tangent(s) then the unit normal; right-handed, deterministic. Shape (d, d)."""
-    if normal.size == 2:
-        return np.array([[normal[1], -normal[0]], normal])
-    axis = np.zeros(3)
-    axis[np.argmin(np.abs(normal))] = 1.0
-    t1 = np.cross(normal, axis)
-    t1 /= np.linalg.norm(t1)
-    return np.array([t1, np.cross(normal, t1), normal])
-
-
-def point_velocity_map(r: FloatArray) -> FloatArray:
-    """Matrix taking a body twist (v_com, omega) to the velocity of the point com + r: (2, 3) or (3, 6)."""
-    if r.size == 2:
-        return np.array([[1.0, 0.0, -r[1]], [0.0, 1.0, r[0]]])
-    skew = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
-    return np.hstack([np.eye(3), -skew])
+__all__ = ["contact_frames", "mover_point_velocity", "mover_point_velocities"]
 
 
 def mover_point_velocity(scene: Scene, contact: Contact) -> FloatArray:
@@ -45,3 +26,30 @@ def mover_point_velocity(scene: Scene, contact: Contact) -> FloatArray:
     if scene.dimension == 2:
         return np.asarray(twist[:2] + twist[2] * np.array([-r[1], r[0]]), dtype=float)
     return np.asarray(twist[:3] + np.cross(twist[3:], r), dtype=float)
+
+
+def contact_frames(normals: FloatArray) -> FloatArray:
+    """Each contact's frame, (m, d, d) for unit ``normals`` (m, d): rows are the tangent(s), then the normal.
+
+    Right-handed and deterministic: in 2-D the tangent is the normal turned clockwise; in 3-D the
+    first tangent is ``n x e`` (normalised) with ``e`` the axis along the normal's smallest entry
+    (the first of equal ones), the second ``n x t1``.
+    """
+    m, d = normals.shape
+    if d == 2:
+        return np.stack([np.column_stack([normals[:, 1], -normals[:, 0]]), normals], axis=1)
+    axes = np.zeros((m, 3))
+    axes[np.arange(m), np.argmin(np.abs(normals), axis=1)] = 1.0
+    t1 = np.cross(normals, axes)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    return np.stack([t1, np.cross(normals, t1), normals], axis=1)
+
+
+def mover_point_velocities(scene: Scene) -> FloatArray:
+    """:func:`mover_point_velocity` at every contact whose ``other`` is a mover (zero rows for body-body contacts), (m, d)."""
+    movers = {m.name: m for m in scene.movers}
+    velocities = np.zeros((len(scene.contacts), scene.dimension))
+    for i, contact in enumerate(scene.contacts):
+        if contact.other in movers:
+            velocities[i] = mover_point_velocity(scene, contact)
+    return velocities

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..tolerances import SMALLEST_LENGTH
-from .kinematics import mover_point_velocity
+from .kinematics import mover_point_velocities
 from .scene import FloatArray, Scene
 
 __all__ = ["Scales", "scene_scales"]
@@ -55,16 +55,19 @@ class Scales:
         return np.r_[np.full(linear, self.force), np.full(angular, self.force * self.length)]
 
 
-def scene_scales(scene: Scene) -> Scales:
-    """Length, force and velocity scales and the origin of a scene."""
+def scene_scales(scene: Scene, mover_velocities: FloatArray | None = None) -> Scales:
+    """Length, force and velocity scales and the origin of a scene.
+
+    ``mover_velocities`` (m, d), when the caller has them: :func:`~.kinematics.mover_point_velocities`.
+    """
     points = np.array([c.point for c in scene.contacts] + [b.com for b in scene.bodies], dtype=float)
     origin = points.mean(axis=0)
     length = _length(points, origin)
     dim = scene.dimension
     loads = [scene.load(body) for body in scene.bodies]
     force = max([float(np.linalg.norm(w[:dim])) for w in loads] + [float(np.linalg.norm(w[dim:])) / length for w in loads])
-    speeds = [float(np.linalg.norm(mover_point_velocity(scene, c))) for c in scene.contacts if not scene.is_body(c.other)]
-    velocity = max(speeds, default=0.0)
+    velocities = mover_point_velocities(scene) if mover_velocities is None else mover_velocities
+    velocity = float(np.max(np.linalg.norm(velocities, axis=1), initial=0.0))
     origin.setflags(write=False)
     return Scales(length=length, force=force or 1.0, velocity=velocity or 1.0, origin=origin)
 
