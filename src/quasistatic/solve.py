@@ -148,7 +148,7 @@ def _check_modes(modes: Sequence[Mode | None] | None, problem: Problem) -> tuple
 def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFAULT_TOLERANCE) -> Motion:
     """A backend's raw motion in physical units, audited on the original scene data."""
     scales = problem.scales
-    geometry = problem.derived("motion_geometry", lambda p: MotionGeometry(p.scene, p.scales))
+    geometry = problem.scene.derived("motion_geometry", lambda scene: MotionGeometry(scene, problem.scales))
     T, forces = to_world(problem, raw.q, raw.c)
     ranges = raw.force_ranges
     physical_ranges = None if ranges is None else [(lo * scales.force, None if hi is None else hi * scales.force) for lo, hi in ranges]

@@ -15,7 +15,7 @@ from typing import Any, TypeVar, cast
 import numpy as np
 
 from ..model import FloatArray, FrictionModel, Scales, Scene, scene_scales
-from ..model.kinematics import contact_frames, mover_point_velocities
+from ..model.kinematics import contact_frames, cross, mover_point_velocities
 
 __all__ = ["Problem", "assemble"]
 
@@ -152,7 +152,7 @@ def _twist_rows(frames: FloatArray, arms: FloatArray) -> FloatArray:
     if frames.shape[-1] == 2:
         spin = arms[:, None, 0] * frames[:, :, 1] - arms[:, None, 1] * frames[:, :, 0]
         return np.concatenate([frames, spin[:, :, None]], axis=2)
-    return np.concatenate([frames, np.cross(arms[:, None, :], frames)], axis=2)
+    return np.concatenate([frames, cross(arms[:, None, :], frames)], axis=2)
 
 
 def _add_blocks(J: FloatArray, rows: np.ndarray, bodies: np.ndarray, blocks: FloatArray, k: int) -> None:

@@ -11,7 +11,7 @@ import numpy as np
 
 from .scene import Contact, FloatArray, Scene
 
-__all__ = ["contact_frames", "mover_point_velocity", "mover_point_velocities"]
+__all__ = ["contact_frames", "cross", "mover_point_velocity", "mover_point_velocities"]
 
 
 def mover_point_velocity(scene: Scene, contact: Contact) -> FloatArray:
@@ -25,7 +25,7 @@ def mover_point_velocity(scene: Scene, contact: Contact) -> FloatArray:
     r = contact.point - mover.origin
     if scene.dimension == 2:
         return np.asarray(twist[:2] + twist[2] * np.array([-r[1], r[0]]), dtype=float)
-    return np.asarray(twist[:3] + np.cross(twist[3:], r), dtype=float)
+    return np.asarray(twist[:3] + cross(twist[3:], r), dtype=float)
 
 
 def contact_frames(normals: FloatArray) -> FloatArray:
@@ -40,16 +40,39 @@ def contact_frames(normals: FloatArray) -> FloatArray:
         return np.stack([np.column_stack([normals[:, 1], -normals[:, 0]]), normals], axis=1)
     axes = np.zeros((m, 3))
     axes[np.arange(m), np.argmin(np.abs(normals), axis=1)] = 1.0
-    t1 = np.cross(normals, axes)
+    t1 = cross(normals, axes)
     t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-    return np.stack([t1, np.cross(normals, t1), normals], axis=1)
+    return np.stack([t1, cross(normals, t1), normals], axis=1)
 
 
 def mover_point_velocities(scene: Scene) -> FloatArray:
-    """:func:`mover_point_velocity` at every contact whose ``other`` is a mover (zero rows for body-body contacts), (m, d)."""
+    """:func:`mover_point_velocity` at every contact whose ``other`` is a mover (zero rows for body-body contacts), (m, d).
+
+    Rigidly moving movers all at once (``v + omega x r``); robot links through their Jacobians.
+    """
     movers = {m.name: m for m in scene.movers}
-    velocities = np.zeros((len(scene.contacts), scene.dimension))
+    d, k = scene.dimension, scene.twist_size
+    m = len(scene.contacts)
+    twists, origins, points = np.zeros((m, k)), np.zeros((m, d)), np.zeros((m, d))
+    velocities = np.zeros((m, d))
     for i, contact in enumerate(scene.contacts):
-        if contact.other in movers:
+        mover = movers.get(contact.other)
+        if mover is None:
+            continue
+        if mover.robot is not None:
             velocities[i] = mover_point_velocity(scene, contact)
-    return velocities
+        else:
+            assert mover.twist is not None and mover.origin is not None  # filled in by the Scene
+            twists[i], origins[i], points[i] = mover.twist, mover.origin, contact.point
+    r = points - origins
+    if d == 2:
+        spin = twists[:, 2:3] * np.column_stack([-r[:, 1], r[:, 0]])
+        return velocities + twists[:, :2] + spin
+    return velocities + twists[:, :3] + cross(twists[:, 3:], r)
+
+
+def cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """``a x b`` over the last axis of 3-vectors, broadcast (``np.cross`` costs ~50 us a call in its axis handling)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)

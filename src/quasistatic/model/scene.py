@@ -12,9 +12,9 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import math
-from collections.abc import Collection, Iterable, Mapping
-from dataclasses import dataclass
-from typing import Any
+from collections.abc import Callable, Collection, Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, TypeVar, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -26,6 +26,7 @@ from .friction import FrictionModel, parse_friction
 __all__ = ["Body", "Mover", "Robot", "Contact", "Scene", "FloatArray"]
 
 FloatArray = npt.NDArray[np.float64]
+T = TypeVar("T")
 
 _TOO_LARGE = "larger numbers overflow the solvers' products; choose other units"
 _MU_TOO_LARGE = "beyond the solvers' precision; mu = 1000 already grips like infinite friction"
@@ -238,6 +239,7 @@ class Scene:
     dimension: int
     gravity: FloatArray
     friction: FrictionModel
+    _derived: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __init__(
         self,
@@ -265,7 +267,26 @@ class Scene:
             dimension=dimension,
             gravity=gravity_vector,
             friction=model,
+            _derived={},
         )
+
+    def __getstate__(self) -> dict[str, Any]:
+        # What later stages derived from this scene is rebuilt where it is needed, not pickled.
+        return {key: value for key, value in self.__dict__.items() if key != "_derived"}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state, _derived={})
+
+    def derived(self, key: str, build: Callable[[Scene], T]) -> T:
+        """``build(self)``, computed once and kept with this scene (scenes are frozen).
+
+        For what every solve of the scene reads the same way (the audit's arrays):
+        solving one scene again, as simulations and interactive use do, skips that work.
+        """
+        values = self._derived
+        if key not in values:
+            values[key] = build(self)
+        return cast(T, values[key])
 
     def body_index(self, name: str) -> int:
         """Index of a free body by name."""
