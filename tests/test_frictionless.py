@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import quasistatic as qs
-from catalogue import Method, methods
+from catalogue import Method, held_slope_3d_data, methods
 
 G = 9.81
 REL, ABS = 1e-6, 1e-9
@@ -146,26 +146,13 @@ DEPTH = 0.3
 
 
 def slope_scene_3d(speed: float, guides: bool = True) -> dict[str, Any]:
-    """``slope_scene`` extruded along z: each contact duplicated at z = -DEPTH/2 and +DEPTH/2.
+    """``slope_scene`` extruded along z, as the catalogue builds it (each contact at z = -DEPTH/2 and +DEPTH/2).
 
     Frictionless contacts whose normals all lie in the x-y plane leave vz free
     at no cost; with ``guides`` two fixed plates touch the front and back faces
     at the com (normals +z and -z) and pin vz = 0.
     """
-    flat = slope_scene(speed)
-    contacts = [{**c, "point": [*c["point"], z], "normal": [*c["normal"], 0.0]} for c in flat["contacts"] for z in (-DEPTH / 2, DEPTH / 2)]
-    com = [*flat["bodies"]["block"]["com"], 0.0]
-    if guides:
-        contacts += [
-            contact("block", "guide", [com[0], com[1], -DEPTH / 2], [0.0, 0.0, 1.0]),
-            contact("block", "guide", [com[0], com[1], DEPTH / 2], [0.0, 0.0, -1.0]),
-        ]
-    return base(
-        3,
-        bodies={"block": {"mass": M, "com": com}},
-        movers={"slope": {}, "guide": {}, "finger": {"twist": [*floats(speed * T), 0.0, 0.0, 0.0, 0.0]}},
-        contacts=contacts,
-    )
+    return held_slope_3d_data(speed, guides)
 
 
 @pytest.mark.parametrize("speed", [0.0, 0.05])

@@ -115,10 +115,6 @@ class Problem:
         """Relative contact velocities ``u = J q - b`` in contact frames, (m, d), at the scene-relative twist ``q``."""
         return np.einsum("mdn,n->md", self.J, q) - self.b
 
-    def with_velocities(self, b: FloatArray) -> Problem:
-        """The same contacts with other prescribed velocities (scene-relative)."""
-        return Problem(self.scene, self.frames, self.J, b, self.g, self.mu, self.friction, self.scales)
-
 
 def assemble(scene: Scene) -> Problem:
     """Build the scene-relative matrices of the contact laws (all contacts at once)."""

@@ -138,6 +138,7 @@ class FixedModeLaws:
         self.kind = kind
         self.n, self.t = problem.n_dof, problem.dimension - 1
         self.column, self.size = columns(kind, self.n, self.t)
+        self._last: tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray]] | None = None
         self.J, self.b = np.ascontiguousarray(problem.J, dtype=float), np.ascontiguousarray(problem.b, dtype=float)
         self.mu, self.g = np.ascontiguousarray(problem.mu, dtype=float), np.ascontiguousarray(problem.g, dtype=float)
 
@@ -158,11 +159,17 @@ class FixedModeLaws:
         return lower
 
     def residual(self, x: FloatArray) -> FloatArray:
-        return system(self.J, self.b, self.mu, self.g, x, self.kind, self.column, self.n)[0]
+        return self._system(x)[0]
 
     def jacobian(self, x: FloatArray) -> FloatArray:
-        return system(self.J, self.b, self.mu, self.g, x, self.kind, self.column, self.n)[1]
+        return self._system(x)[1]
+
+    def _system(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """:func:`system` at ``x``, kept for the last ``x``: a least-squares step asks for the residual and the Jacobian at one point."""
+        if self._last is None or not np.array_equal(self._last[0], x):
+            self._last = (x.copy(), system(self.J, self.b, self.mu, self.g, x, self.kind, self.column, self.n))
+        return self._last[1]
 
     def motion(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Twist (n,) and contact-frame forces (m, d) at ``x``."""
-        return x[: self.n].copy(), system(self.J, self.b, self.mu, self.g, x, self.kind, self.column, self.n)[2]
+        return x[: self.n].copy(), self._system(x)[2]

@@ -300,10 +300,6 @@ class Scene:
         """A robot by name."""
         return next(r for r in self.robots if r.name == name)
 
-    def is_body(self, name: str) -> bool:
-        """True when ``name`` is a free body (else it is a mover)."""
-        return any(b.name == name for b in self.bodies)
-
     def load(self, body: Body) -> FloatArray:
         """Gravity plus applied wrench on ``body``, about its com [force, force x length]."""
         wrench = np.zeros(self.twist_size) if body.wrench is None else np.array(body.wrench, dtype=float)
