@@ -9,6 +9,7 @@ in the Solution, its JSON and its table.
 from __future__ import annotations
 
 import io
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,6 +19,8 @@ import quasistatic as qs
 from quasistatic.report import render_solution
 from quasistatic.tools.bench.families import grasp_2d, grasp_3d
 from random_scenes import random_scene
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 def stick_on_two_fingers() -> qs.Scene:
@@ -134,7 +137,7 @@ def test_audit_measures_friction_direction_linearly() -> None:
     """
     from quasistatic.check import audit_motion
 
-    scene = qs.load_scene(str(_example("puck_push_3d.yaml")))
+    scene = qs.load_scene(EXAMPLES / "puck_push_3d.yaml")
     problem = qs.assemble(scene)
     sol = qs.solve(problem, certify=False)
     assert sol.status == "solved" and sol.audit is not None and sol.audit.passed
@@ -148,20 +151,3 @@ def test_audit_measures_friction_direction_linearly() -> None:
             forces[i] = f_n + f_t * np.cos(angle) + np.cross(n, f_t) * np.sin(angle)
     audit, _ = audit_motion(scene, sol.twists, forces, problem.scales)
     assert audit.dissipation > 10 * audit.tolerance
-
-
-def _example(name: str) -> object:
-    from pathlib import Path
-
-    return Path(__file__).resolve().parents[1] / "examples" / name
-
-
-def test_certified_search_reports_its_progress() -> None:
-    """The stick's search finds its two motions (a rolling end and the sliding continuum) and then proves
-    there is no third: progress is reported after each step, with the count of motions found so far."""
-    seen: list[qs.solvers.SearchProgress] = []
-    sol = qs.solve(stick_on_two_fingers(), progress=seen.append)
-    assert sol.status == "ambiguous"
-    assert [p.motions for p in seen] == sorted(p.motions for p in seen)
-    assert seen[-1].motions == len(sol.solutions) == 2
-    assert all(p.seconds >= 0.0 and p.nodes >= 0 for p in seen)
