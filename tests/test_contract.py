@@ -151,3 +151,14 @@ def test_audit_measures_friction_direction_linearly() -> None:
             forces[i] = f_n + f_t * np.cos(angle) + np.cross(n, f_t) * np.sin(angle)
     audit, _ = audit_motion(scene, sol.twists, forces, problem.scales)
     assert audit.dissipation > 10 * audit.tolerance
+
+
+def test_certified_search_reports_its_progress() -> None:
+    """The stick's search finds its two motions (a rolling end and the sliding continuum) and then proves
+    there is no third: progress is reported after each step, with the count of motions found so far."""
+    seen: list[qs.solvers.SearchProgress] = []
+    sol = qs.solve(stick_on_two_fingers(), progress=seen.append)
+    assert sol.status == "ambiguous"
+    assert [p.motions for p in seen] == sorted(p.motions for p in seen)
+    assert seen[-1].motions == len(sol.solutions) == 2
+    assert all(p.seconds >= 0.0 and p.nodes >= 0 for p in seen)
