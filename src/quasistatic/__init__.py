@@ -4,10 +4,26 @@ Given the motion of a robot and the contacts, predict how grasped or pushed
 objects move, the contact forces and each contact's mode (Trinkle & Hunter).
 """
 
+from .adapters import (
+    Box,
+    Capsule,
+    ContactDetection,
+    Cylinder,
+    FrictionPair,
+    Halfspace,
+    Mesh,
+    Pose,
+    ShapedMover,
+    SolidBody,
+    Sphere,
+    UrdfRobot,
+    World,
+)
 from .batch import solve_many
 from .errors import BackendUnavailableError, QuasistaticError, SceneError, SolverError
 from .laws import Problem, assemble
-from .model import Body, Contact, FrictionModel, Mover, Robot, Scene, load_scene
+from .loading import load_scene, load_world
+from .model import Body, Contact, FrictionModel, Mover, Robot, Scene
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
 
@@ -18,25 +34,39 @@ __all__ = [
     "Audit",
     "BackendUnavailableError",
     "Body",
+    "Box",
+    "Capsule",
     "Certificate",
     "CertificateKind",
     "Contact",
+    "ContactDetection",
     "ContactResult",
+    "Cylinder",
     "Diagnosis",
     "FrictionModel",
+    "FrictionPair",
+    "Halfspace",
     "METHODS",
+    "Mesh",
     "Motion",
     "Mover",
+    "Pose",
     "PowerBalance",
     "Problem",
     "QuasistaticError",
     "Robot",
     "Scene",
     "SceneError",
+    "ShapedMover",
+    "SolidBody",
     "Solution",
     "SolverError",
+    "Sphere",
+    "UrdfRobot",
+    "World",
     "assemble",
     "load_scene",
+    "load_world",
     "solve",
     "solve_many",
 ]

@@ -1,4 +1,4 @@
-"""Command line: ``quasistatic demo | solve SCENE | check SCENE | validate``. A thin layer, no physics.
+"""Command line: ``quasistatic demo | solve SCENE | check SCENE | contacts SCENE | validate | bench``. A thin layer, no physics.
 
 Exit codes: 0 when the library gave an answer (``solved``, ``ambiguous``,
 ``jammed`` or ``unstable``: a diagnosis is an answer), 1 when the solve
@@ -20,11 +20,14 @@ import typer
 from rich.console import Console
 from rich.status import Status
 
+from .adapters import Detection, World
 from .errors import QuasistaticError, SolverError
-from .model import Scene, load_scene
-from .report import make_console, render_solution
+from .loading import load_scene, load_world
+from .model import Scene
+from .model.io import scene_to_dict
+from .report import make_console, render_contacts, render_solution
 from .solution import Mode, Solution
-from .solve import METHODS, solve
+from .solve import METHODS, solve, with_detection
 from .solvers import SearchProgress
 
 __all__ = ["app", "main"]
@@ -82,7 +85,7 @@ def solve_command(
         _fail(f"--max-solutions must be at least 1 (got {max_solutions})")
     if not 0.0 < time_limit < float("inf"):
         _fail(f"--time-limit must be a positive number of seconds (got {time_limit})")
-    scene = _guarded(lambda: load_scene(scene_file))
+    scene, detection = _loaded(scene_file)
     prescribed = _guarded(lambda: _parse_modes(modes)) if modes is not None else None
     certify = all_solutions and method in ("auto", "scip")
     with _StatusLine(enabled=not as_json) as status:
@@ -97,7 +100,17 @@ def solve_command(
                 progress=status.update,
             )
         )
-    _report(solution, as_json)
+    _report(solution if detection is None else with_detection(solution, detection), as_json)
+
+
+def _loaded(scene_file: Path) -> tuple[Scene, Detection | None]:
+    """The scene of a file; for shapes and URDF robots, with the contacts found and what detection saw."""
+    loaded = _guarded(lambda: load_world(scene_file))
+    if isinstance(loaded, Scene):
+        return loaded, None
+    world: World = loaded
+    detection = _guarded(world.detect)
+    return _guarded(lambda: world.scene(detection)), detection
 
 
 class _StatusLine:
@@ -129,12 +142,35 @@ class _StatusLine:
 
 @app.command()
 def check(scene_file: SceneArgument) -> None:
-    """Validate a scene file without solving it."""
-    scene: Scene = _guarded(lambda: load_scene(scene_file))
+    """Validate a scene file without solving it (a scene with shapes or URDF robots has its contacts found)."""
+    scene, detection = _loaded(scene_file)
+    found = "" if detection is None else f" ({len(detection.contacts)} found)"
     typer.echo(
-        f"ok: {len(scene.bodies)} bodies, {len(scene.movers)} movers, {len(scene.contacts)} contacts, "
+        f"ok: {len(scene.bodies)} bodies, {len(scene.movers)} movers, {len(scene.contacts)} contacts{found}, "
         f"dimension {scene.dimension}, friction {scene.friction}"
     )
+    for line in () if detection is None else detection.notes():
+        typer.echo(line)
+
+
+@app.command()
+def contacts(
+    scene_file: SceneArgument,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the scene with its contacts listed (format version 1, JSON), and nothing else.")
+    ] = False,
+) -> None:
+    """Find the contacts of a scene with shapes or URDF robots, and print them.
+
+    With --json the output is the same scene with every contact listed (points, normals, mu, robot Jacobians):
+    a plain scene file that `quasistatic solve` reads.
+    """
+    scene, detection = _loaded(scene_file)
+    if as_json:
+        typer.echo(json.dumps(scene_to_dict(scene), indent=2, allow_nan=False))
+        return
+    gaps = (0.0,) * len(scene.contacts) if detection is None else detection.gaps + (0.0,) * (len(scene.contacts) - len(detection.gaps))
+    render_contacts(scene.contacts, gaps, () if detection is None else detection.notes(), make_console())
 
 
 @app.command()

@@ -51,12 +51,13 @@ class SolverError(QuasistaticError, RuntimeError):
 
 
 class BackendUnavailableError(QuasistaticError, ImportError):
-    """An optional backend was asked for but its library is not installed."""
+    """An optional backend (a solver, or the robots-and-shapes adapter) was asked for but its library is not installed."""
 
-    def __init__(self, backend: str, install_hint: str) -> None:
+    def __init__(self, backend: str, install_hint: str, needed_for: str | None = None) -> None:
         self.backend = backend
         self.install_hint = install_hint
-        super().__init__(f"solver {backend!r} is not available: {install_hint}")
+        what = f"solver {backend!r}" if needed_for is None else f"{backend}, needed for {needed_for},"
+        super().__init__(f"{what} is not available: {install_hint}")
 
 
 _FIELD_LIMIT = 120

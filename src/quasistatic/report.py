@@ -15,10 +15,11 @@ from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
+from .model import Contact
 from .solution import Certificate, CertificateKind, ContactResult, Motion, Solution
 from .tolerances import DISPLAY_ZERO
 
-__all__ = ["render_solution", "make_console", "format_float", "format_vector"]
+__all__ = ["render_solution", "render_contacts", "make_console", "format_float", "format_vector"]
 
 _STATUS_STYLE = {
     "solved": "bold green",
@@ -97,6 +98,23 @@ def render_solution(solution: Solution, console: Console) -> None:
     ):
         console.print()
         console.print(table)
+
+
+def render_contacts(contacts: Sequence[Contact], gaps: Sequence[float], notes: Sequence[str], console: Console) -> None:
+    """Print detected contacts: the pair, the point, the normal into the body, the gap, mu, and whose Jacobian."""
+    table = _table(f"{len(contacts)} contacts found")
+    table.caption = "normal: into body; gap: > 0 apart, < 0 overlapping (scene units)"
+    table.caption_justify = "left"
+    for name in ("#", "body", "other", "point", "normal", "gap", "mu", "jacobian"):
+        table.add_column(name, justify="right" if name in ("#", "gap", "mu") else "left", overflow="fold")
+    length = max((float(np.max(np.abs(c.point), initial=0.0)) for c in contacts), default=0.0)
+    for index, (contact, gap) in enumerate(zip(contacts, gaps, strict=False)):
+        joints = "" if contact.jacobian is None else f"{contact.jacobian.shape[1]} joints"
+        row = [str(index), Text(contact.body), Text(contact.other), format_vector(contact.point, length)]
+        table.add_row(*row, format_vector(contact.normal, 1.0), format_float(gap, length), format_float(contact.mu), joints)
+    console.print(table)
+    for line in notes:
+        console.print(Text(line))
 
 
 def _explain(certificate: Certificate) -> str:

@@ -13,6 +13,7 @@ import dataclasses
 import time
 from collections.abc import Callable, Sequence
 
+from .adapters import Detection, World
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
 from .errors import QuasistaticError, SolverError
 from .laws import Problem, RawMotion, assemble, free_directions, physical_twists, to_world
@@ -20,14 +21,14 @@ from .model import Scene
 from .solution import Attempt, Mode, Motion, Solution
 from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, get_backend
 
-__all__ = ["solve", "METHODS", "audited_raw_motion"]
+__all__ = ["solve", "METHODS", "audited_raw_motion", "with_detection"]
 
 METHODS = ("auto", *BACKENDS)
 _MODE_NAMES = ("rolling", "sliding", "separating")
 
 
 def solve(
-    scene: Scene | Problem,
+    scene: Scene | Problem | World,
     method: str = "auto",
     *,
     certify: bool = True,
@@ -42,8 +43,10 @@ def solve(
 
     Parameters
     ----------
-    scene : Scene or Problem
-        A validated scene (or one already assembled, to solve it again cheaply).
+    scene : Scene, Problem or World
+        A validated scene (or one already assembled, to solve it again cheaply), or a
+        World of shapes and robots, whose contacts are found first (the answer's message
+        then says when a body touches nothing, and how far the nearest surface is).
     method : str
         ``auto`` (default) or a backend name from :data:`METHODS`. ``auto``
         solves frictionless scenes by LP and frictional ones by the certified
@@ -75,6 +78,20 @@ def solve(
     Solution
         Every motion in it has been audited on the original scene data.
     """
+    if isinstance(scene, World):
+        detection = scene.detect()
+        solution = solve(
+            scene.scene(detection),
+            method,
+            certify=certify,
+            modes=modes,
+            all_solutions=all_solutions,
+            max_solutions=max_solutions,
+            tolerance=tolerance,
+            time_limit=time_limit,
+            progress=progress,
+        )
+        return with_detection(solution, detection)
     started = time.perf_counter()
     problem = scene if isinstance(scene, Problem) else assemble(scene)
     checked = _check_modes(modes, problem)
@@ -131,6 +148,15 @@ def _choose(method: str, problem: Problem, modes_given: bool, certify: bool, ins
 
 def _frictional(problem: Problem) -> list[int]:
     return [i for i, mu in enumerate(problem.mu) if mu > 0]
+
+
+def with_detection(solution: Solution, detection: Detection) -> Solution:
+    """The answer with what contact detection found missing: which body touches nothing, and the nearest gap."""
+    lines = detection.notes()
+    if not lines:
+        return solution
+    message = f"{solution.message} ({'; '.join(lines)})"
+    return dataclasses.replace(solution, message=message, notes=(*solution.notes, ("contact_detection", list(lines))))
 
 
 def _check_modes(modes: Sequence[Mode | None] | None, problem: Problem) -> tuple[Mode | None, ...] | None:

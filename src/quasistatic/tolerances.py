@@ -53,6 +53,7 @@ __all__ = [
     "MAX_DEPTH",
     "MAX_VALUES",
     "MAX_FILE_BYTES",
+    "DETECTION_MARGIN",
 ]
 
 # --------------------------------------------------------------------------- input (physical units)
@@ -157,6 +158,15 @@ LEAST_SQUARES_STEP = 1e-15
 
 JACOBI_ORTHOGONAL = 1e-15
 """Two columns of a one-sided Jacobi SVD are orthogonal when their cosine is below this (working precision) [-]."""
+
+# --------------------------------------------------------------------------- contact detection (shapes and robots)
+
+DETECTION_MARGIN = 1e-4
+"""Default contact margin, relative to the largest free body's bounding radius [-]: gaps up to it count
+as contacts. Geometry from CAD or forward kinematics is exact to far better than this, so a part resting
+on another is found touching, while parts a ten-thousandth of their size apart (a 0.01 mm gap on a 10 cm
+part) are not: a user who wants a looser test gives ``contact_detection.margin`` in length units.
+"""
 
 # --------------------------------------------------------------------------- input limits (what a scene may hold at all)
 

@@ -1,14 +1,45 @@
 """Adapters: the user's world (URDF robots, shapes and meshes) turned into a :class:`~quasistatic.model.Scene`.
 
-Empty for now; its rules, for the first tenants (robots through Pinocchio,
-contact detection through coal):
+- ``shapes``: poses and shapes (box, sphere, cylinder, capsule, halfspace, mesh).
+- ``detect``: contacts between placed shapes, through coal (broad phase, contact patches).
+- ``robot``: URDF robots through Pinocchio: forward kinematics, collision geometry, point Jacobians.
+- ``world``: a :class:`World` of shapes and robots, and the Scene it gives at this instant.
+- ``world_file``: a scene file with shapes and robots read into a World.
+
+Rules:
 
 - An adapter's output is a Scene (points, normals, Jacobians, twists): no
   third-party type (``pinocchio.Model``, ``coal.CollisionObject``) leaks into
   ``model``, ``laws``, ``solvers`` or ``check``.
 - It imports ``model`` (and the leaf modules ``errors``, ``tolerances``) only;
-  heavy libraries are optional extras, imported inside the adapter, and a
-  missing one raises an error that says how to install it.
+  heavy libraries (Pinocchio, coal: the ``robots`` extra) are imported inside
+  the functions that need them, so ``import quasistatic`` never loads them,
+  and a missing one raises an error that says how to install it.
 - Bad input (a missing URDF, an unknown joint) is a ``SceneError`` naming the
   field and the value.
 """
+
+from .robot import ROBOTS_INSTALL_HINT, UrdfRobot
+from .shapes import Box, Capsule, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere
+from .world import ContactDetection, Detection, FrictionPair, ShapedMover, SolidBody, World
+from .world_file import world_from_file
+
+__all__ = [
+    "ROBOTS_INSTALL_HINT",
+    "Box",
+    "Capsule",
+    "ContactDetection",
+    "Cylinder",
+    "Detection",
+    "FrictionPair",
+    "Halfspace",
+    "Mesh",
+    "Pose",
+    "Shape",
+    "ShapedMover",
+    "SolidBody",
+    "Sphere",
+    "UrdfRobot",
+    "World",
+    "world_from_file",
+]

@@ -17,6 +17,7 @@ from __future__ import annotations
 import difflib
 import json
 import re
+import typing
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -28,7 +29,7 @@ from ..errors import MISSING, SceneError
 from ..tolerances import MAX_DEPTH, MAX_FILE_BYTES, MAX_VALUES
 from .scene import Body, Contact, Mover, Robot, Scene
 
-__all__ = ["load_scene", "FORMAT_VERSION"]
+__all__ = ["load_scene", "read_scene_file", "scene_from_file", "scene_to_dict", "SceneFile", "FORMAT_VERSION"]
 
 FORMAT_VERSION = 1
 
@@ -52,23 +53,77 @@ class _FileModel(pydantic.BaseModel):
     model_config = pydantic.ConfigDict(extra="forbid", allow_inf_nan=True, strict=False)
 
 
-class _BodyFile(_FileModel):
+class PoseFile(_FileModel):
+    """``{position: [x, y, z], rotation: {rpy: [...]} | {quaternion: [w, x, y, z]} | {matrix: [[...], ...]}}``."""
+
+    position: list[_Number] = [0.0, 0.0, 0.0]
+    rotation: RotationFile | None = None
+
+
+class RotationFile(_FileModel):
+    """Exactly one of roll-pitch-yaw angles [rad], a unit quaternion (w first) or a 3x3 rotation matrix."""
+
+    rpy: list[_Number] | None = None
+    quaternion: list[_Number] | None = None
+    matrix: list[list[_Number]] | None = None
+
+
+class CylinderFile(_FileModel):
+    radius: _Number
+    length: _Number
+
+
+class HalfspaceFile(_FileModel):
+    """Points x with ``normal . x <= offset`` are inside (the solid side)."""
+
+    normal: list[_Number]
+    offset: _Number = 0.0
+
+
+class ShapeFile(_FileModel):
+    """Exactly one shape: ``box`` (3 full edge lengths), ``sphere`` (radius), ``cylinder``/``capsule`` (along the local z
+    axis), ``halfspace``, or ``mesh`` (a file path, relative to the scene file) with an optional ``scale``."""
+
+    box: list[_Number] | None = None
+    sphere: _Number | None = None
+    cylinder: CylinderFile | None = None
+    capsule: CylinderFile | None = None
+    halfspace: HalfspaceFile | None = None
+    mesh: str | None = None
+    scale: _Number | list[_Number] | None = None
+
+
+class BodyFile(_FileModel):
+    """A free body. With a ``pose``, ``com`` is in the body's frame (default: its origin); without, in the world's."""
+
     mass: _Number
-    com: list[_Number]
+    com: list[_Number] | None = None
     wrench: list[_Number] | None = None
+    shape: ShapeFile | None = None
+    pose: PoseFile | None = None
 
 
-class _MoverFile(_FileModel):
+class MoverFile(_FileModel):
+    """A prescribed body: fixed, a rigid ``twist`` (about ``origin``, or the pose's position), or a robot link."""
+
     twist: list[_Number] | None = None
     origin: list[_Number] | None = None
     robot: str | None = None
+    shape: ShapeFile | None = None
+    pose: PoseFile | None = None
 
 
-class _RobotFile(_FileModel):
-    joint_velocities: list[_Number]
+class RobotFile(_FileModel):
+    """Joint velocities (a list, or by joint name for a URDF robot); a URDF robot also has its file, base and joints."""
+
+    joint_velocities: list[_Number] | dict[str, _Number] = []
+    urdf: str | None = None
+    package_dirs: list[str] = []
+    base: PoseFile | None = None
+    q: list[_Number] | dict[str, _Number] | None = None
 
 
-class _ContactFile(_FileModel):
+class ContactFile(_FileModel):
     body: str
     other: str
     point: list[_Number]
@@ -77,19 +132,52 @@ class _ContactFile(_FileModel):
     jacobian: list[list[_Number]] | None = None
 
 
-class _SceneFile(_FileModel):
+class FrictionPairFile(_FileModel):
+    between: list[str]
+    mu: _Number
+
+
+class DetectionFrictionFile(_FileModel):
+    default: _Number = 0.0
+    pairs: list[FrictionPairFile] = []
+
+
+class DetectionFile(_FileModel):
+    """Gaps up to ``margin`` count as contacts (default: relative to the bodies' size); friction by pair of names."""
+
+    margin: _Number | None = None
+    friction: DetectionFrictionFile = DetectionFrictionFile()
+
+
+class SceneFile(_FileModel):
+    """A scene file's keys, checked for structure and types (the values are checked by what they build)."""
+
     quasistatic: pydantic.StrictInt
     dimension: Literal[2, 3] = 3
     gravity: list[_Number] | None = None
     friction: str = "exact"
-    bodies: dict[str, _BodyFile]
-    movers: dict[str, _MoverFile | None] = {}
-    robots: dict[str, _RobotFile] = {}
-    contacts: list[_ContactFile]
+    bodies: dict[str, BodyFile]
+    movers: dict[str, MoverFile | None] = {}
+    robots: dict[str, RobotFile] = {}
+    contacts: list[ContactFile] = []
+    contact_detection: DetectionFile | None = None
+
+    @property
+    def is_geometric(self) -> bool:
+        """Whether contacts are to be found from shapes and robot models (rather than all listed)."""
+        return (
+            self.contact_detection is not None
+            or any(b.shape is not None or b.pose is not None for b in self.bodies.values())
+            or any(m is not None and (m.shape is not None or m.pose is not None) for m in self.movers.values())
+            or any(r.urdf is not None for r in self.robots.values())
+        )
 
 
-def load_scene(source: str | Path | Mapping[str, Any]) -> Scene:
-    """Load and validate a scene from a YAML/JSON file path or a dict of the file's keys.
+PoseFile.model_rebuild()
+
+
+def read_scene_file(source: str | Path | Mapping[str, Any]) -> tuple[SceneFile, Path]:
+    """The checked keys of a scene file (or of a dict of its keys), and the folder its relative paths start from.
 
     Raises
     ------
@@ -98,23 +186,94 @@ def load_scene(source: str | Path | Mapping[str, Any]) -> Scene:
         expanding past :data:`MAX_VALUES` values, or holding a key twice.
     """
     data = _read(source) if isinstance(source, (str, Path)) else source
+    folder = Path(source).parent if isinstance(source, (str, Path)) else Path.cwd()
     if not isinstance(data, Mapping):
         raise SceneError("", type(data).__name__, "a scene must be a mapping of keys (quasistatic, bodies, contacts, ...)")
     _check_structure(data)
     _check_version(data)
     try:
-        parsed = _SceneFile.model_validate(dict(data))
+        return SceneFile.model_validate(dict(data)), folder
     except pydantic.ValidationError as exc:
         raise _scene_error(exc) from None
+
+
+def load_scene(source: str | Path | Mapping[str, Any]) -> Scene:
+    """Load and validate a scene that lists its contacts, from a YAML/JSON file path or a dict of the file's keys.
+
+    A scene with shapes or URDF robots needs its contacts found: ``quasistatic.load_scene`` does that.
+
+    Raises
+    ------
+    SceneError
+        As :func:`read_scene_file`, or for a value its part rejects.
+    """
+    parsed, _ = read_scene_file(source)
+    if parsed.is_geometric:
+        raise SceneError("", "shapes or URDF robots", "this scene's contacts must be found first: use quasistatic.load_scene")
+    return scene_from_file(parsed)
+
+
+def scene_from_file(parsed: SceneFile) -> Scene:
+    """The Scene of a file that lists its contacts."""
+    if "contacts" not in parsed.model_fields_set:
+        raise SceneError("contacts", MISSING, "required key is missing (or describe shapes and let the contacts be found)")
     return Scene(
         dimension=parsed.dimension,
         gravity=parsed.gravity,
         friction=parsed.friction,
-        bodies=tuple(Body(name, b.mass, b.com, b.wrench) for name, b in parsed.bodies.items()),
+        bodies=tuple(Body(name, b.mass, _com(name, b), b.wrench) for name, b in parsed.bodies.items()),
         movers=tuple(Mover(name, m.twist, m.origin, m.robot) if m is not None else Mover(name) for name, m in parsed.movers.items()),
-        robots=tuple(Robot(name, r.joint_velocities) for name, r in parsed.robots.items()),
+        robots=tuple(Robot(name, _velocity_list(name, r)) for name, r in parsed.robots.items()),
         contacts=tuple(_contact(c, index) for index, c in enumerate(parsed.contacts)),
     )
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """The scene file (format version 1) that lists this scene's contacts: :func:`load_scene` reads it back as an equal Scene."""
+    return {
+        "quasistatic": FORMAT_VERSION,
+        "dimension": scene.dimension,
+        "gravity": scene.gravity.tolist(),
+        "friction": str(scene.friction),
+        "bodies": {b.name: {"mass": b.mass, "com": b.com.tolist(), "wrench": _listed(b.wrench)} for b in scene.bodies},
+        "movers": {m.name: _mover_entry(m) for m in scene.movers},
+        "robots": {r.name: {"joint_velocities": r.joint_velocities.tolist()} for r in scene.robots},
+        "contacts": [_contact_entry(c) for c in scene.contacts],
+    }
+
+
+def _mover_entry(mover: Mover) -> dict[str, Any]:
+    if mover.robot is not None:
+        return {"robot": mover.robot}
+    return {"twist": _listed(mover.twist), "origin": _listed(mover.origin)}
+
+
+def _contact_entry(contact: Contact) -> dict[str, Any]:
+    entry = {"body": contact.body, "other": contact.other, "point": contact.point.tolist(), "normal": contact.normal.tolist()}
+    entry["mu"] = contact.mu
+    if contact.jacobian is not None:
+        entry["jacobian"] = contact.jacobian.tolist()
+    return entry
+
+
+def _listed(values: Any) -> Any:
+    return None if values is None else values.tolist()
+
+
+def _com(name: str, body: BodyFile) -> list[float]:
+    if body.com is None:
+        raise SceneError(f"bodies.{name}.com", MISSING, "required key is missing")
+    return body.com
+
+
+def _velocity_list(name: str, robot: RobotFile) -> list[float]:
+    """Joint velocities of a robot with no model: a list (names mean nothing without a URDF)."""
+    if isinstance(robot.joint_velocities, dict):
+        reason = "joints can be named only for a robot with a urdf; give a list, one per Jacobian column"
+        raise SceneError(f"robots.{name}.joint_velocities", robot.joint_velocities, reason)
+    if "joint_velocities" not in robot.model_fields_set:
+        raise SceneError(f"robots.{name}.joint_velocities", MISSING, "required key is missing")
+    return robot.joint_velocities
 
 
 def _check_version(data: Mapping[str, Any]) -> None:
@@ -129,7 +288,7 @@ def _check_version(data: Mapping[str, Any]) -> None:
         raise SceneError("quasistatic", version, reason)
 
 
-def _contact(entry: _ContactFile, index: int) -> Contact:
+def _contact(entry: ContactFile, index: int) -> Contact:
     """A contact of the file; an error in it names the contact by its index."""
     try:
         return Contact(entry.body, entry.other, entry.point, entry.normal, entry.mu, entry.jacobian)
@@ -400,14 +559,12 @@ _CONTAINERS = (Mapping, list, tuple, set, frozenset)
 
 # --------------------------------------------------------------------------- pydantic's errors in the library's words
 
-_MODELS_BY_DEPTH: dict[str, type[pydantic.BaseModel]] = {
-    "": _SceneFile,
-    "bodies": _BodyFile,
-    "movers": _MoverFile,
-    "robots": _RobotFile,
-    "contacts": _ContactFile,
+_MODEL_NAMES = {
+    model.__name__
+    for model in (SceneFile, BodyFile, MoverFile, RobotFile, ContactFile, ShapeFile, PoseFile, RotationFile)
+    + (CylinderFile, HalfspaceFile, DetectionFile, DetectionFrictionFile, FrictionPairFile)
 }
-_MODEL_NAMES = {model.__name__ for model in _MODELS_BY_DEPTH.values()}
+_UNION_TAG = re.compile(r"^(list|dict)\[")  # pydantic's name for one branch of a union, e.g. 'list[float]'
 _WORDS = {
     "list_type": "expected a list",
     "dict_type": "expected a mapping of names to entries",
@@ -425,19 +582,46 @@ def _scene_error(exc: pydantic.ValidationError) -> SceneError:
     errors = exc.errors()
     # A misspelt key shows as both "missing" and "extra": report the extra one, with a hint.
     error = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
-    loc = [part for part in error["loc"] if part not in _MODEL_NAMES]
+    loc = [part for part in error["loc"] if part not in _MODEL_NAMES and not _UNION_TAG.match(str(part))]
     kind = error["type"]
     if loc and loc[-1] == "[key]":
         return SceneError(_format_path(loc[:-2]), loc[-2], "names (keys) must be strings")
     path = _format_path(loc)
-    model = _MODELS_BY_DEPTH.get(str(loc[0]) if len(loc) > 1 else "", _SceneFile)
     if kind == "extra_forbidden":
-        return SceneError(path, loc[-1], f"unknown key{_key_hint(str(loc[-1]), model)}")
+        return SceneError(path, loc[-1], f"unknown key{_key_hint(str(loc[-1]), _model_at(loc[:-1]))}")
     if kind == "missing":
         return SceneError(path, MISSING, "required key is missing")
     if kind == "model_type":
-        return SceneError(path, error.get("input"), f"expected a mapping with keys {', '.join(model.model_fields)}")
+        keys = ", ".join(_model_at(loc).model_fields)
+        return SceneError(path, error.get("input"), f"expected a mapping with keys {keys}")
     return SceneError(path, error.get("input"), _WORDS.get(kind) or _plain(error["msg"]))
+
+
+def _model_at(loc: Sequence[Any]) -> type[pydantic.BaseModel]:
+    """The schema model that checks the value at ``loc`` (``bodies.cube.shape`` -> ShapeFile), for the allowed keys."""
+    model: type[pydantic.BaseModel] = SceneFile
+    parts = list(loc)
+    while parts:
+        field = model.model_fields.get(str(parts.pop(0)))
+        inner = None if field is None else _inner_model(field.annotation)
+        if inner is None:
+            return model
+        model, keyed = inner
+        if keyed and parts:
+            parts.pop(0)  # the entry's name or index
+    return model
+
+
+def _inner_model(annotation: Any) -> tuple[type[pydantic.BaseModel], bool] | None:
+    """The schema model inside a field's type, and whether it sits in a dict or list (so one path part names the entry)."""
+    if isinstance(annotation, type) and issubclass(annotation, pydantic.BaseModel):
+        return annotation, False
+    origin = typing.get_origin(annotation)
+    for argument in typing.get_args(annotation):
+        inner = _inner_model(argument)
+        if inner is not None:
+            return inner[0], inner[1] or origin in (dict, list)
+    return None
 
 
 def _key_hint(key: str, model: type[pydantic.BaseModel]) -> str:
@@ -449,7 +633,7 @@ def _key_hint(key: str, model: type[pydantic.BaseModel]) -> str:
 def _plain(message: str) -> str:
     """pydantic's message without its 'Value error, ' prefix or class names, starting in lower case."""
     message = re.sub(r"^value error, ", "", message, flags=re.IGNORECASE)
-    message = re.sub(r"\b_\w+File\b", "mapping", message)
+    message = re.sub(r"\b_?\w+File\b", "mapping", message)
     return message[:1].lower() + message[1:]
 
 

@@ -1,0 +1,376 @@
+"""Robots from their URDF, through Pinocchio: forward kinematics, collision geometry and point Jacobians.
+
+A :class:`UrdfRobot` is one robot at one configuration: its joint positions,
+joint velocities and base pose. The URDF is parsed once; :meth:`UrdfRobot.at`
+gives the same robot at another configuration without parsing again (what a
+simulation step does). Everything it hands out is numpy and :class:`Pose`:
+no Pinocchio type leaves this module.
+
+Joint positions and velocities have one entry per joint degree of freedom in
+the model's order (:attr:`UrdfRobot.joint_names`): revolute, continuous and
+prismatic joints, in rad or length units. Fixed joints are merged away by
+Pinocchio; other joint types (floating, planar, spherical) are rejected.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sysconfig
+import tempfile
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import BackendUnavailableError, SceneError
+from ..tolerances import MAX_FILE_BYTES, MAX_MAGNITUDE
+from .shapes import Pose
+
+__all__ = ["UrdfRobot", "RobotCollider", "ROBOTS_INSTALL_HINT", "link_owner", "installed_model_folders", "resolve_package_path"]
+
+FloatArray = npt.NDArray[np.float64]
+
+ROBOTS_INSTALL_HINT = "install the robots extra: pip install 'quasistatic[robots]'"
+_PACKAGE = "package://"
+_MESSAGE_LINES = 2  # lines of urdfdom's own error text kept in a message
+
+
+def installed_model_folders() -> list[Path]:
+    """Where pip-installed robot model packages put their files (``example-robot-data`` among them): searched for
+    ``package://`` paths after the scene's own ``package_dirs``. Nothing is downloaded."""
+    share = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share"
+    return [share] if share.is_dir() else []
+
+
+def resolve_package_path(text: str, folders: Sequence[Path], field: str) -> Path:
+    """A path, or ``package://name/rest`` found as ``folder/name/rest`` in the first folder that has it."""
+    if not text.startswith(_PACKAGE):
+        return Path(text)
+    relative = text.removeprefix(_PACKAGE)
+    for folder in folders:
+        if (folder / relative).exists():
+            return folder / relative
+    searched = ", ".join(str(f) for f in folders) or "none (give package_dirs)"
+    raise SceneError(field, text, f"no such file in the package folders searched: {searched}")
+
+
+def link_owner(robot: str, link: str) -> str:
+    """The name of a robot link as a mover in the Scene: ``hand/link_3.0_tip``."""
+    return f"{robot}/{link}"
+
+
+@dataclass(frozen=True)
+class RobotCollider:
+    """One collision geometry of a robot link, placed in the world at the robot's configuration.
+
+    ``geometry`` is the collision library's own object (a coal geometry); only the adapters read it.
+    """
+
+    owner: str
+    link: str
+    geometry: Any
+    pose: Pose
+
+
+class _Kinematics:
+    """Pinocchio's model and collision model of one URDF, parsed once and shared by every configuration."""
+
+    def __init__(self, urdf: Path, package_dirs: Sequence[Path], field: str) -> None:
+        pinocchio = _pinocchio()
+        text = _urdf_text(urdf, field)  # bounded read: a device or a huge file never reaches the parser
+        with _captured_stderr() as errors:
+            try:
+                self.model = pinocchio.buildModelFromXML(text)
+            except (ValueError, RuntimeError) as exc:
+                raise SceneError(field, str(urdf), f"not a valid URDF: {_first_lines(errors(), exc)}") from None
+            try:
+                # From the file, not the text: mesh paths relative to the URDF resolve from its folder.
+                self.geometry = pinocchio.buildGeomFromUrdf(
+                    self.model, str(urdf), pinocchio.GeometryType.COLLISION, package_dirs=[str(d) for d in package_dirs] or None
+                )
+            except (ValueError, RuntimeError) as exc:
+                reason = f"its collision geometry cannot be loaded: {_first_lines(errors(), exc)}"
+                raise SceneError(field, str(urdf), f"{reason} (package:// paths are resolved in package_dirs)") from None
+        self.data = self.model.createData()
+        self.geometry_data = pinocchio.GeometryData(self.geometry)
+        self.joint_names = self._joint_names(field, urdf)
+        links = [frame for frame in self.model.frames if frame.type == pinocchio.FrameType.BODY]
+        self.link_names = tuple(frame.name for frame in links)
+        # Constant offsets: a link's frame, and each collision geometry, in its parent joint's frame.
+        self.link_in_joint = {frame.name: (int(frame.parentJoint), _matrix(frame.placement)) for frame in links}
+        self.geometry_in_joint = np.array([_matrix(item.placement) for item in self.geometry.geometryObjects]).reshape(-1, 4, 4)
+        self.geometry_joint = np.array([int(item.parentJoint) for item in self.geometry.geometryObjects], dtype=int)
+        self.geometry_link = tuple(self.model.frames[item.parentFrame].name for item in self.geometry.geometryObjects)
+        self.chain_columns = self._chain_columns()
+        joints = [self.model.joints[joint_id] for joint_id in range(1, self.model.njoints)]
+        self.plain_dof = np.array([i for i, j in enumerate(joints) if j.nq == 1], dtype=int)
+        self.plain_q = np.array([j.idx_q for j in joints if j.nq == 1], dtype=int)
+        self.circle_dof = np.array([i for i, j in enumerate(joints) if j.nq == 2], dtype=int)  # continuous: cos, sin
+        self.circle_q = np.array([j.idx_q for j in joints if j.nq == 2], dtype=int)
+
+    def _joint_names(self, field: str, urdf: Path) -> tuple[str, ...]:
+        """One name per degree of freedom; a joint with other than one (revolute, prismatic, continuous) is rejected."""
+        names = []
+        for joint_id in range(1, self.model.njoints):
+            joint, name = self.model.joints[joint_id], self.model.names[joint_id]
+            if joint.nv != 1:
+                raise SceneError(field, str(urdf), f"joint {name!r} has {joint.nv} degrees of freedom; only 1-DOF joints are supported")
+            names.append(name)
+        return tuple(names)
+
+    def _chain_columns(self) -> FloatArray:
+        """Per joint, a 0/1 row over the velocity columns of the joints that move it (its kinematic chain)."""
+        columns = np.zeros((self.model.njoints, self.model.nv))
+        for joint_id in range(1, self.model.njoints):
+            for ancestor in self.model.supports[joint_id]:
+                if ancestor > 0:
+                    columns[joint_id, self.model.joints[ancestor].idx_v] = 1.0
+        return columns
+
+    def configuration(self, angles: FloatArray) -> FloatArray:
+        """Pinocchio's configuration vector from one position per joint (a continuous joint is stored as cos, sin)."""
+        q = np.zeros(self.model.nq)
+        q[self.plain_q] = angles[self.plain_dof]
+        q[self.circle_q] = np.cos(angles[self.circle_dof])
+        q[self.circle_q + 1] = np.sin(angles[self.circle_dof])
+        return q
+
+
+@dataclass(frozen=True)
+class _Placement:
+    """What the configuration fixes, copied out of Pinocchio's scratch data: joint frames and the Jacobian."""
+
+    joints: FloatArray  # (joints, 4, 4): each joint's frame in the world (the base pose applied)
+    jacobian: FloatArray  # (6, dofs): [v of the model origin; w] per joint velocity, in the model's root frame
+
+
+class UrdfRobot:
+    """A robot described by a URDF, at one configuration.
+
+    Parameters
+    ----------
+    name : str
+        The robot's name in the scene; its links become movers named ``name/link``.
+    urdf : path
+        The URDF file. ``package://`` mesh paths are resolved in ``package_dirs``.
+    package_dirs : paths, optional
+        Folders that hold the packages the URDF names.
+    base : Pose, optional
+        World pose of the robot's root link (identity by default).
+    q : list or mapping, optional
+        Joint positions: a list in model order (:attr:`joint_names`), or a mapping by joint name
+        (unnamed joints at 0). Zero by default.
+    joint_velocities : list or mapping, optional
+        Joint velocities, in the same forms. Zero by default.
+    field : str, optional
+        Where the robot is in a scene file, for error messages (``robots.hand``).
+    """
+
+    def __init__(
+        self,
+        name: str,
+        urdf: str | Path,
+        *,
+        package_dirs: Sequence[str | Path] = (),
+        base: Pose | None = None,
+        q: Sequence[float] | Mapping[str, float] | None = None,
+        joint_velocities: Sequence[float] | Mapping[str, float] | None = None,
+        field: str | None = None,
+    ) -> None:
+        field = field or f"robots.{name}"
+        folders = [Path(d) for d in package_dirs] + installed_model_folders()
+        path = resolve_package_path(str(urdf), folders, f"{field}.urdf")
+        kinematics = _Kinematics(path, folders, f"{field}.urdf")
+        self._build(name, path, kinematics, base or Pose(), q, joint_velocities, field)
+
+    def _build(
+        self,
+        name: str,
+        urdf: Path,
+        kinematics: _Kinematics,
+        base: Pose,
+        q: Sequence[float] | Mapping[str, float] | FloatArray | None,
+        joint_velocities: Sequence[float] | Mapping[str, float] | FloatArray | None,
+        field: str,
+    ) -> None:
+        self.name = name
+        self.urdf = urdf
+        self.base = base
+        self._kinematics = kinematics
+        self._field = field
+        self.q = _per_joint(q, kinematics.joint_names, f"{field}.q")
+        self.joint_velocities = _per_joint(joint_velocities, kinematics.joint_names, f"{field}.joint_velocities")
+        self._placement = _place(kinematics, self.q, base)
+        self._colliders: tuple[RobotCollider, ...] | None = None
+
+    def at(
+        self,
+        q: Sequence[float] | Mapping[str, float] | FloatArray | None = None,
+        joint_velocities: Sequence[float] | Mapping[str, float] | FloatArray | None = None,
+        base: Pose | None = None,
+    ) -> UrdfRobot:
+        """The same robot at another configuration (what is not given is kept); the URDF is not parsed again."""
+        robot = UrdfRobot.__new__(UrdfRobot)
+        robot._build(
+            self.name,
+            self.urdf,
+            self._kinematics,
+            self.base if base is None else base,
+            self.q if q is None else q,
+            self.joint_velocities if joint_velocities is None else joint_velocities,
+            self._field,
+        )
+        return robot
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """One name per joint degree of freedom, in the order of :attr:`q` and the Jacobians' columns."""
+        return self._kinematics.joint_names
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """Every link of the model."""
+        return self._kinematics.link_names
+
+    @property
+    def colliders(self) -> tuple[RobotCollider, ...]:
+        """The collision geometries of every link, placed in the world (built on first use)."""
+        if self._colliders is None:
+            kinematics = self._kinematics
+            placed = self._placement.joints[kinematics.geometry_joint] @ kinematics.geometry_in_joint
+            self._colliders = tuple(
+                RobotCollider(link_owner(self.name, link), link, item.geometry, _pose(matrix))
+                for link, item, matrix in zip(kinematics.geometry_link, kinematics.geometry.geometryObjects, placed, strict=True)
+            )
+        return self._colliders
+
+    def link_pose(self, link: str) -> Pose:
+        """World pose of a link's frame."""
+        joint, offset = self._kinematics.link_in_joint[self._link(link)]
+        return _pose(self._placement.joints[joint] @ offset)
+
+    def point_jacobian(self, link: str, point: npt.ArrayLike) -> FloatArray:
+        """World velocity of the material point of ``link`` at world ``point``, per unit joint velocity: (3, joints)."""
+        joint, _ = self._kinematics.link_in_joint[self._link(link)]
+        jacobian = self._placement.jacobian * self._kinematics.chain_columns[joint]
+        local = self.base.inverse().apply(np.asarray(point, dtype=float))
+        # v(p) = v(origin) + w x p: the linear rows minus p x (angular rows), then turned into the world.
+        in_model = jacobian[:3] - _cross_matrix(local) @ jacobian[3:]
+        result: FloatArray = self.base.rotation @ in_model
+        return result
+
+    def _link(self, link: str) -> str:
+        if link not in self._kinematics.link_in_joint:
+            raise SceneError(f"{self._field}.links", link, f"no link of that name in {self.urdf.name}")
+        return link
+
+
+def _place(kinematics: _Kinematics, angles: FloatArray, base: Pose) -> _Placement:
+    """Forward kinematics and the joint Jacobians at ``angles`` (Pinocchio's data is scratch: copy what is kept)."""
+    pinocchio = _pinocchio()
+    model, data = kinematics.model, kinematics.data
+    pinocchio.computeJointJacobians(model, data, kinematics.configuration(angles))  # runs the forward kinematics too
+    joints = np.array([placement.homogeneous for placement in data.oMi])
+    return _Placement(base.matrix() @ joints, np.array(data.J, dtype=float))
+
+
+def _matrix(placement: Any) -> FloatArray:
+    """Pinocchio's SE3 as a 4x4 homogeneous matrix."""
+    return np.array(placement.homogeneous, dtype=float)
+
+
+def _pose(matrix: FloatArray) -> Pose:
+    return Pose(position=matrix[:3, 3].copy(), rotation=matrix[:3, :3].copy())
+
+
+def _per_joint(values: Any, names: tuple[str, ...], field: str) -> FloatArray:
+    """One finite number per joint, from a list in model order or a mapping by name (missing names are 0)."""
+    result = np.zeros(len(names))
+    if values is None:
+        return result
+    if isinstance(values, Mapping):
+        for joint, value in values.items():
+            if joint not in names:
+                shown = ", ".join(names[:8]) + (", ..." if len(names) > 8 else "")
+                raise SceneError(f"{field}.{joint}", joint, f"no joint of that name; the joints are {shown}")
+            result[names.index(joint)] = _finite(value, f"{field}.{joint}")
+        return result
+    if isinstance(values, (str, bytes)) or np.ndim(values) != 1:
+        raise SceneError(field, values, "expected a list of numbers, one per joint, or a mapping by joint name")
+    if len(values) != len(names):
+        raise SceneError(field, f"{len(values)} values", f"expected {len(names)}, one per joint ({', '.join(names[:8])}, ...)")
+    if isinstance(values, np.ndarray) and values.dtype.kind == "f" and np.all(np.abs(values) <= MAX_MAGNITUDE):
+        return values.astype(float)  # a simulation's own arrays: checked at once (NaN fails the comparison)
+    for index, value in enumerate(values):
+        result[index] = _finite(value, f"{field}[{index}]")
+    return result
+
+
+def _finite(value: Any, field: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise SceneError(field, value, "expected a number")
+    number = float(value)
+    if not np.isfinite(number) or abs(number) > MAX_MAGNITUDE:
+        raise SceneError(field, value, f"must be a finite number of magnitude at most {MAX_MAGNITUDE:g}")
+    return number
+
+
+def _cross_matrix(vector: FloatArray) -> FloatArray:
+    x, y, z = vector
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def _urdf_text(urdf: Path, field: str) -> str:
+    """The URDF's text, read up to :data:`MAX_FILE_BYTES`; a missing or unreadable file is a SceneError."""
+    try:
+        with urdf.open("rb") as stream:
+            raw = stream.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise SceneError(field, str(urdf), f"cannot read the URDF: {exc.strerror or exc}") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise SceneError(field, str(urdf), f"the URDF is larger than {MAX_FILE_BYTES // 2**20} MiB")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise SceneError(field, str(urdf), "the URDF is not UTF-8 text") from None
+
+
+def _pinocchio() -> Any:
+    try:
+        import pinocchio
+    except ImportError:
+        raise BackendUnavailableError("Pinocchio", ROBOTS_INSTALL_HINT, needed_for="URDF robots") from None
+    return pinocchio
+
+
+@contextlib.contextmanager
+def _captured_stderr() -> Iterator[Any]:
+    """Redirect file descriptor 2 (where urdfdom and assimp print their errors) to a file while parsing.
+
+    Yields a function that returns what was written, for the error message; nothing reaches the user's terminal.
+    """
+    with tempfile.TemporaryFile(mode="w+b") as sink:
+        saved = os.dup(2)
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lambda: _read_back(sink)
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+
+
+def _read_back(sink: Any) -> str:
+    sink.flush()
+    sink.seek(0)
+    return str(sink.read(4096).decode("utf-8", "replace"))
+
+
+def _first_lines(captured: str, exc: Exception) -> str:
+    """The library's own words: its first lines on stderr ('File ... does not exist'), else the exception."""
+    lines = [line.strip().removeprefix("Error:").strip() for line in captured.splitlines() if line.strip()]
+    kept = [line for line in lines if not line.startswith("at line")][:_MESSAGE_LINES]
+    return "; ".join(kept) or str(exc)

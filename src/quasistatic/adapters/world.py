@@ -1,0 +1,193 @@
+"""A world of shapes and robots, and the point-contact :class:`Scene` it gives at this instant.
+
+:class:`World` holds what a user describes: free bodies with shapes and
+poses, movers with shapes and twists, URDF robots at a configuration with
+their joint velocities, the contact-detection settings, and any explicit
+contacts. :meth:`World.detect` finds the contacts with coal
+(:mod:`.detect`); :meth:`World.scene` turns them into the Scene the solvers
+read: one ``Contact`` per point with its normal into the free body, its
+friction coefficient and, for a robot link, the link's point Jacobian.
+
+A body's ``com`` is given in the body's frame (its ``pose``); with no pose
+the body frame is the world frame, as in an explicit scene.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from ..model import Body, Contact, FrictionModel, Mover, Robot, Scene
+from ..tolerances import DETECTION_MARGIN
+from .detect import Collider, ContactPoint, detect, nearest_gaps
+from .robot import UrdfRobot, link_owner
+from .shapes import Pose, Shape, bounding_radius
+
+__all__ = ["SolidBody", "ShapedMover", "FrictionPair", "ContactDetection", "Detection", "World"]
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class SolidBody:
+    """A free body: its shape (optional), pose, mass, centre of mass in its own frame, and applied wrench."""
+
+    name: str
+    mass: float
+    shape: Shape | None = None
+    pose: Pose = field(default_factory=Pose)
+    com: npt.ArrayLike = (0.0, 0.0, 0.0)
+    wrench: npt.ArrayLike | None = None
+
+    def body(self) -> Body:
+        """The solver's Body: the com in the world frame."""
+        return Body(self.name, self.mass, self.pose.apply(np.asarray(self.com, dtype=float)), self.wrench)
+
+
+@dataclass(frozen=True)
+class ShapedMover:
+    """A body with a prescribed motion: its shape (optional), pose, and twist [v of the pose origin, w] in the world frame."""
+
+    name: str
+    shape: Shape | None = None
+    pose: Pose = field(default_factory=Pose)
+    twist: npt.ArrayLike | None = None
+
+    def mover(self) -> Mover:
+        return Mover(self.name, self.twist, origin=self.pose.position)
+
+
+@dataclass(frozen=True)
+class FrictionPair:
+    """The friction coefficient between two names: bodies, movers, robots (all their links) or links (``robot/link``)."""
+
+    between: tuple[str, str]
+    mu: float
+
+
+@dataclass(frozen=True)
+class ContactDetection:
+    """What counts as a contact and its friction.
+
+    ``margin``: gaps up to this count as contacts [length]; None means :data:`DETECTION_MARGIN` times the
+    largest free body's size, so a scene in millimetres finds the same contacts as one in metres.
+    ``mu``: the default friction coefficient; ``pairs`` override it.
+    """
+
+    margin: float | None = None
+    mu: float = 0.0
+    pairs: tuple[FrictionPair, ...] = ()
+
+
+@dataclass(frozen=True)
+class Detection:
+    """The contacts found, and for each free body with none, the nearest surface and its distance."""
+
+    contacts: tuple[Contact, ...]
+    gaps: tuple[float, ...]  # per contact: > 0 apart (within the margin), < 0 overlapping [length]
+    margin: float
+    isolated: Mapping[str, tuple[str, float]]  # free body -> (nearest other, gap)
+
+    def notes(self) -> tuple[str, ...]:
+        """One line per free body that touches nothing, for the answer's notes."""
+        return tuple(
+            f"no contact within the margin {self.margin:.3g} for body {name!r}; the nearest surface is {other!r}, {gap:.3g} away"
+            if other
+            else f"no contact for body {name!r}: nothing else in the scene has a shape"
+            for name, (other, gap) in self.isolated.items()
+        )
+
+
+@dataclass(frozen=True)
+class World:
+    """Shapes, robots and explicit contacts: a scene before its contacts are found."""
+
+    bodies: tuple[SolidBody, ...]
+    movers: tuple[ShapedMover, ...] = ()
+    robots: tuple[UrdfRobot, ...] = ()
+    explicit_robots: tuple[Robot, ...] = ()
+    contacts: tuple[Contact, ...] = ()
+    detection: ContactDetection = field(default_factory=ContactDetection)
+    gravity: npt.ArrayLike | None = None
+    friction: FrictionModel | str = "exact"
+
+    def detect(self) -> Detection:
+        """The contacts within the margin, as solver contacts (normals into the free body, Jacobians for robot links)."""
+        colliders = self._colliders()
+        margin = self._margin()
+        points = detect(colliders, self._may_touch, margin)
+        contacts = tuple(self._contact(point) for point in points)
+        touched = {c.body for c in contacts} | {c.other for c in contacts} | {c.body for c in self.contacts}
+        lonely = [b.name for b in self.bodies if b.name not in touched and b.shape is not None]
+        isolated = nearest_gaps(colliders, lonely, self._may_touch) if lonely else {}
+        return Detection(contacts, tuple(p.gap for p in points), margin, isolated)
+
+    def scene(self, detection: Detection | None = None) -> Scene:
+        """The point-contact Scene at this instant: detected contacts first, then the explicit ones."""
+        detection = detection or self.detect()
+        contacts = detection.contacts + self.contacts
+        links = sorted({c.other for c in contacts if c.other in self._link_robot})
+        return Scene(
+            bodies=[b.body() for b in self.bodies],
+            movers=[m.mover() for m in self.movers] + [Mover(link, robot=self._link_robot[link]) for link in links],
+            robots=[Robot(r.name, r.joint_velocities) for r in self.robots] + list(self.explicit_robots),
+            contacts=contacts,
+            dimension=3,
+            gravity=self.gravity,
+            friction=self.friction,
+        )
+
+    # ----------------------------------------------------------------- parts
+
+    @property
+    def _link_robot(self) -> dict[str, str]:
+        return {link_owner(r.name, link): r.name for r in self.robots for link in r.link_names}
+
+    def _colliders(self) -> list[Collider]:
+        shaped = [Collider(p.name, p.shape, p.pose) for p in (*self.bodies, *self.movers) if p.shape is not None]
+        return shaped + [Collider(c.owner, c.geometry, c.pose) for r in self.robots for c in r.colliders]
+
+    def _margin(self) -> float:
+        if self.detection.margin is not None:
+            return self.detection.margin
+        sizes = [bounding_radius(b.shape) for b in self.bodies if b.shape is not None]
+        return DETECTION_MARGIN * max(sizes, default=1.0)
+
+    def _may_touch(self, first: str, second: str) -> bool:
+        """Only pairs with a free body constrain its motion; two links of one robot, or two movers, never do."""
+        free = {b.name for b in self.bodies}
+        return first in free or second in free
+
+    def _contact(self, point: ContactPoint) -> Contact:
+        """A solver contact: the free body first, its normal into it; a robot link's Jacobian at the point."""
+        free = {b.name for b in self.bodies}
+        body, other, normal = point.first, point.second, point.normal
+        if body not in free:
+            body, other, normal = other, body, -normal
+        robot_link = self._robot_link(other)
+        jacobian = None if robot_link is None else robot_link[0].point_jacobian(robot_link[1], point.point)
+        return Contact(body, other, point.point, normal, mu=self._mu(body, other), jacobian=jacobian)
+
+    def _robot_link(self, owner: str) -> tuple[UrdfRobot, str] | None:
+        for robot in self.robots:
+            prefix = f"{robot.name}/"
+            if owner.startswith(prefix):
+                return robot, owner.removeprefix(prefix)
+        return None
+
+    def _mu(self, body: str, other: str) -> float:
+        names = {body: {body}, other: {other, *_robot_of(other)}}
+        for pair in self.detection.pairs:
+            a, b = pair.between
+            if (a in names[body] and b in names[other]) or (b in names[body] and a in names[other]):
+                return pair.mu
+        return self.detection.mu
+
+
+def _robot_of(owner: str) -> Iterable[str]:
+    """``hand`` for ``hand/link``: a friction pair may name the whole robot."""
+    return owner.split("/", 1)[:1] if "/" in owner else ()
+

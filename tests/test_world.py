@@ -1,0 +1,221 @@
+"""Scenes described by shapes and URDF robots: contacts found, solved like their hand-written twins.
+
+Every scene here has a twin with its contacts written by hand (or derived by hand), and the two must
+give the same Solution; the command line is run as a user runs it, in a subprocess.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+pytest.importorskip("coal")
+pytest.importorskip("pinocchio")
+
+import quasistatic as qs  # noqa: E402
+from quasistatic.model.io import scene_to_dict  # noqa: E402
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+BOX_PUSH = EXAMPLES / "box_push_shapes.yaml"
+HAND = EXAMPLES / "planar_hand.yaml"
+SCRIPT = Path(sys.executable).with_name("quasistatic")
+
+
+def _run(*args: str) -> subprocess.CompletedProcess[str]:
+    environment = {**os.environ, "COLUMNS": "200"}
+    return subprocess.run([str(SCRIPT), *args], capture_output=True, text=True, timeout=120, env=environment, check=False)
+
+
+def _same_answer(first: qs.Solution, second: qs.Solution, length: float = 1.0) -> None:
+    """Same status, twists, forces and modes (twists' linear parts and forces in the units of each scene)."""
+    assert first.status == second.status
+    assert first.motion is not None and second.motion is not None
+    for name, twist in first.motion.twists.items():
+        other = second.motion.twists[name]
+        assert np.allclose(twist[:3] * length, other[:3], atol=1e-9 * length), name
+        assert np.allclose(twist[3:], other[3:], atol=1e-9), name
+    for ours, theirs in zip(first.motion.contacts, second.motion.contacts, strict=True):
+        assert ours.mode == theirs.mode
+        assert np.allclose(ours.force, theirs.force, atol=1e-7)
+
+
+def _box_push_by_hand() -> qs.Scene:
+    corners = [[-0.05, -0.05, 0.0], [-0.05, 0.05, 0.0], [0.05, -0.05, 0.0], [0.05, 0.05, 0.0]]
+    return qs.Scene(
+        bodies=[qs.Body("box", 1.0, [0.0, 0.0, 0.05])],
+        movers=[qs.Mover("finger", [0.01, 0, 0, 0, 0, 0], origin=[-0.055, 0.0, 0.05]), qs.Mover("table")],
+        contacts=[qs.Contact("box", "finger", [-0.05, 0.0, 0.05], [1.0, 0.0, 0.0], mu=0.2)]
+        + [qs.Contact("box", "table", corner, [0.0, 0.0, 1.0], mu=0.5) for corner in corners],
+    )
+
+
+def _by_pair(scene: qs.Scene) -> list[tuple[str, str, tuple[float, ...]]]:
+    return sorted((c.body, c.other, tuple(np.round(c.point, 12))) for c in scene.contacts)
+
+
+def test_box_push_finds_the_contacts_written_by_hand() -> None:
+    found = qs.load_scene(BOX_PUSH)
+    by_hand = _box_push_by_hand()
+    assert _by_pair(found) == _by_pair(by_hand)
+    for contact in found.contacts:
+        twin = next(c for c in by_hand.contacts if c.other == contact.other and np.allclose(c.point, contact.point))
+        assert np.allclose(contact.normal, twin.normal, atol=1e-12) and contact.mu == twin.mu
+
+
+def test_box_push_solves_like_its_hand_written_twin() -> None:
+    found = qs.load_scene(BOX_PUSH)
+    by_hand = qs.Scene(bodies=found.bodies, movers=found.movers, contacts=_box_push_by_hand().contacts)
+    solution = qs.solve(found)
+    assert solution.status == "solved" and solution.certified
+    _same_answer(solution, qs.solve(by_hand))
+    assert solution.motion is not None
+    assert np.allclose(solution.motion.twists["box"], [0.01, 0, 0, 0, 0, 0], atol=1e-9)
+
+
+def _scaled(data: dict[str, Any], factor: float) -> dict[str, Any]:
+    """The box push with every length multiplied by ``factor`` (metres to millimetres: 1000)."""
+    data = json.loads(json.dumps(data))
+    data["bodies"]["box"]["shape"]["box"] = [x * factor for x in data["bodies"]["box"]["shape"]["box"]]
+    data["bodies"]["box"]["pose"]["position"] = [x * factor for x in data["bodies"]["box"]["pose"]["position"]]
+    finger = data["movers"]["finger"]
+    finger["shape"]["sphere"] *= factor
+    finger["pose"]["position"] = [x * factor for x in finger["pose"]["position"]]
+    finger["twist"] = [x * factor for x in finger["twist"][:3]] + finger["twist"][3:]
+    data["gravity"] = [0.0, 0.0, -9.81 * factor]
+    return data
+
+
+def _box_push_data() -> dict[str, Any]:
+    import yaml
+
+    data: dict[str, Any] = yaml.safe_load(BOX_PUSH.read_text(encoding="utf-8"))
+    return data
+
+
+def test_millimetres_give_the_same_answer_as_metres() -> None:
+    metres = qs.solve(qs.load_scene(_box_push_data()))
+    millimetres = qs.solve(qs.load_scene(_scaled(_box_push_data(), 1000.0)))
+    _same_answer(metres, millimetres, length=1000.0)
+
+
+def test_detection_turns_with_the_world_frame() -> None:
+    """The same scene seen from a turned and shifted world frame: contacts move with it, the answer turns with it."""
+    turn = qs.Pose.from_rpy([0.3, -0.2, 0.1], [0.4, -0.3, 1.1])
+    data = _box_push_data()
+
+    def moved(entry: dict[str, Any]) -> dict[str, Any]:
+        pose = turn.compose(qs.Pose(entry["pose"]["position"]))
+        entry["pose"] = {"position": pose.position.tolist(), "rotation": {"matrix": pose.rotation.tolist()}}
+        return entry
+
+    moved(data["bodies"]["box"])
+    moved(data["movers"]["finger"])
+    data["movers"]["finger"]["twist"] = (turn.rotation @ [0.01, 0, 0]).tolist() + [0.0, 0.0, 0.0]
+    data["movers"]["table"]["shape"]["halfspace"] = {"normal": turn.rotation[:, 2].tolist(), "offset": float(turn.rotation[:, 2] @ turn.position)}
+    data["gravity"] = (turn.rotation @ [0, 0, -9.81]).tolist()
+    turned = qs.load_scene(data)
+    plain = qs.load_scene(_box_push_data())
+    expected = sorted(tuple(np.round(turn.apply(c.point), 9)) for c in plain.contacts)
+    assert sorted(tuple(np.round(c.point, 9)) for c in turned.contacts) == expected
+    solution = qs.solve(turned)
+    assert solution.status == "solved" and solution.motion is not None
+    assert np.allclose(solution.motion.twists["box"][:3], turn.rotation @ [0.01, 0, 0], atol=1e-9)
+
+
+def test_a_body_touching_nothing_is_unstable_and_the_message_names_the_gap() -> None:
+    data = _box_push_data()
+    data["bodies"]["box"]["pose"]["position"] = [0.0, 0.0, 0.07]  # 2 cm above the table
+    data["movers"]["finger"]["pose"]["position"] = [-0.1, 0.0, 0.07]
+    solution = qs.solve(qs.load_world(data))  # type: ignore[arg-type]
+    assert solution.status == "unstable"
+    assert "nearest surface" in solution.message and "0.02" in solution.message
+
+
+def test_contacts_json_is_a_plain_scene_that_solves_the_same(tmp_path: Path) -> None:
+    listed = _run("contacts", str(BOX_PUSH), "--json")
+    assert listed.returncode == 0, listed.stderr
+    plain = tmp_path / "plain.json"
+    plain.write_text(listed.stdout, encoding="utf-8")
+    data = json.loads(listed.stdout)
+    assert len(data["contacts"]) == 5 and "shape" not in data["bodies"]["box"]
+    ours = json.loads(_run("solve", str(BOX_PUSH), "--json").stdout)
+    theirs = json.loads(_run("solve", str(plain), "--json").stdout)
+    assert ours["status"] == theirs["status"] == "solved"
+    assert np.allclose(ours["motion"]["twists"]["box"], theirs["motion"]["twists"]["box"])
+
+
+def test_contacts_table_lists_every_contact() -> None:
+    result = _run("contacts", str(BOX_PUSH))
+    assert result.returncode == 0, result.stderr
+    assert "5 contacts found" in result.stdout and result.stdout.count("table") >= 4
+
+
+def test_planar_hand_grasp_has_the_analytic_jacobians() -> None:
+    world = qs.load_world(HAND)
+    assert isinstance(world, qs.World)
+    scene = world.scene()
+    hand = world.robots[0]
+    fingertips = [c for c in scene.contacts if c.other.startswith("hand/")]
+    assert {c.other for c in fingertips} == {"hand/left_tip", "hand/right_tip"}
+    for contact in fingertips:
+        link = contact.other.removeprefix("hand/")
+        assert contact.jacobian is not None
+        assert np.allclose(contact.jacobian, hand.point_jacobian(link, contact.point))
+    solution = qs.solve(scene)
+    assert solution.certified and solution.status in ("solved", "ambiguous")
+
+
+def test_explicit_contacts_are_added_to_the_found_ones() -> None:
+    data = _box_push_data()
+    data["contacts"] = [{"body": "box", "other": "table", "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0], "mu": 0.5}]
+    assert len(qs.load_scene(data).contacts) == 6
+
+
+def test_the_explicit_twin_round_trips_through_the_file_format() -> None:
+    scene = qs.load_scene(BOX_PUSH)
+    again = qs.load_scene(json.loads(json.dumps(scene_to_dict(scene))))
+    _same_answer(qs.solve(scene), qs.solve(again))
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        (lambda d: d["bodies"]["box"]["shape"].update(box=[0.1, -0.1, 0.1]), "bodies.box.shape.box"),
+        (lambda d: d["bodies"]["box"]["shape"].update(sphere=0.1), "bodies.box.shape"),
+        (lambda d: d["bodies"]["box"]["pose"].update(rotation={"quaternion": [1.0, 1.0, 0.0, 0.0]}), "bodies.box.pose.rotation"),
+        (lambda d: d["movers"]["finger"]["shape"].update(sphere=0.0, **{}), "movers.finger.shape.sphere"),
+        (lambda d: d["bodies"]["box"]["shape"].update(box=None, mesh="no/such/part.obj"), "bodies.box.shape.mesh"),
+        (lambda d: d["bodies"]["box"]["shape"].update(boxx=[1, 1, 1]), "bodies.box.shape.boxx"),
+        (lambda d: d.update(robots={"arm": {"urdf": "no/such/arm.urdf"}}), "robots.arm.urdf"),
+        (lambda d: d.update(contact_detection={"margin": -1.0}), "contact_detection.margin"),
+    ],
+)
+def test_bad_geometry_is_one_error_line_naming_the_field(tmp_path: Path, change: Any, field: str) -> None:
+    data = _box_push_data()
+    change(data)
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(data), encoding="utf-8")
+    result = _run("solve", str(path))
+    assert result.returncode == 2, result.stdout + result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and field in lines[0], lines
+
+
+def test_a_missing_robots_extra_says_how_to_install_it(tmp_path: Path) -> None:
+    """With Pinocchio and coal hidden, a scene with shapes is one line naming the extra; a plain scene still solves."""
+    code = "import sys; sys.modules['coal'] = None; sys.modules['pinocchio'] = None; sys.argv = ['quasistatic', *sys.argv[1:]]; "
+    code += "from quasistatic.cli import main; main()"
+    hidden = subprocess.run([sys.executable, "-c", code, "solve", str(BOX_PUSH)], capture_output=True, text=True, timeout=60, check=False)
+    assert hidden.returncode == 2 and hidden.stderr.count("\n") == 1
+    assert "pip install 'quasistatic[robots]'" in hidden.stderr
+    plain = subprocess.run(
+        [sys.executable, "-c", code, "solve", str(EXAMPLES / "squeeze.yaml")], capture_output=True, text=True, timeout=60, check=False
+    )
+    assert plain.returncode == 0, plain.stderr
