@@ -256,40 +256,37 @@ def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margi
     to_b = _unit(patch.getNormal())  # coal's normal points from a to b
     if to_b is None:
         raise SolverError("coal", f"contact patch without a finite normal between {a.owner!r} and {b.owner!r}")
-    points, gaps = [], []
-    for k in range(patch.size()):
-        on_a, on_b = np.asarray(patch.getPointShape1(k)) - shift, np.asarray(patch.getPointShape2(k))
-        gap = float((on_b - on_a) @ to_b)
-        if gap <= margin + PATCH_THICKNESS * size and np.all(np.isfinite(on_a + on_b)):
-            points.append((on_a + on_b) / 2.0)
-            gaps.append(gap)
-    keep = _polygon_vertices(points, DUPLICATE_POINT * size)
+    count = patch.size()
+    on_a = np.array([patch.getPointShape1(k) for k in range(count)], dtype=float).reshape(-1, 3) - shift
+    on_b = np.array([patch.getPointShape2(k) for k in range(count)], dtype=float).reshape(-1, 3)
+    gaps = (on_b - on_a) @ to_b
+    within = (gaps <= margin + PATCH_THICKNESS * size) & np.all(np.isfinite(on_a + on_b), axis=1)
+    points, gaps = ((on_a + on_b) / 2.0)[within], gaps[within]
     normal = -to_b
     normal.setflags(write=False)
-    return [ContactPoint(a.owner, b.owner, _frozen(points[k]), normal, gaps[k]) for k in keep]
+    return [
+        ContactPoint(a.owner, b.owner, _frozen(points[k]), normal, float(gaps[k]))
+        for k in _polygon_vertices(points, DUPLICATE_POINT * size)
+    ]
 
 
-def _polygon_vertices(points: list[FloatArray], tolerance: float) -> list[int]:
-    """Indices of the corners of a polygon given in order: no duplicates, no points along an edge."""
+def _polygon_vertices(points: FloatArray, tolerance: float) -> list[int]:
+    """Indices of the corners of a polygon given in order (k, 3): no duplicates, no points along an edge."""
+    apart = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2) > tolerance
     kept: list[int] = []
-    for k, point in enumerate(points):
-        if all(np.linalg.norm(point - points[m]) > tolerance for m in kept):
+    for k in range(len(points)):
+        if all(apart[k, kept]):
             kept.append(k)
-    k = 0
-    while len(kept) > 2 and k < len(kept):
-        before, here, after = (points[kept[(k + s) % len(kept)]] for s in (-1, 0, 1))
-        if _distance_to_segment(here, before, after) <= tolerance:
-            del kept[k]
-            k = 0  # a removal can make the previous corner an edge point too
-        else:
-            k += 1
+    while len(kept) > 2:  # drop one edge point at a time: a removal can make its neighbour an edge point too
+        ring = points[kept]
+        before, after = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
+        along = after - before
+        t = np.clip(np.einsum("ij,ij->i", ring - before, along) / np.maximum(np.einsum("ij,ij->i", along, along), 1e-300), 0.0, 1.0)
+        on_edge = np.flatnonzero(np.linalg.norm(ring - (before + t[:, None] * along), axis=1) <= tolerance)
+        if not on_edge.size:
+            break
+        del kept[int(on_edge[0])]
     return kept
-
-
-def _distance_to_segment(point: FloatArray, start: FloatArray, end: FloatArray) -> float:
-    along = end - start
-    t = float(np.clip((point - start) @ along / max(float(along @ along), 1e-300), 0.0, 1.0))
-    return float(np.linalg.norm(point - (start + t * along)))
 
 
 # --------------------------------------------------------------------------- coal queries
