@@ -85,6 +85,21 @@ def test_a_box_tilted_about_a_bottom_edge_touches_along_that_edge() -> None:
     assert all(abs(c.gap) < EXACT for c in contacts)
 
 
+def test_a_box_tilted_less_than_the_margin_touches_at_four_corners_with_their_own_gaps() -> None:
+    rise = MARGIN / 2.0  # the far bottom edge, 0.1 away, is this far up
+    tilt = np.arcsin(rise / 0.1)
+    pose = Pose.from_rpy((0, 0, 0), (0.0, tilt, 0.0))
+    edge = np.array([0.05, 0.0, 0.0])
+    box = Collider("box", Box(SIZE), Pose(edge + pose.rotation @ (np.array([0.0, 0.0, 0.15]) - edge), pose.rotation))
+    contacts = detect([box, TABLE], margin=MARGIN)
+    near = [c for c in contacts if c.point[0] > 0.0]
+    far = [c for c in contacts if c.point[0] < 0.0]
+    assert len(near) == len(far) == 2
+    assert all(abs(c.gap) < EXACT for c in near)
+    assert all(c.gap == pytest.approx(rise, abs=EXACT) for c in far)
+    np.testing.assert_allclose([c.point[2] for c in far], rise / 2.0, atol=EXACT)  # midway up the gap
+
+
 def test_a_box_lifted_within_the_margin_is_in_contact_and_beyond_it_is_not() -> None:
     lift = MARGIN / 2.0
     near = detect([Collider("box", Box(SIZE), Pose((0.0, 0.0, 0.15 + lift))), TABLE], margin=MARGIN)

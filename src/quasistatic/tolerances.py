@@ -188,7 +188,8 @@ close to the margin still belongs to the patch (round-off of the normal times th
 
 DUPLICATE_POINT = 1e-6
 """Two contact points of one pair closer than this, relative to the smaller shape's extent, are one point; a
-point this close to the segment between its neighbours is on an edge, not a vertex, of the contact polygon [-].
+point this close to the segment between its neighbours is on an edge, not a vertex, of the contact polygon;
+a line along the normal through a patch corner that misses a shape by less than this still meets it [-].
 """
 
 CURVED_PATCH_POINTS = 8

@@ -10,7 +10,9 @@ Three stages, each a function below:
 3. manifold: the pair is moved apart along that normal (coal's GJK is exact
    for separate shapes where EPA, for overlapping ones, is not), coal's contact
    patch gives the contact polygon, and its vertices are moved back: a box flat
-   on a table gives its 4 corners, a box on an edge 2 points, a sphere 1.
+   on a table gives its 4 corners, a box on an edge 2 points, a sphere 1. Coal
+   puts all of a patch's points at the pair's deepest gap; each vertex's own
+   gap is measured along the normal against the shapes themselves.
 
 Coal's normal can be zero or NaN for deep overlaps (a capsule inside another on
 the same axis); detection then takes the direction of least overlap among the
@@ -259,6 +261,14 @@ def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margi
     count = patch.size()
     on_a = np.array([patch.getPointShape1(k) for k in range(count)], dtype=float).reshape(-1, 3) - shift
     on_b = np.array([patch.getPointShape2(k) for k in range(count)], dtype=float).reshape(-1, 3)
+    # coal puts every patch point on one plane, at the pair's deepest gap: find each one's own
+    # surfaces along the normal, so a face tilted within the margin gets its true gaps.
+    slack = DUPLICATE_POINT * size
+    for k in range(count):
+        mid = (on_a[k] + on_b[k]) / 2.0
+        enter, leave = _along(a, mid, -to_b, slack), _along(b, mid, -to_b, slack)
+        if enter is not None and leave is not None:
+            on_a[k], on_b[k] = mid - enter[0] * to_b, mid - leave[1] * to_b
     gaps = (on_b - on_a) @ to_b
     within = (gaps <= margin + PATCH_THICKNESS * size) & np.all(np.isfinite(on_a + on_b), axis=1)
     points, gaps = ((on_a + on_b) / 2.0)[within], gaps[within]
@@ -287,6 +297,83 @@ def _polygon_vertices(points: FloatArray, tolerance: float) -> list[int]:
             break
         del kept[int(on_edge[0])]
     return kept
+
+
+# --------------------------------------------------------------------------- a shape along a line
+
+
+def _along(collider: Collider, origin: FloatArray, direction: FloatArray, slack: float) -> tuple[float, float] | None:
+    """``(t_in, t_out)``: the line ``origin + t * direction`` (unit, world) is in the shape for t between them.
+
+    None when the line misses the shape by more than ``slack`` [length]. A patch corner lies on an
+    edge, which round-off alone could miss: a line that grazes the shape within ``slack`` still
+    gets the (exact) heights where it passes, so a near miss never shifts a gap.
+    """
+    shape, pose = collider.shape, collider.pose
+    q, u = pose.rotation.T @ (origin - pose.position), pose.rotation.T @ direction
+    if isinstance(shape, Halfspace):
+        return _in_planes(shape.normal[None, :], np.array([shape.offset]), q, u, slack)
+    if isinstance(shape, Box):
+        return _in_planes(np.vstack([np.eye(3), -np.eye(3)]), np.concatenate([shape.size, shape.size]) / 2.0, q, u, slack)
+    if isinstance(shape, Sphere):
+        return _in_ball(q, u, shape.radius, slack)
+    if isinstance(shape, Cylinder):
+        return _in_tube(q, u, shape.radius, shape.length / 2.0, slack)
+    if isinstance(shape, Capsule):
+        ends = (np.array([0.0, 0.0, shape.length / 2.0]), np.array([0.0, 0.0, -shape.length / 2.0]))
+        pieces = [_in_tube(q, u, shape.radius, shape.length / 2.0, slack), *(_in_ball(q - e, u, shape.radius, slack) for e in ends)]
+        hits = [piece for piece in pieces if piece is not None]  # a capsule is their union, and convex: one interval
+        return (min(h[0] for h in hits), max(h[1] for h in hits)) if hits else None
+    normals, offsets = shape.derived("planes", _planes)
+    return _in_planes(normals, offsets, q, u, slack)
+
+
+def _planes(shape: Convex | Mesh) -> tuple[FloatArray, FloatArray]:
+    """Outward unit normals (m, 3) and offsets (m,) of a convex hull's faces: ``normals @ x <= offsets`` inside."""
+    convex = shape.convex if isinstance(shape, Mesh) else shape
+    a, b, c = (convex.vertices[convex.triangles[:, k]] for k in range(3))
+    normals = np.cross(b - a, c - a)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    return normals, np.einsum("ij,ij->i", normals, a)
+
+
+def _in_planes(normals: FloatArray, offsets: FloatArray, q: FloatArray, u: FloatArray, slack: float) -> tuple[float, float] | None:
+    """Where ``q + t u`` satisfies ``normals @ x <= offsets`` (unit normals)."""
+    rate, room = normals @ u, offsets - normals @ q
+    if np.any((rate == 0.0) & (room < -slack)):
+        return None
+    with np.errstate(divide="ignore", invalid="ignore"):  # planes along the line: rate 0, never read below
+        bound = room / rate
+    low = float(np.max(bound[rate < 0.0], initial=-math.inf))
+    high = float(np.min(bound[rate > 0.0], initial=math.inf))
+    return None if low > high + slack else (low, high)
+
+
+def _in_ball(q: FloatArray, u: FloatArray, radius: float, slack: float) -> tuple[float, float] | None:
+    """Where ``q + t u`` (u unit) is within ``radius`` of the origin."""
+    middle = -float(q @ u)
+    room = middle**2 - float(q @ q) + radius**2
+    if room < radius**2 - (radius + slack) ** 2:
+        return None
+    half = math.sqrt(max(room, 0.0))
+    return middle - half, middle + half
+
+
+def _in_tube(q: FloatArray, u: FloatArray, radius: float, half_length: float, slack: float) -> tuple[float, float] | None:
+    """Where ``q + t u`` (u unit) is within ``radius`` of the z axis and ``half_length`` of the xy plane."""
+    slab = _in_planes(np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]), np.array([half_length, half_length]), q, u, slack)
+    across, off_axis = float(u[0] ** 2 + u[1] ** 2), float(q[0] ** 2 + q[1] ** 2)
+    if slab is None or (across == 0.0 and off_axis > (radius + slack) ** 2):
+        return None
+    if across == 0.0:
+        return slab
+    middle = -float(q[0] * u[0] + q[1] * u[1]) / across
+    room = middle**2 - (off_axis - radius**2) / across
+    if room < -((radius + slack) ** 2 - radius**2) / across:
+        return None
+    half = math.sqrt(max(room, 0.0))
+    low, high = max(slab[0], middle - half), min(slab[1], middle + half)
+    return None if low > high + slack else (low, high)
 
 
 # --------------------------------------------------------------------------- coal queries
