@@ -46,6 +46,12 @@ __all__ = [
     "NEWTON_DAMPING",
     "LEAST_SQUARES_STEP",
     "JACOBI_ORTHOGONAL",
+    "ROTATION_ORTHONORMAL",
+    "QUATERNION_NORM",
+    "CONTACT_SEPARATION",
+    "PATCH_THICKNESS",
+    "DUPLICATE_POINT",
+    "CURVED_PATCH_POINTS",
     "MAX_MAGNITUDE",
     "MAX_FRICTION",
     "MAX_PYRAMID_EDGES",
@@ -159,7 +165,39 @@ LEAST_SQUARES_STEP = 1e-15
 JACOBI_ORTHOGONAL = 1e-15
 """Two columns of a one-sided Jacobi SVD are orthogonal when their cosine is below this (working precision) [-]."""
 
-# --------------------------------------------------------------------------- contact detection (shapes and robots)
+# --------------------------------------------------------------------------- geometry and contact detection (adapters/)
+
+ROTATION_ORTHONORMAL = 1e-6
+"""Largest entry of |R^T R - I| a pose's rotation matrix may have [-]; within it R is projected onto the nearest
+rotation. URDF and mesh files print 6 to 9 digits: their matrices are orthonormal to about 1e-7.
+"""
+
+QUATERNION_NORM = 1e-3
+"""|‖q‖ - 1| a pose's quaternion may have before it is rejected [-]; within it q is normalised (as for normals)."""
+
+CONTACT_SEPARATION = 1e-3
+"""How far apart contact detection moves two touching or overlapping shapes before it computes their contact
+patch, relative to the smaller one's extent [-]. coal finds the normal of overlapping polytopes with EPA, off by
+about 1e-6 rad (2.5e-6 measured for a box resting on a box), and that of separate ones with GJK, to round-off
+(1e-13): detection separates them, reads the patch, and moves the first shape's points back.
+"""
+
+PATCH_THICKNESS = 1e-6
+"""Thickness of a contact patch beyond the margin, relative to the smaller shape's extent [-]: a vertex this
+close to the margin still belongs to the patch (round-off of the normal times the shape's size).
+"""
+
+DUPLICATE_POINT = 1e-6
+"""Two contact points of one pair closer than this, relative to the smaller shape's extent, are one point; a
+point this close to the segment between its neighbours is on an edge, not a vertex, of the contact polygon;
+a line along the normal through a patch corner that misses a shape by less than this still meets it [-].
+"""
+
+CURVED_PATCH_POINTS = 8
+"""Vertices of the regular polygon inscribed in a curved flat contact (a cylinder standing on its end face) [-].
+An inscribed polygon keeps the support region inside the true disc, so a stability verdict stays on the
+safe side; its area is 90 % of the disc's at 8 vertices.
+"""
 
 DETECTION_MARGIN = 1e-4
 """Default contact margin, relative to the largest free body's bounding radius [-]: gaps up to it count

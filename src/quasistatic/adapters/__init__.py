@@ -1,7 +1,7 @@
 """Adapters: the user's world (URDF robots, shapes and meshes) turned into a :class:`~quasistatic.model.Scene`.
 
-- ``shapes``: poses and shapes (box, sphere, cylinder, capsule, halfspace, mesh).
-- ``detect``: contacts between placed shapes, through coal (broad phase, contact patches).
+- ``shapes``: poses and collision shapes (box, sphere, cylinder, capsule, halfspace, convex hull, mesh).
+- ``detect``: contact points of placed shapes, found with coal (sweep-and-prune broad phase, contact patches).
 - ``robot``: URDF robots through Pinocchio: forward kinematics, collision geometry, point Jacobians.
 - ``world``: a :class:`World` of shapes and robots, and the Scene it gives at this instant.
 - ``world_file``: a scene file with shapes and robots read into a World.
@@ -19,8 +19,9 @@ Rules:
   field and the value.
 """
 
+from .detect import Collider, ContactPoint, candidate_pairs, detect
 from .robot import ROBOTS_INSTALL_HINT, UrdfRobot
-from .shapes import Box, Capsule, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere
+from .shapes import Box, Capsule, Convex, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere, shape_from_coal
 from .world import ContactDetection, Detection, FrictionPair, ShapedMover, SolidBody, World
 from .world_file import world_from_file
 
@@ -28,7 +29,10 @@ __all__ = [
     "ROBOTS_INSTALL_HINT",
     "Box",
     "Capsule",
+    "Collider",
     "ContactDetection",
+    "ContactPoint",
+    "Convex",
     "Cylinder",
     "Detection",
     "FrictionPair",
@@ -41,5 +45,8 @@ __all__ = [
     "Sphere",
     "UrdfRobot",
     "World",
+    "candidate_pairs",
+    "detect",
+    "shape_from_coal",
     "world_from_file",
 ]

@@ -28,7 +28,7 @@ import numpy.typing as npt
 
 from ..errors import BackendUnavailableError, SceneError
 from ..tolerances import MAX_FILE_BYTES, MAX_MAGNITUDE
-from .shapes import Pose
+from .shapes import Pose, Shape, shape_from_coal
 
 __all__ = ["UrdfRobot", "RobotCollider", "ROBOTS_INSTALL_HINT", "link_owner", "installed_model_folders", "resolve_package_path"]
 
@@ -65,14 +65,11 @@ def link_owner(robot: str, link: str) -> str:
 
 @dataclass(frozen=True)
 class RobotCollider:
-    """One collision geometry of a robot link, placed in the world at the robot's configuration.
-
-    ``geometry`` is the collision library's own object (a coal geometry); only the adapters read it.
-    """
+    """One collision shape of a robot link, placed in the world at the robot's configuration."""
 
     owner: str
     link: str
-    geometry: Any
+    shape: Shape
     pose: Pose
 
 
@@ -105,6 +102,10 @@ class _Kinematics:
         self.geometry_in_joint = np.array([_matrix(item.placement) for item in self.geometry.geometryObjects]).reshape(-1, 4, 4)
         self.geometry_joint = np.array([int(item.parentJoint) for item in self.geometry.geometryObjects], dtype=int)
         self.geometry_link = tuple(self.model.frames[item.parentFrame].name for item in self.geometry.geometryObjects)
+        # Converted once: a Shape keeps the coal geometry built from it, so every configuration reuses it.
+        self.shapes = tuple(
+            shape_from_coal(item.geometry, f"{field}: collision geometry {item.name!r}") for item in self.geometry.geometryObjects
+        )
         self.chain_columns = self._chain_columns()
         joints = [self.model.joints[joint_id] for joint_id in range(1, self.model.njoints)]
         self.plain_dof = np.array([i for i, j in enumerate(joints) if j.nq == 1], dtype=int)
@@ -243,8 +244,8 @@ class UrdfRobot:
             kinematics = self._kinematics
             placed = self._placement.joints[kinematics.geometry_joint] @ kinematics.geometry_in_joint
             self._colliders = tuple(
-                RobotCollider(link_owner(self.name, link), link, item.geometry, _pose(matrix))
-                for link, item, matrix in zip(kinematics.geometry_link, kinematics.geometry.geometryObjects, placed, strict=True)
+                RobotCollider(link_owner(self.name, link), link, shape, _pose(matrix))
+                for link, shape, matrix in zip(kinematics.geometry_link, kinematics.shapes, placed, strict=True)
             )
         return self._colliders
 

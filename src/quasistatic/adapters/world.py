@@ -24,7 +24,7 @@ from ..model import Body, Contact, FrictionModel, Mover, Robot, Scene
 from ..tolerances import DETECTION_MARGIN
 from .detect import Collider, ContactPoint, detect, nearest_gaps
 from .robot import UrdfRobot, link_owner
-from .shapes import Pose, Shape, bounding_radius
+from .shapes import Pose, Shape
 
 __all__ = ["SolidBody", "ShapedMover", "FrictionPair", "ContactDetection", "Detection", "World"]
 
@@ -148,12 +148,12 @@ class World:
 
     def _colliders(self) -> list[Collider]:
         shaped = [Collider(p.name, p.shape, p.pose) for p in (*self.bodies, *self.movers) if p.shape is not None]
-        return shaped + [Collider(c.owner, c.geometry, c.pose) for r in self.robots for c in r.colliders]
+        return shaped + [Collider(c.owner, c.shape, c.pose) for r in self.robots for c in r.colliders]
 
     def _margin(self) -> float:
         if self.detection.margin is not None:
             return self.detection.margin
-        sizes = [bounding_radius(b.shape) for b in self.bodies if b.shape is not None]
+        sizes = [b.shape.extent for b in self.bodies if b.shape is not None]
         return DETECTION_MARGIN * max(sizes, default=1.0)
 
     def _may_touch(self, first: str, second: str) -> bool:

@@ -1,0 +1,523 @@
+"""Contact detection with coal: the contact points of placed shapes, as exact contact polygons.
+
+Three stages, each a function below:
+
+1. broad phase (:func:`candidate_pairs`): a sweep over axis-aligned bounding
+   boxes grown by the margin, so the work grows with the pairs that are near,
+   not with all pairs;
+2. narrow phase: ``coal.collide`` with the margin as security margin says
+   whether a pair is within reach, and roughly along which normal;
+3. manifold: the pair is moved apart along that normal (coal's GJK is exact
+   for separate shapes where EPA, for overlapping ones, is not), coal's contact
+   patch gives the contact polygon, and its vertices are moved back: a box flat
+   on a table gives its 4 corners, a box on an edge 2 points, a sphere 1. Coal
+   puts all of a patch's points at the pair's deepest gap; each vertex's own
+   gap is measured along the normal against the shapes themselves.
+
+Coal's normal can be zero or NaN for deep overlaps (a capsule inside another on
+the same axis); detection then takes the direction of least overlap among the
+shapes' axes and the line between their centres, and never passes NaN on.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import SceneError, SolverError
+from ..tolerances import CONTACT_SEPARATION, CURVED_PATCH_POINTS, DUPLICATE_POINT, NORMAL_LENGTH, PATCH_THICKNESS
+from ._coal import import_coal
+from .shapes import Box, Capsule, Convex, Cylinder, FloatArray, Halfspace, Mesh, Pose, Shape, Sphere, shape_from_coal
+
+__all__ = ["Collider", "ContactPoint", "candidate_pairs", "detect", "nearest_gaps"]
+
+
+@dataclass(frozen=True, init=False)
+class Collider:
+    """One collision shape placed in the world.
+
+    Attributes
+    ----------
+    owner : str
+        The body, mover or robot link it belongs to; colliders of one owner never touch each other.
+    shape : Shape
+        Its shape. A coal geometry (a Pinocchio ``GeometryObject.geometry``) is converted
+        with :func:`~quasistatic.adapters.shapes.shape_from_coal`; convert it once yourself
+        to reuse the coal geometry built from it across poses.
+    pose : Pose
+        World pose of the shape's frame.
+    """
+
+    owner: str
+    shape: Shape
+    pose: Pose
+
+    def __init__(self, owner: str, shape: Shape | object, pose: Pose | None = None, field: str = "colliders") -> None:
+        if not isinstance(owner, str) or not owner:
+            raise SceneError(f"{field}.owner", owner, "expected a non-empty name")
+        if pose is not None and not isinstance(pose, Pose):
+            raise SceneError(f"{field}.pose", pose, "expected a Pose")
+        placed = shape if isinstance(shape, Shape) else shape_from_coal(shape, f"{field}.shape")
+        object.__setattr__(self, "owner", owner)
+        object.__setattr__(self, "shape", placed)
+        object.__setattr__(self, "pose", Pose() if pose is None else pose)
+
+
+@dataclass(frozen=True)
+class ContactPoint:
+    """One point of contact between two colliders' owners.
+
+    Attributes
+    ----------
+    first, second : str
+        The owners; ``first`` is the one whose collider comes first in the input.
+    point : array (3,)
+        World point on the contact surface: the midpoint of the two shapes' witness points [length].
+    normal : array (3,)
+        Unit normal, from ``second`` into ``first``.
+    gap : float
+        Signed distance along ``normal`` [length]: > 0 apart (within the margin), < 0 overlapping.
+    """
+
+    first: str
+    second: str
+    point: FloatArray
+    normal: FloatArray
+    gap: float
+
+    def flipped(self) -> ContactPoint:
+        """The same contact seen from ``second``: owners swapped, normal reversed."""
+        return ContactPoint(self.second, self.first, self.point, -self.normal, self.gap)
+
+
+# --------------------------------------------------------------------------- broad phase
+
+
+def candidate_pairs(colliders: Sequence[Collider], margin: float = 0.0) -> list[tuple[int, int]]:
+    """Pairs ``(i, j)``, ``i < j``, of colliders whose bounding boxes come within ``margin``.
+
+    A sweep along the axis where the boxes are most spread out: each box is
+    compared only with those that overlap it along that axis, so ``n`` objects
+    spread over a table cost about ``n log n``, not ``n^2``. A halfspace is
+    unbounded and pairs with every collider.
+
+    Parameters
+    ----------
+    colliders : sequence of Collider
+    margin : float
+        Distance within which two shapes count as near [length], >= 0.
+
+    Returns
+    -------
+    list of (int, int)
+        Sorted indices into ``colliders``.
+    """
+    margin = _margin(margin)
+    if len(colliders) < 2:
+        return []
+    bounds = np.array([_bounds(c) for c in colliders])  # (n, 2, 3): lower and upper corners
+    low, high = bounds[:, 0] - margin / 2.0, bounds[:, 1] + margin / 2.0
+    axis = _sweep_axis(low, high)
+    order = np.argsort(low[:, axis], kind="stable")
+    starts = low[order, axis]
+    pairs = []
+    for rank, i in enumerate(order):
+        stop = int(np.searchsorted(starts, high[i, axis], side="right"))
+        others = order[rank + 1 : stop]
+        near = np.all((low[others] <= high[i]) & (low[i] <= high[others]), axis=1)
+        pairs += [(min(int(i), int(j)), max(int(i), int(j))) for j in others[near]]
+    return sorted(pairs)
+
+
+def _sweep_axis(low: FloatArray, high: FloatArray) -> int:
+    """The axis along which the bounded boxes' centres spread most (unbounded ones overlap everything anyway)."""
+    bounded = np.all(np.isfinite(low) & np.isfinite(high), axis=1)
+    if np.count_nonzero(bounded) < 2:
+        return 0
+    centres = (low[bounded] + high[bounded]) / 2.0
+    return int(np.argmax(np.var(centres, axis=0)))
+
+
+def _bounds(collider: Collider) -> tuple[FloatArray, FloatArray]:
+    """World axis-aligned bounding box (lower, upper corner) of a collider [length]."""
+    if isinstance(collider.shape, Halfspace):
+        return np.full(3, -math.inf), np.full(3, math.inf)
+    centre, half = _local_box(collider.shape)
+    rotation = collider.pose.rotation
+    world_centre = rotation @ centre + collider.pose.position
+    world_half = np.abs(rotation) @ half
+    return world_centre - world_half, world_centre + world_half
+
+
+def _local_box(shape: Shape) -> tuple[FloatArray, FloatArray]:
+    """Centre and half extents of a bounded shape's box in its own frame [length]."""
+    if isinstance(shape, Mesh):
+        shape = shape.convex
+    if isinstance(shape, Box):
+        return np.zeros(3), shape.size / 2.0
+    if isinstance(shape, Sphere):
+        return np.zeros(3), np.full(3, shape.radius)
+    if isinstance(shape, Cylinder):
+        return np.zeros(3), np.array([shape.radius, shape.radius, shape.length / 2.0])
+    if isinstance(shape, Capsule):
+        return np.zeros(3), np.array([shape.radius, shape.radius, shape.length / 2.0 + shape.radius])
+    assert isinstance(shape, Convex)  # a halfspace has no box; the callers handle it
+    low, high = shape.vertices.min(axis=0), shape.vertices.max(axis=0)
+    return (low + high) / 2.0, (high - low) / 2.0
+
+
+# --------------------------------------------------------------------------- detection
+
+
+def detect(
+    colliders: Sequence[Collider],
+    pairs: Callable[[str, str], bool] | None = None,
+    margin: float = 0.0,
+) -> list[ContactPoint]:
+    """Every contact point between the colliders, within ``margin``.
+
+    Parameters
+    ----------
+    colliders : sequence of Collider
+        The placed shapes; a pair's ``first`` owner is the one listed first.
+    pairs : callable (owner, owner) -> bool, optional
+        Whether two owners may touch (e.g. not two links of one robot); called with
+        the owners in input order. All pairs of different owners when omitted.
+    margin : float
+        Distance within which separate shapes are in contact [length], >= 0: points
+        with ``gap <= margin`` are reported.
+
+    Returns
+    -------
+    list of ContactPoint
+        Sorted by owners, then by point: the same scene gives the same list.
+        Each pair contributes the vertices of its contact polygon, without duplicates.
+
+    Raises
+    ------
+    SceneError
+        On a negative or non-finite margin.
+    BackendUnavailableError
+        When coal is not installed.
+    SolverError
+        When coal returns no finite normal even for shapes moved apart.
+    """
+    coal = import_coal()
+    margin = _margin(margin)
+    found: list[ContactPoint] = []
+    for i, j in candidate_pairs(colliders, margin):
+        a, b = colliders[i], colliders[j]
+        if a.owner == b.owner or (pairs is not None and not pairs(a.owner, b.owner)):
+            continue
+        if isinstance(a.shape, Halfspace) and isinstance(b.shape, Halfspace):
+            continue  # two unbounded shapes: environment against environment, no contact polygon
+        found += _pair_contacts(coal, a, b, margin)
+    return sorted(found, key=lambda c: (c.first, c.second, tuple(c.point)))
+
+
+def nearest_gaps(
+    colliders: Sequence[Collider], owners: Sequence[str], pairs: Callable[[str, str], bool] | None = None
+) -> dict[str, tuple[str, float]]:
+    """For each of ``owners``, the nearest other owner it may touch and the distance to it [length].
+
+    What a user needs when a body touches nothing: how far it is from the surface it was meant
+    to rest on. ``("", inf)`` when no other collider may touch it. One distance query per
+    collider pair of the owner: call it for the few owners with no contact, not for all.
+    """
+    coal = import_coal()
+    result: dict[str, tuple[str, float]] = {}
+    for owner in owners:
+        best = ("", math.inf)
+        for mine in (c for c in colliders if c.owner == owner):
+            for other in colliders:
+                if other.owner == owner or (pairs is not None and not pairs(owner, other.owner)):
+                    continue
+                gap = _distance(coal, mine, other)
+                if gap < best[1]:
+                    best = (other.owner, gap)
+        result[owner] = best
+    return result
+
+
+def _distance(coal: Any, a: Collider, b: Collider) -> float:
+    """Signed distance between two placed shapes (negative when they overlap)."""
+    request, outcome = coal.DistanceRequest(), coal.DistanceResult()
+    ga, gb = _geometry(coal, a.shape), _geometry(coal, b.shape)
+    return float(coal.distance(ga, _transform(coal, a.pose), gb, _transform(coal, b.pose), request, outcome))
+
+
+def _margin(value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise SceneError("margin", value, "expected a number")
+    if not math.isfinite(float(value)) or value < 0:
+        raise SceneError("margin", value, "must be a finite distance >= 0")
+    return float(value)
+
+
+def _pair_contacts(coal: Any, a: Collider, b: Collider, margin: float) -> list[ContactPoint]:
+    """The contact polygon of one pair within ``margin``, as ContactPoints from ``b`` into ``a``."""
+    size = min(a.shape.extent, b.shape.extent)
+    ga, gb = _geometry(coal, a.shape), _geometry(coal, b.shape)
+    tb = _transform(coal, b.pose)
+    rough = _collide(coal, ga, _transform(coal, a.pose), gb, tb, margin)
+    if rough is None:
+        return []
+    direction, gap = rough
+    if direction is None:
+        direction, gap = _least_overlap(a, b)
+    # Move a away from b until they are apart by CONTACT_SEPARATION * size: GJK then gives the exact normal.
+    shift = max(0.0, CONTACT_SEPARATION * size - gap)
+    moved = _transform(coal, a.pose, direction * shift)
+    result = coal.CollisionResult()
+    request = _request(coal, margin + 2.0 * shift)
+    coal.collide(ga, moved, gb, tb, request, result)
+    if not result.isCollision() or _unit(result.getContact(0).normal) is None:
+        raise SolverError("coal", f"no finite contact normal between {a.owner!r} and {b.owner!r}, even moved apart")
+    thickness = max(margin - gap, 0.0) + PATCH_THICKNESS * size
+    patch_request = coal.ContactPatchRequest(1, CURVED_PATCH_POINTS, thickness)
+    patches = coal.ContactPatchResult(patch_request)
+    coal.computeContactPatch(ga, moved, gb, tb, result, patch_request, patches)
+    return _patch_points(a, b, patches.getContactPatch(0), direction * shift, margin, size)
+
+
+def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margin: float, size: float) -> list[ContactPoint]:
+    """The patch's vertices within the margin, ``a``'s witness points moved back by ``shift``."""
+    to_b = _unit(patch.getNormal())  # coal's normal points from a to b
+    if to_b is None:
+        raise SolverError("coal", f"contact patch without a finite normal between {a.owner!r} and {b.owner!r}")
+    count = patch.size()
+    on_a = np.array([patch.getPointShape1(k) for k in range(count)], dtype=float).reshape(-1, 3) - shift
+    on_b = np.array([patch.getPointShape2(k) for k in range(count)], dtype=float).reshape(-1, 3)
+    # coal puts every patch point on one plane, at the pair's deepest gap: find each one's own
+    # surfaces along the normal, so a face tilted within the margin gets its true gaps.
+    slack = DUPLICATE_POINT * size
+    for k in range(count):
+        mid = (on_a[k] + on_b[k]) / 2.0
+        enter, leave = _along(a, mid, -to_b, slack), _along(b, mid, -to_b, slack)
+        if enter is not None and leave is not None:
+            on_a[k], on_b[k] = mid - enter[0] * to_b, mid - leave[1] * to_b
+    gaps = (on_b - on_a) @ to_b
+    within = (gaps <= margin + PATCH_THICKNESS * size) & np.all(np.isfinite(on_a + on_b), axis=1)
+    points, gaps = ((on_a + on_b) / 2.0)[within], gaps[within]
+    normal = -to_b
+    normal.setflags(write=False)
+    return [
+        ContactPoint(a.owner, b.owner, _frozen(points[k]), normal, float(gaps[k]))
+        for k in _polygon_vertices(points, DUPLICATE_POINT * size)
+    ]
+
+
+def _polygon_vertices(points: FloatArray, tolerance: float) -> list[int]:
+    """Indices of the corners of a polygon given in order (k, 3): no duplicates, no points along an edge."""
+    apart = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2) > tolerance
+    kept: list[int] = []
+    for k in range(len(points)):
+        if all(apart[k, kept]):
+            kept.append(k)
+    while len(kept) > 2:  # drop one edge point at a time: a removal can make its neighbour an edge point too
+        ring = points[kept]
+        before, after = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
+        along = after - before
+        t = np.clip(np.einsum("ij,ij->i", ring - before, along) / np.maximum(np.einsum("ij,ij->i", along, along), 1e-300), 0.0, 1.0)
+        on_edge = np.flatnonzero(np.linalg.norm(ring - (before + t[:, None] * along), axis=1) <= tolerance)
+        if not on_edge.size:
+            break
+        del kept[int(on_edge[0])]
+    return kept
+
+
+# --------------------------------------------------------------------------- a shape along a line
+
+
+def _along(collider: Collider, origin: FloatArray, direction: FloatArray, slack: float) -> tuple[float, float] | None:
+    """``(t_in, t_out)``: the line ``origin + t * direction`` (unit, world) is in the shape for t between them.
+
+    None when the line misses the shape by more than ``slack`` [length]. A patch corner lies on an
+    edge, which round-off alone could miss: a line that grazes the shape within ``slack`` still
+    gets the (exact) heights where it passes, so a near miss never shifts a gap.
+    """
+    shape, pose = collider.shape, collider.pose
+    q, u = pose.rotation.T @ (origin - pose.position), pose.rotation.T @ direction
+    if isinstance(shape, Halfspace):
+        return _in_planes(shape.normal[None, :], np.array([shape.offset]), q, u, slack)
+    if isinstance(shape, Box):
+        return _in_planes(np.vstack([np.eye(3), -np.eye(3)]), np.concatenate([shape.size, shape.size]) / 2.0, q, u, slack)
+    if isinstance(shape, Sphere):
+        return _in_ball(q, u, shape.radius, slack)
+    if isinstance(shape, Cylinder):
+        return _in_tube(q, u, shape.radius, shape.length / 2.0, slack)
+    if isinstance(shape, Capsule):
+        ends = (np.array([0.0, 0.0, shape.length / 2.0]), np.array([0.0, 0.0, -shape.length / 2.0]))
+        pieces = [_in_tube(q, u, shape.radius, shape.length / 2.0, slack), *(_in_ball(q - e, u, shape.radius, slack) for e in ends)]
+        hits = [piece for piece in pieces if piece is not None]  # a capsule is their union, and convex: one interval
+        return (min(h[0] for h in hits), max(h[1] for h in hits)) if hits else None
+    normals, offsets = shape.derived("planes", _planes)
+    return _in_planes(normals, offsets, q, u, slack)
+
+
+def _planes(shape: Convex | Mesh) -> tuple[FloatArray, FloatArray]:
+    """Outward unit normals (m, 3) and offsets (m,) of a convex hull's faces: ``normals @ x <= offsets`` inside."""
+    convex = shape.convex if isinstance(shape, Mesh) else shape
+    a, b, c = (convex.vertices[convex.triangles[:, k]] for k in range(3))
+    normals = np.cross(b - a, c - a)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    return normals, np.einsum("ij,ij->i", normals, a)
+
+
+def _in_planes(normals: FloatArray, offsets: FloatArray, q: FloatArray, u: FloatArray, slack: float) -> tuple[float, float] | None:
+    """Where ``q + t u`` satisfies ``normals @ x <= offsets`` (unit normals)."""
+    rate, room = normals @ u, offsets - normals @ q
+    if np.any((rate == 0.0) & (room < -slack)):
+        return None
+    with np.errstate(divide="ignore", invalid="ignore"):  # planes along the line: rate 0, never read below
+        bound = room / rate
+    low = float(np.max(bound[rate < 0.0], initial=-math.inf))
+    high = float(np.min(bound[rate > 0.0], initial=math.inf))
+    return None if low > high + slack else (low, high)
+
+
+def _in_ball(q: FloatArray, u: FloatArray, radius: float, slack: float) -> tuple[float, float] | None:
+    """Where ``q + t u`` (u unit) is within ``radius`` of the origin."""
+    middle = -float(q @ u)
+    room = middle**2 - float(q @ q) + radius**2
+    if room < radius**2 - (radius + slack) ** 2:
+        return None
+    half = math.sqrt(max(room, 0.0))
+    return middle - half, middle + half
+
+
+def _in_tube(q: FloatArray, u: FloatArray, radius: float, half_length: float, slack: float) -> tuple[float, float] | None:
+    """Where ``q + t u`` (u unit) is within ``radius`` of the z axis and ``half_length`` of the xy plane."""
+    slab = _in_planes(np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]), np.array([half_length, half_length]), q, u, slack)
+    across, off_axis = float(u[0] ** 2 + u[1] ** 2), float(q[0] ** 2 + q[1] ** 2)
+    if slab is None or (across == 0.0 and off_axis > (radius + slack) ** 2):
+        return None
+    if across == 0.0:
+        return slab
+    middle = -float(q[0] * u[0] + q[1] * u[1]) / across
+    room = middle**2 - (off_axis - radius**2) / across
+    if room < -((radius + slack) ** 2 - radius**2) / across:
+        return None
+    half = math.sqrt(max(room, 0.0))
+    low, high = max(slab[0], middle - half), min(slab[1], middle + half)
+    return None if low > high + slack else (low, high)
+
+
+# --------------------------------------------------------------------------- coal queries
+
+
+def _request(coal: Any, margin: float) -> Any:
+    request = coal.CollisionRequest()
+    request.security_margin = margin
+    request.num_max_contacts = 1
+    return request
+
+
+def _collide(coal: Any, ga: Any, ta: Any, gb: Any, tb: Any, margin: float) -> tuple[FloatArray | None, float] | None:
+    """``(direction from b into a or None if coal's is not a unit vector, signed distance)``, or None when apart."""
+    result = coal.CollisionResult()
+    coal.collide(ga, ta, gb, tb, _request(coal, margin), result)
+    if not result.isCollision():
+        return None
+    contact = result.getContact(0)
+    to_b = _unit(contact.normal)
+    return (None if to_b is None else -to_b), float(contact.penetration_depth)  # coal 3: signed distance
+
+
+def _unit(vector: Any) -> FloatArray | None:
+    """``vector`` as a float array if it is a finite unit vector (within :data:`NORMAL_LENGTH`), else None."""
+    array = np.array(vector, dtype=float)
+    if not np.all(np.isfinite(array)) or abs(float(np.linalg.norm(array)) - 1.0) > NORMAL_LENGTH:
+        return None
+    return array / np.linalg.norm(array)
+
+
+def _transform(coal: Any, pose: Pose, shift: FloatArray | None = None) -> Any:
+    position = pose.position if shift is None else pose.position + shift
+    return coal.Transform3s(np.array(pose.rotation), np.array(position))
+
+
+def _geometry(coal: Any, shape: Shape) -> Any:
+    """The coal geometry of a shape, built once and kept with the shape."""
+    return shape.derived("coal", lambda s: _build_geometry(coal, s))
+
+
+def _build_geometry(coal: Any, shape: Shape) -> Any:
+    if isinstance(shape, Box):
+        return coal.Box(*shape.size)
+    if isinstance(shape, Sphere):
+        return coal.Sphere(shape.radius)
+    if isinstance(shape, Cylinder):
+        return coal.Cylinder(shape.radius, shape.length)
+    if isinstance(shape, Capsule):
+        return coal.Capsule(shape.radius, shape.length)
+    if isinstance(shape, Halfspace):
+        return coal.Halfspace(np.array(shape.normal), shape.offset)
+    convex = shape.convex if isinstance(shape, Mesh) else shape
+    model = coal.BVHModelOBBRSS()
+    model.beginModel(len(convex.triangles), len(convex.vertices))
+    model.addVertices(np.array(convex.vertices))
+    model.addTriangles(np.array(convex.triangles))
+    model.endModel()
+    model.buildConvexRepresentation(False)  # the hull is convex already: no qhull needed
+    return model.convex
+
+
+# --------------------------------------------------------------------------- fallback normal
+
+
+def _least_overlap(a: Collider, b: Collider) -> tuple[FloatArray, float]:
+    """Direction from ``b`` into ``a`` of least overlap, and the signed distance along it [length].
+
+    Candidates: a halfspace's normal if there is one; else the shapes' own axes
+    (both signs) and the line between their centres. The overlap along ``d`` is
+    ``h_b(d) + h_a(-d)`` with ``h`` the support function: how far ``a`` must move
+    along ``d`` to clear ``b``.
+    """
+    if isinstance(b.shape, Halfspace):
+        candidates = [b.pose.rotation @ b.shape.normal]
+    elif isinstance(a.shape, Halfspace):
+        candidates = [-(a.pose.rotation @ a.shape.normal)]
+    else:
+        axes = np.hstack([a.pose.rotation, b.pose.rotation]).T
+        line = _centre(a) - _centre(b)
+        length = float(np.linalg.norm(line))
+        candidates = ([line / length] if length > 0.0 else []) + [s * axis for axis in axes for s in (1.0, -1.0)]
+    overlaps = [_support(b, d) + _support(a, -d) for d in candidates]
+    best = int(np.argmin(overlaps))
+    return np.asarray(candidates[best], dtype=float), -float(overlaps[best])
+
+
+def _centre(collider: Collider) -> FloatArray:
+    centre, _ = _local_box(collider.shape)
+    return collider.pose.rotation @ centre + collider.pose.position
+
+
+def _support(collider: Collider, direction: FloatArray) -> float:
+    """``max over the shape of direction @ x`` (world) [length]; for a halfspace, only along its normal."""
+    shape, pose = collider.shape, collider.pose
+    u = pose.rotation.T @ direction
+    base = float(pose.position @ direction)
+    if isinstance(shape, Halfspace):
+        return base + shape.offset * float(u @ shape.normal)  # only evaluated with u along the normal
+    if isinstance(shape, Mesh):
+        shape = shape.convex
+    if isinstance(shape, Box):
+        return base + float(np.abs(u) @ shape.size) / 2.0
+    if isinstance(shape, Sphere):
+        return base + shape.radius * float(np.linalg.norm(u))
+    if isinstance(shape, Cylinder):
+        return base + shape.radius * float(np.hypot(u[0], u[1])) + shape.length / 2.0 * abs(float(u[2]))
+    if isinstance(shape, Capsule):
+        return base + shape.radius * float(np.linalg.norm(u)) + shape.length / 2.0 * abs(float(u[2]))
+    return base + float(np.max(shape.vertices @ u))
+
+
+def _frozen(array: FloatArray) -> FloatArray:
+    out = np.array(array, dtype=float)
+    out.setflags(write=False)
+    return out
