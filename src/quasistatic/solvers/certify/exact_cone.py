@@ -54,7 +54,7 @@ from .min_power import solve_min_power
 from .search import enumerate_motions, summarise
 from .wedge import exact_cones_jam
 
-__all__ = ["solve_exact_3d", "SEARCH_EDGES"]
+__all__ = ["solve_exact_3d", "unique_exact_motion", "SEARCH_EDGES"]
 
 SEARCH_EDGES = 8  # pyramid edges of the first certified search
 VERDICT_EDGES = 256  # polygons tried when the searched ones cannot decide between unstable and at rest
@@ -62,12 +62,16 @@ WIDER_SEARCH_EDGES = 32  # the most edges the mixed-integer search is run with (
 RANGE_EDGES = 64  # polygon used for force ranges at rolling contacts (inner, within 0.12 %)
 
 
-def solve_exact_3d(problem: Problem, options: Options) -> BackendResult:
-    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided."""
+def solve_exact_3d(problem: Problem, options: Options, seed: np.ndarray | None = None) -> BackendResult:
+    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided.
+
+    ``seed``: a point satisfying every law of the 8-edge pyramid's form (checked by the caller),
+    taken as that search's first motion.
+    """
     options = options.start_clock()
     undecided, relaxed = "", False
     for count in (SEARCH_EDGES, WIDER_SEARCH_EDGES):
-        result, undecided = _search(problem, options, count)
+        result, undecided = _search(problem, options, count, seed if count == SEARCH_EDGES else None)
         if result is not None:
             return result
         if undecided in ("wedged", "modes") and not relaxed:  # the pyramid has no motion: try to prove it for the circle
@@ -106,7 +110,7 @@ def _is_exact_motion(problem: Problem, q: np.ndarray) -> bool:
     return _forces_at(problem, q, ModeMasks.of(problem, contact_modes(problem, q))) is not None
 
 
-def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResult | None, str]:
+def _search(problem: Problem, options: Options, count: int, seed: np.ndarray | None = None) -> tuple[BackendResult | None, str]:
     """Motions of a ``count``-edge pyramid refined to the exact cone, or None and why the pyramid cannot decide.
 
     Undecided: ``refinement`` (a pyramid motion has no exact motion next to
@@ -115,7 +119,7 @@ def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResu
     (equilibrium exists in the circumscribed pyramid but not the inscribed one).
     """
     edges = aligned_edges(problem, count)
-    motions, complete = enumerate_motions(polyhedral_form(problem, edges), options)
+    motions, complete = enumerate_motions(polyhedral_form(problem, edges), options, seed)
     if motions:
         result = _refined_result(problem, motions, complete, options, count)
         return result, "" if result is not None else "refinement"
@@ -200,6 +204,13 @@ def _summary(problem: Problem, motions: list[RawMotion], complete: bool, options
     if len(motions) == 1 and not motions[0].continuum and complete:
         return _unique_for_the_pyramid(summarise(range_form, motions, True, options)).with_notes(exact_cone=note)
     return summarise(range_form, motions, False, options).with_notes(exact_cone=note)
+
+
+def unique_exact_motion(problem: Problem, motion: RawMotion, options: Options, proof: str) -> BackendResult:
+    """``solved``, certified, for a motion of the exact laws that ``proof`` shows is the only one (force ranges as usual)."""
+    range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motion.q)))
+    result = summarise(range_form, [motion], True, options)
+    return dataclasses.replace(result, message=f"{result.message}; unique for the exact cones: {proof}").with_notes(exact_cone=proof)
 
 
 def _unique_for_the_pyramid(result: BackendResult) -> BackendResult:
