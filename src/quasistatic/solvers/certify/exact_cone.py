@@ -62,16 +62,12 @@ WIDER_SEARCH_EDGES = 32  # the most edges the mixed-integer search is run with (
 RANGE_EDGES = 64  # polygon used for force ranges at rolling contacts (inner, within 0.12 %)
 
 
-def solve_exact_3d(problem: Problem, options: Options, seed: np.ndarray | None = None) -> BackendResult:
-    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided.
-
-    ``seed``: a point satisfying every law of the 8-edge pyramid's form (checked by the caller),
-    taken as that search's first motion.
-    """
+def solve_exact_3d(problem: Problem, options: Options) -> BackendResult:
+    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided."""
     options = options.start_clock()
     undecided, relaxed = "", False
     for count in (SEARCH_EDGES, WIDER_SEARCH_EDGES):
-        result, undecided = _search(problem, options, count, seed if count == SEARCH_EDGES else None)
+        result, undecided = _search(problem, options, count)
         if result is not None:
             return result
         if undecided in ("wedged", "modes") and not relaxed:  # the pyramid has no motion: try to prove it for the circle
@@ -110,7 +106,7 @@ def _is_exact_motion(problem: Problem, q: np.ndarray) -> bool:
     return _forces_at(problem, q, ModeMasks.of(problem, contact_modes(problem, q))) is not None
 
 
-def _search(problem: Problem, options: Options, count: int, seed: np.ndarray | None = None) -> tuple[BackendResult | None, str]:
+def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResult | None, str]:
     """Motions of a ``count``-edge pyramid refined to the exact cone, or None and why the pyramid cannot decide.
 
     Undecided: ``refinement`` (a pyramid motion has no exact motion next to
@@ -119,7 +115,7 @@ def _search(problem: Problem, options: Options, count: int, seed: np.ndarray | N
     (equilibrium exists in the circumscribed pyramid but not the inscribed one).
     """
     edges = aligned_edges(problem, count)
-    motions, complete = enumerate_motions(polyhedral_form(problem, edges), options, seed)
+    motions, complete = enumerate_motions(polyhedral_form(problem, edges), options)
     if motions:
         result = _refined_result(problem, motions, complete, options, count)
         return result, "" if result is not None else "refinement"
