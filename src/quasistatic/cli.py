@@ -87,7 +87,7 @@ def solve_command(
         _fail(f"--time-limit must be a positive number of seconds (got {time_limit})")
     scene, detection = _loaded(scene_file)
     prescribed = _guarded(lambda: _parse_modes(modes)) if modes is not None else None
-    certify = all_solutions and method in ("auto", "scip")
+    certify = all_solutions and method in ("auto", "scip", "certified")
     with _StatusLine(enabled=not as_json) as status:
         solution = _guarded(
             lambda: solve(

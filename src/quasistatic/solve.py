@@ -49,9 +49,10 @@ def solve(
         then says when a body touches nothing, and how far the nearest surface is).
     method : str
         ``auto`` (default) or a backend name from :data:`METHODS`. ``auto``
-        solves frictionless scenes by LP and frictional ones by the certified
-        search (or, with ``certify=False``, by the fast path first, falling
-        back to the certified search when it finds no audited motion).
+        solves frictionless scenes by LP and frictional ones by ``certified``
+        (cheap certificates, then the certified search; ``scip`` with
+        prescribed modes) or, with ``certify=False``, by the fast path first,
+        falling back to the certified search when it finds no audited motion.
     certify : bool
         True (default): ``solved`` means proven unique and ``ambiguous`` lists
         every motion. False: with ``method="auto"``, accept the first audited
@@ -105,8 +106,11 @@ def solve(
                 f"method {name!r} is frictionless but contacts {_frictional(problem)} have mu > 0; "
                 "use method 'auto', or set 'friction: none' to drop friction on purpose"
             )
-        solution = _audited(problem, _run(backend, problem, options), name, tolerance, options, tuple(tried), started)
-        if solution.ok or name == names[-1]:
+        result = _run(backend, problem, options)
+        solution = _audited(problem, result, name, tolerance, options, tuple(tried), started)
+        # A certifying method's verdict stands unless the audit turned its motion down; the fast path's only when solved.
+        rejected = solution.status == "failed" and result.status != "failed"
+        if name == names[-1] or (not rejected if backend.certifies else solution.ok):
             return solution
         tried.append(Attempt(name, solution.message))
     raise AssertionError("unreachable: the last method always returns")
@@ -141,8 +145,10 @@ def _choose(method: str, problem: Problem, modes_given: bool, certify: bool, ins
         return (method,)
     if problem.is_frictionless and not modes_given:
         return ("lp",)
-    if modes_given or certify:
+    if modes_given:
         return ("scip",)
+    if certify:
+        return ("certified", "scip")  # scip only if the audit rejects a cheap certificate's motion
     return ("fast", "scip")
 
 

@@ -103,6 +103,17 @@ BACKENDS: dict[str, Backend] = {
             install_hint="pip install pyscipopt",
         ),
         Backend(
+            "certified",
+            ".certified",
+            "solve_cheap_certified",
+            "certified, as scip, cheap certificates first: Lemke's motion proven unique by kinematics, "
+            "else the SCIP search started from it (the default for frictional scenes)",
+            lists_all_motions=True,
+            prescribes_modes=True,
+            requires="pyscipopt",
+            install_hint="pip install pyscipopt",
+        ),
+        Backend(
             "paper",
             ".paper",
             "solve_paper",

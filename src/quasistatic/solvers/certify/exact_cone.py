@@ -54,7 +54,7 @@ from .min_power import solve_min_power
 from .search import enumerate_motions, summarise
 from .wedge import exact_cones_jam
 
-__all__ = ["solve_exact_3d", "SEARCH_EDGES"]
+__all__ = ["solve_exact_3d", "unique_exact_motion", "SEARCH_EDGES"]
 
 SEARCH_EDGES = 8  # pyramid edges of the first certified search
 VERDICT_EDGES = 256  # polygons tried when the searched ones cannot decide between unstable and at rest
@@ -200,6 +200,13 @@ def _summary(problem: Problem, motions: list[RawMotion], complete: bool, options
     if len(motions) == 1 and not motions[0].continuum and complete:
         return _unique_for_the_pyramid(summarise(range_form, motions, True, options)).with_notes(exact_cone=note)
     return summarise(range_form, motions, False, options).with_notes(exact_cone=note)
+
+
+def unique_exact_motion(problem: Problem, motion: RawMotion, options: Options, proof: str) -> BackendResult:
+    """``solved``, certified, for a motion of the exact laws that ``proof`` shows is the only one (force ranges as usual)."""
+    range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motion.q)))
+    result = summarise(range_form, [motion], True, options)
+    return dataclasses.replace(result, message=f"{result.message}; unique for the exact cones: {proof}").with_notes(exact_cone=proof)
 
 
 def _unique_for_the_pyramid(result: BackendResult) -> BackendResult:

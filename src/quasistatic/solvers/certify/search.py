@@ -35,9 +35,10 @@ __all__ = ["enumerate_motions", "certified_polyhedral", "summarise", "relative_i
 _SLIDE_MIN = 10.0 * MODE_SPEED  # scene-relative slip speed that counts as sliding when a mode is prescribed
 
 
-def certified_polyhedral(problem: Problem, edges: np.ndarray, options: Options) -> BackendResult:
+def certified_polyhedral(problem: Problem, edges: np.ndarray, options: Options, seed: np.ndarray | None = None) -> BackendResult:
+    """The complete search's verdict; ``seed``, a point satisfying every law (checked by the caller), is its first motion."""
     form = polyhedral_form(problem, edges)
-    motions, complete = enumerate_motions(form, options)
+    motions, complete = enumerate_motions(form, options, seed)
     if not motions:
         if not complete:
             return BackendResult("failed", "failed: the certified search hit its time limit before finding a motion")
@@ -128,8 +129,12 @@ def _prescribe_modes(scip: Any, form: LCPForm, x: list[Any], options: Options) -
             scip.addCons(x[lam0 + i] >= _SLIDE_MIN)
 
 
-def enumerate_motions(form: LCPForm, options: Options) -> tuple[list[RawMotion], bool]:
+def enumerate_motions(form: LCPForm, options: Options, seed: np.ndarray | None = None) -> tuple[list[RawMotion], bool]:
     """Every distinct motion (up to ``options.max_solutions``), and whether the search was complete.
+
+    ``seed``: a point ``x`` of the form already known to satisfy every law (checked by the
+    caller, e.g. Lemke's): it is taken as the first motion found, so SCIP's first solve
+    (find any motion) is skipped; the rest of the search is unchanged.
 
     A single motion is excluded by a box around its twist (so the many
     degenerate patterns that share it are excluded at once). A continuum is
@@ -143,15 +148,19 @@ def enumerate_motions(form: LCPForm, options: Options) -> tuple[list[RawMotion],
     measured robust on the same scenes.
     """
     try:
-        return _enumerate(form, options, sos1=True)
+        return _enumerate(form, options, sos1=True, seed=seed)
     except SolverError:
-        return _enumerate(form, options, sos1=False)
+        return _enumerate(form, options, sos1=False, seed=seed)
 
 
-def _enumerate(form: LCPForm, options: Options, sos1: bool) -> tuple[list[RawMotion], bool]:
+def _enumerate(form: LCPForm, options: Options, sos1: bool, seed: np.ndarray | None) -> tuple[list[RawMotion], bool]:
     model = _build(form, options, sos1)
     scip = model.scip
     motions: list[RawMotion] = []
+    if seed is not None:
+        _record(form, model, seed, form.W @ seed - form.r, motions, options)
+        if len(motions) >= options.max_solutions:
+            return motions, False
     while True:
         if options.remaining() <= 0.0:
             return motions, False
@@ -165,17 +174,22 @@ def _enumerate(form: LCPForm, options: Options, sos1: bool) -> tuple[list[RawMot
         best = scip.getBestSol()
         xs = np.array([scip.getSolVal(best, v) for v in model.x])
         ws = np.array([scip.getSolVal(best, v) for v in model.w])
-        zs = _pattern(xs[form.pair_cols], ws)
-        motion = _pattern_motion(form, xs, zs, options)
-        if not any(_same(form.problem, motion, other) for other in motions):
-            motions.append(motion)
+        scip.freeTransform()
+        _record(form, model, xs, ws, motions, options)
         if len(motions) >= options.max_solutions:
             return motions, False
-        scip.freeTransform()
-        if motion.continuum:
-            _exclude_polyhedron(scip, model, zs, form)
-        else:
-            exclude_box(scip, model.x[: form.n_q], xs[: form.n_q], DISTINCT_TWIST)
+
+
+def _record(form: LCPForm, model: _Model, xs: np.ndarray, ws: np.ndarray, motions: list[RawMotion], options: Options) -> None:
+    """The motion of the solution ``(xs, ws)``, added to ``motions`` when new, and excluded from the model."""
+    zs = _pattern(xs[form.pair_cols], ws)
+    motion = _pattern_motion(form, xs, zs, options)
+    if not any(_same(form.problem, motion, other) for other in motions):
+        motions.append(motion)
+    if motion.continuum:
+        _exclude_polyhedron(model.scip, model, zs, form)
+    else:
+        exclude_box(model.scip, model.x[: form.n_q], xs[: form.n_q], DISTINCT_TWIST)
 
 
 def _pattern(x: np.ndarray, w: np.ndarray) -> np.ndarray:

@@ -28,7 +28,7 @@ from ...laws.fixed_modes import columns, system
 from ...tolerances import CONE_ROUNDOFF, NEWTON_DAMPING, NEWTON_STOP
 from .lemke import SOLUTION, lemke
 
-__all__ = ["solve_split_lcp", "NOT_CONVERGED", "PIVOTS_PER_ROW"]
+__all__ = ["solve_split_lcp", "split_lcp_point", "NOT_CONVERGED", "PIVOTS_PER_ROW"]
 
 PIVOTS_PER_ROW = 20  # Lemke pivot cap per LCP row
 NOT_CONVERGED = 3  # kernel status beyond Lemke's: neither re-alignment nor Newton's method reached the exact cone
@@ -118,6 +118,40 @@ def solve_split_lcp(
                 q, c = _motion(z, edges, frictional, m, d, n)
                 return status, 1, q, c, pivots, realignments
         q, c = _motion(z, edges, frictional, m, d, n)
+
+
+@njit
+def split_lcp_point(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    frictional: np.ndarray,
+    base: np.ndarray,
+    pivot_tol: float,
+    pivots_per_row: int,
+) -> tuple[int, np.ndarray]:
+    """Lemke on the split-twist LCP with fixed edges (``base`` as in :func:`solve_split_lcp`, no re-alignment).
+
+    Returns Lemke's status and its raw point ``z = [q+ (n), q- (n), cn (m), beta (f K), lam (f)]``
+    (edges and slip speeds of the frictional contacts only): what a caller needs to
+    rebuild every variable of the polyhedral laws, not just the motion.
+    """
+    m, d, n = J.shape
+    f = frictional.shape[0]
+    Jn = np.ascontiguousarray(J[:, d - 1, :])
+    bn = np.ascontiguousarray(b[:, d - 1])
+    Jt = np.empty((f, d - 1, n))
+    bt = np.empty((f, d - 1))
+    mu_f = np.empty(f)
+    for a in range(f):
+        Jt[a] = J[frictional[a], : d - 1, :]
+        bt[a] = b[frictional[a], : d - 1]
+        mu_f[a] = mu[frictional[a]]
+    edges = _edges(base, np.zeros(f), d - 1)
+    M, qv = _assemble(Jn, Jt, bn, bt, mu_f, g, edges, frictional)
+    status, z, _, _ = lemke(M, qv, np.ones(qv.shape[0]), pivots_per_row * qv.shape[0], pivot_tol)
+    return status, z
 
 
 @njit

@@ -40,7 +40,7 @@ from .naive import naive_applicable, solve_naive, to_solution
 __all__ = ["BenchConfig", "Row", "BatchRow", "BenchResult", "run_benchmarks", "machine_info", "growth_exponents"]
 
 NAIVE = "scipy-dense"
-FRICTIONAL_METHODS = ("scip", "fast", "paper", NAIVE)
+FRICTIONAL_METHODS = ("scip", "certified", "fast", "paper", NAIVE)
 FRICTIONLESS_METHODS = ("lp", "fast", "paper", NAIVE)
 AGREEMENT_TOLERANCE = 1e-4  # scene-relative twist difference still counted as the same motion
 

@@ -1,0 +1,165 @@
+"""Cheap certificates: a verified first motion for the search, and uniqueness proven by kinematics alone.
+
+**A verified first motion** (:func:`seed_point`). Lemke's method solves the
+polyhedral LCP with the search's own edges in microseconds; its point is
+rebuilt in the search's variables and every law of the form (equilibrium,
+signs, complementarity) is checked here in numpy before it is used. The
+certified search then starts from it, so its first mixed-integer solve (find a
+motion) is skipped and only the proof that no other motion exists remains.
+A point that fails the check is dropped: the search starts from nothing, as before.
+
+**Kinematic uniqueness** (:func:`kinematically_unique`). Whatever the friction
+model, every motion keeps each contact from penetrating: ``Jn q >= bn``. When
+that set of twists is a single point, the motion is unique before any force
+is looked at. The proof is a bound, not a numerical test (Gordan's theorem,
+made quantitative). Let ``A`` be the rows of ``Jn`` closed at the found twist
+``q*`` (``k`` rows, full column rank, smallest singular value ``s``) and
+``t = bn_A - A q*`` (round-off). Suppose ``y > 0`` with ``A^T y = e`` (``e`` ~ 0).
+For any admissible twist ``q = q* + d``: ``v = A d - t >= 0`` and
+``y.v = e.d - y.t``, so every ``v_i <= (|e| |d| + |y.t|) / y_i``, hence
+``|v| <= (|e| |d| + |y.t|) |1/y|``; and ``|d| <= (|v| + |t|) / s``. Together::
+
+    |d| (1 - |e| |1/y| / s) <= (|y.t| |1/y| + |t|) / s
+
+which bounds ``|d|`` once the bracket is positive (2-norms throughout). A
+radius below half of ``SAME_TWIST`` means every motion's twist is ``q*``
+within the tolerance the search itself uses to call two twists the same, so
+the complete search would find one single motion there. The same bound with
+every row loosened by the LP solvers' feasibility tolerance must also stay
+within ``DISTINCT_TWIST`` (the search's exclusion box): nothing the
+mixed-integer search could accept within its tolerance lies outside it either.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...laws import Problem, RawMotion
+from ...laws.polyhedral import LCPForm
+from ...tolerances import (
+    BASIS_FEASIBILITY,
+    DISTINCT_TWIST,
+    FRICTION_ALIGNMENT,
+    LP_FEASIBILITY,
+    MODE_SPEED,
+    MOTION_RANK,
+    PIVOT,
+    SAME_TWIST,
+    ZERO,
+)
+from ..numerics.lcp import PIVOTS_PER_ROW, solve_split_lcp, split_lcp_point
+from ..numerics.lemke import SOLUTION
+
+__all__ = ["seed_point", "exact_motion", "kinematically_unique", "kinematic_radius"]
+
+EXACT_EDGES = 6  # the fast path's pyramid for exact 3-D cones, before its edges turn with the slips
+REALIGNMENTS = 20  # most edge re-alignments, as on the fast path
+
+
+def seed_point(form: LCPForm) -> np.ndarray | None:
+    """A point ``x = [q, cn, beta, lam]`` satisfying every law of ``form`` (checked here), or None.
+
+    ``form`` must use unrotated edges (:func:`~quasistatic.laws.polyhedral.aligned_edges` without slips),
+    as the certified search does: Lemke's kernel builds the same ones.
+    """
+    problem = form.problem
+    m, K = form.edges.shape[:2]
+    J, b, mu, g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.mu, problem.g))
+    frictional = np.flatnonzero(mu > 0.0)
+    base = np.array([1.0, -1.0]) if problem.dimension == 2 else 2.0 * np.pi * np.arange(K) / K
+    status, z = split_lcp_point(J, b, mu, g, frictional, base, PIVOT, PIVOTS_PER_ROW)
+    if status != SOLUTION:
+        return None
+    x = _form_point(form, z, frictional)
+    return x if _satisfies(form, x) else None
+
+
+def exact_motion(problem: Problem) -> RawMotion | None:
+    """A motion of the exact 3-D laws by the fast path's kernel (re-aligned pyramid, then Newton), or None.
+
+    Only a candidate: the caller proves it unique, and the audit checks its laws.
+    """
+    J, b, mu, g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.mu, problem.g))
+    base = 2.0 * np.pi * np.arange(EXACT_EDGES) / EXACT_EDGES
+    status, _, q, c, _, _ = solve_split_lcp(
+        J,
+        b,
+        mu,
+        g,
+        np.flatnonzero(mu > 0.0),
+        base,
+        True,
+        REALIGNMENTS,
+        FRICTION_ALIGNMENT,
+        MODE_SPEED,
+        PIVOT,
+        BASIS_FEASIBILITY,
+        PIVOTS_PER_ROW,
+    )
+    return RawMotion(q, c) if status == SOLUTION else None
+
+
+def _form_point(form: LCPForm, z: np.ndarray, frictional: np.ndarray) -> np.ndarray:
+    """The kernel's ``[q+, q-, cn, beta, lam]`` (frictional contacts only) as the form's ``[q, cn, beta, lam]``."""
+    n, (m, K) = form.n_q, form.edges.shape[:2]
+    f = frictional.size
+    q = z[:n] - z[n : 2 * n]
+    beta = np.zeros((m, K))
+    beta[frictional] = z[2 * n + m : 2 * n + m + f * K].reshape(f, K)
+    lam = np.zeros(m)
+    lam[frictional] = z[2 * n + m + f * K :]
+    # A frictionless contact's slip speed is free of its force (beta = 0): the least one its edges accept.
+    slip_along = (form.W[m : m + m * K, :n] @ q - form.r[m : m + m * K]).reshape(m, K)
+    frictionless = np.setdiff1d(np.arange(m), frictional)
+    lam[frictionless] = np.maximum(0.0, np.max(-slip_along[frictionless], axis=1, initial=0.0))
+    return np.r_[q, z[2 * n : 2 * n + m], beta.ravel(), lam]
+
+
+def _satisfies(form: LCPForm, x: np.ndarray) -> bool:
+    """Equilibrium, signs and complementarity of ``x`` hold to ``ZERO`` (scene-relative)."""
+    w = form.W @ x - form.r
+    pairs = x[form.pair_cols]
+    equilibrium = np.max(np.abs(form.E_eq @ x - form.e_eq), initial=0.0)
+    signs = min(np.min(pairs, initial=0.0), np.min(w, initial=0.0))
+    complementarity = np.max(np.minimum(np.abs(pairs), np.abs(w)), initial=0.0)
+    return bool(equilibrium <= ZERO and signs >= -ZERO and complementarity <= ZERO)
+
+
+def kinematically_unique(problem: Problem, q: np.ndarray) -> bool:
+    """True when every twist the contacts allow (``Jn q' >= bn``) is ``q`` itself, proven by the bound above.
+
+    Both radii are checked: the exact rows (within half ``SAME_TWIST``) and the rows loosened by
+    ``LP_FEASIBILITY`` (within ``DISTINCT_TWIST``), so the complete search would agree.
+    """
+    gap = problem.Jn @ q - problem.bn
+    closed = np.abs(gap) <= MODE_SPEED
+    A, t = problem.Jn[closed], -gap[closed]
+    exact = kinematic_radius(A, t)
+    loose = kinematic_radius(A, np.abs(t) + LP_FEASIBILITY)
+    return exact <= 0.5 * SAME_TWIST and loose <= DISTINCT_TWIST
+
+
+def kinematic_radius(A: np.ndarray, t: np.ndarray) -> float:
+    """Largest ``|d|`` (2-norm) with ``A d >= t``, bounded by Gordan multipliers; ``inf`` when no bound is found.
+
+    ``A`` (k, n): rows of the normal Jacobian; ``t`` (k,): small right-hand sides.
+    """
+    k, n = A.shape
+    if k <= n:  # a pointed cone needs more rows than unknowns
+        return np.inf
+    u, sigma, _ = np.linalg.svd(A, full_matrices=True)
+    s = float(sigma[-1])
+    if s <= MOTION_RANK:
+        return np.inf
+    null = u[:, n:]  # left null space of A: every y with A^T y = 0
+    y = null @ (null.T @ np.ones(k))  # the all-ones vector's part in it; Gordan multipliers when positive
+    top = float(np.max(y, initial=0.0))
+    if top <= 0.0 or float(np.min(y)) <= MOTION_RANK * top:
+        return np.inf
+    y = y / top
+    inverse = float(np.linalg.norm(1.0 / y))
+    e = float(np.linalg.norm(A.T @ y))
+    bracket = 1.0 - e * inverse / s
+    if bracket < 0.5:  # the multipliers are too far from A^T y = 0 to bound anything
+        return np.inf
+    return float((abs(float(y @ t)) * inverse + float(np.linalg.norm(t))) / (s * bracket))

@@ -1,0 +1,140 @@
+"""The default certified method (``certified``: cheap certificates, then the SCIP search) against ``scip``.
+
+``certified`` must never contradict the complete search of ``scip``: the same
+status, and the same motions (twists within ``TWIST_RTOL``) wherever the
+search's list is complete. The default run takes 60 random 2-D scenes, 6
+random 3-D ones and the 2-D benchmark grasps; ``pytest -m slow`` sweeps 300
+more 2-D and 40 more 3-D scenes. The kinematic bound is checked against the
+true extent of the admissible twists, computed by LPs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import quasistatic as qs
+from quasistatic.laws.polyhedral import aligned_edges, polyhedral_form
+from quasistatic.solvers import Options
+from quasistatic.solvers.certify.cheap import kinematic_radius, seed_point
+from quasistatic.solvers.certify.search import enumerate_motions
+from quasistatic.solvers.numerics.highs import solve_lp
+from quasistatic.tools.bench.families import grasp_2d
+from random_scenes import random_scene
+
+TWIST_RTOL = 1e-6  # scene-relative twist agreement required between the methods
+
+
+def _twist(problem: qs.Problem, motion: qs.Motion) -> np.ndarray:
+    units = np.tile(problem.scales.twist_units(problem.dimension), len(problem.scene.bodies))
+    return np.concatenate([motion.twists[b.name] for b in problem.scene.bodies]) / units
+
+
+def _motions(solution: qs.Solution) -> tuple[qs.Motion, ...]:
+    return solution.solutions or ((solution.motion,) if solution.motion is not None else ())
+
+
+def _listed(problem: qs.Problem, motion: qs.Motion, among: tuple[qs.Motion, ...]) -> bool:
+    twist = _twist(problem, motion)
+    scale = max(1.0, float(np.max(np.abs(twist))))
+    return any(
+        other.continuum == motion.continuum and np.max(np.abs(_twist(problem, other) - twist)) <= TWIST_RTOL * scale for other in among
+    )
+
+
+def _agree(scene: qs.Scene) -> None:
+    problem = qs.assemble(scene)
+    new = qs.solve(problem)  # the default: method "certified"
+    old = qs.solve(problem, method="scip")
+    assert new.method == "certified" and new.status == old.status, f"certified: {new.message}; scip: {old.message}"
+    assert new.certified == old.certified or (new.certified and new.status == "solved"), "a kinematic proof may only add certainty"
+    if new.status in ("solved", "ambiguous") and old.search_complete is not False and new.search_complete is not False:
+        mine, theirs = _motions(new), _motions(old)
+        assert len(mine) == len(theirs)
+        assert all(_listed(problem, motion, theirs) for motion in mine)
+    for motion in _motions(new):
+        assert motion.audit.passed
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_certified_agrees_with_scip_2d(seed: int) -> None:
+    _agree(random_scene(2, seed))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_certified_agrees_with_scip_3d(seed: int) -> None:
+    _agree(random_scene(3, seed))
+
+
+@pytest.mark.parametrize(("contacts", "instance"), [(m, i) for m in (2, 3, 4, 6, 8) for i in range(4)])
+def test_certified_agrees_with_scip_on_benchmark_grasps(contacts: int, instance: int) -> None:
+    _agree(grasp_2d(contacts, instance))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(60, 360))
+def test_certified_agrees_with_scip_2d_sweep(seed: int) -> None:
+    _agree(random_scene(2, seed))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(6, 46))
+def test_certified_agrees_with_scip_3d_sweep(seed: int) -> None:
+    _agree(random_scene(3, seed))
+
+
+def test_kinematic_certificate_decides_a_squeezing_grasp() -> None:
+    """Seven of eight fingers close around the ellipse: non-penetration alone fixes the twist."""
+    problem = qs.assemble(grasp_2d(8, 0))
+    solution = qs.solve(problem)
+    assert solution.status == "solved" and solution.certified
+    assert "non-penetration" in dict(solution.notes).get("certificate", "")
+    _agree(grasp_2d(8, 0))
+
+
+def _true_extent(A: np.ndarray, t: np.ndarray) -> float:
+    """Largest |d_j| over ``A d >= t``, by 2 n LPs (inf when unbounded, 0 when the set is empty)."""
+    n = A.shape[1]
+    worst = 0.0
+    for j in range(n):
+        for sign in (1.0, -1.0):
+            lp = solve_lp(sign * np.eye(n)[j], A, t, np.full(len(t), np.inf), maximize=True)
+            if lp.status == "infeasible":
+                return 0.0
+            if lp.status != "optimal":
+                return np.inf
+            worst = max(worst, abs(lp.x[j]))
+    return worst
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_kinematic_radius_bounds_every_admissible_twist(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 7))
+    k = int(rng.integers(n + 1, n + 5))
+    A = rng.normal(size=(k, n))
+    A[-1] = -rng.uniform(0.2, 1.0, k - 1) @ A[:-1]  # positive multipliers exist: a pointed set
+    t = rng.normal(size=k)  # the bound is linear in t: order one keeps HiGHS's 1e-7 tolerance out of the comparison
+    radius = kinematic_radius(A, t)
+    extent = _true_extent(A, t)
+    assert np.isfinite(extent)
+    assert extent <= radius * (1.0 + 1e-6) + 1e-6, (extent, radius)
+
+
+def test_kinematic_radius_refuses_an_open_set() -> None:
+    A = np.array([[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])  # every row points one way: d can grow along (1, 1)
+    assert kinematic_radius(A, np.zeros(3)) == np.inf
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_seeded_search_lists_the_same_motions(seed: int) -> None:
+    problem = qs.assemble(random_scene(2, seed))
+    form = polyhedral_form(problem, aligned_edges(problem, 2))
+    x = seed_point(form)
+    if x is None:
+        pytest.skip("Lemke finds no motion here")
+    plain, complete = enumerate_motions(form, Options().start_clock())
+    seeded, seeded_complete = enumerate_motions(form, Options().start_clock(), x)
+    assert complete == seeded_complete and len(plain) == len(seeded)
+    for a in seeded:
+        assert any(np.max(np.abs(a.q - b.q)) <= 1e-6 and a.continuum == b.continuum for b in plain)
