@@ -110,7 +110,7 @@ def render_contacts(contacts: Sequence[Contact], gaps: Sequence[float], notes: S
     length = max((float(np.max(np.abs(c.point), initial=0.0)) for c in contacts), default=0.0)
     for index, (contact, gap) in enumerate(zip(contacts, gaps, strict=False)):
         joints = "" if contact.jacobian is None else f"{contact.jacobian.shape[1]} joints"
-        row = [str(index), Text(contact.body), Text(contact.other), format_vector(contact.point, length)]
+        row: list[str | Text] = [str(index), Text(contact.body), Text(contact.other), format_vector(contact.point, length)]
         table.add_row(*row, format_vector(contact.normal, 1.0), format_float(gap, length), format_float(contact.mu), joints)
     console.print(table)
     for line in notes:

@@ -147,7 +147,8 @@ class World:
         return {link_owner(r.name, link): r.name for r in self.robots for link in r.link_names}
 
     def _colliders(self) -> list[Collider]:
-        shaped = [Collider(p.name, p.shape, p.pose) for p in (*self.bodies, *self.movers) if p.shape is not None]
+        parts: list[SolidBody | ShapedMover] = [*self.bodies, *self.movers]
+        shaped = [Collider(p.name, p.shape, p.pose) for p in parts if p.shape is not None]
         return shaped + [Collider(c.owner, c.shape, c.pose) for r in self.robots for c in r.colliders]
 
     def _margin(self) -> float:
@@ -190,4 +191,3 @@ class World:
 def _robot_of(owner: str) -> Iterable[str]:
     """``hand`` for ``hand/link``: a friction pair may name the whole robot."""
     return owner.split("/", 1)[:1] if "/" in owner else ()
-

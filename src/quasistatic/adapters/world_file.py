@@ -16,8 +16,8 @@ import numpy as np
 
 from ..errors import SceneError
 from ..model import Contact, Robot
-from ..tolerances import MAX_FRICTION
 from ..model.io import BodyFile, ContactFile, DetectionFile, MoverFile, PoseFile, RobotFile, SceneFile, ShapeFile
+from ..tolerances import MAX_FRICTION
 from .robot import UrdfRobot
 from .shapes import Box, Capsule, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere
 from .world import ContactDetection, FrictionPair, ShapedMover, SolidBody, World
