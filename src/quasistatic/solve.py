@@ -19,7 +19,7 @@ from .errors import QuasistaticError, SolverError
 from .laws import Problem, RawMotion, assemble, free_directions, physical_twists, to_world
 from .model import Scene
 from .solution import Attempt, Mode, Motion, Solution
-from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, get_backend
+from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, get_backend, too_large
 
 Range = tuple[float, float | None]
 
@@ -105,6 +105,9 @@ def _run(backend: Backend, problem: Problem, options: Options) -> BackendResult:
     extreme numbers, a numerical library's internal error): the user gets the library's
     own exception, with the original chained as its cause.
     """
+    oversized = too_large(problem, backend.name)  # dense matrices past the memory limit: an honest failed
+    if oversized is not None:
+        return oversized
     try:
         return backend.solver(problem, options)
     except QuasistaticError:
