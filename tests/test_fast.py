@@ -454,7 +454,7 @@ def test_audit_rejects_non_finite_motions() -> None:
 
 def test_jacobi_singular_values_match_lapack() -> None:
     """The small-matrix SVD behind the frictionless rank tests gives LAPACK's singular values and ranks."""
-    from quasistatic.solvers.lp import _rank, _singular_values
+    from quasistatic.solvers.lp import _full_rank, _singular_values
 
     rng = np.random.default_rng(3)
     for trial in range(500):
@@ -467,5 +467,28 @@ def test_jacobi_singular_values_match_lapack() -> None:
         lapack = np.linalg.svd(A, compute_uv=False)
         np.testing.assert_allclose(ours, lapack, rtol=0, atol=1e-14 * max(1.0, lapack.max()))
         for tol in (1e-9, 1e-10):
-            assert _rank(A, tol) == int(np.sum(lapack > tol))
-    assert _rank(np.zeros((0, 6)), 1e-9) == 0
+            rank = int(np.sum(lapack > tol))
+            assert _full_rank(A, tol, rank) == 1
+            assert _full_rank(A, tol, rank + 1) == 0
+    assert _full_rank(np.zeros((0, 6)), 1e-9, 0) == 1
+    assert _full_rank(np.zeros((30, 30)), 1e-9, 0) == -1  # too large for Jacobi rotations: the caller decides
+
+
+def test_sparse_full_column_rank_matches_lapack() -> None:
+    """Large matrices get their full-column-rank test from a sparse LU (no dense SVD): it agrees with LAPACK's
+    smallest singular value wherever that is not within a factor 2 of the threshold."""
+    from quasistatic.solvers.numerics.rank import DENSE_MAX, full_column_rank
+
+    rng = np.random.default_rng(5)
+    for trial in range(60):
+        r = int(rng.integers(DENSE_MAX + 1, 160))
+        c = int(rng.integers(DENSE_MAX + 1, r + 1))
+        A = (rng.random((r, c)) < 0.05) * rng.normal(size=(r, c)) + np.eye(r, c) * rng.uniform(0.0, 1.0)
+        if trial % 2:  # a column nearly a multiple of another
+            i, j = rng.choice(c, size=2, replace=False)
+            A[:, i] = A[:, j] * rng.uniform(0.5, 2.0) + rng.normal(size=r) * 10.0 ** rng.uniform(-13, -6)
+        smallest = np.linalg.svd(A, compute_uv=False)[-1]
+        for tol in (1e-9, 1e-10):
+            if not 0.5 < smallest / tol < 2.0:
+                assert full_column_rank(A, tol) is bool(smallest > tol), (trial, smallest, tol)
+    assert not full_column_rank(np.zeros((DENSE_MAX + 5, DENSE_MAX + 1)), 1e-9)  # exactly singular: the LU stops

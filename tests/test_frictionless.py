@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
 import quasistatic as qs
@@ -266,6 +266,80 @@ def test_random_frictionless_scene_gives_an_audited_verdict(data: dict[str, Any]
         if motion is not None:
             assert motion.audit.passed, motion.audit
             assert motion.power.residual == approx(0.0, abs=1e-6 * max(1.0, abs(motion.power.input)))
+
+
+def _range_widths(problem: qs.Problem, sol: qs.Solution) -> list[float]:
+    """Each closed contact's normal-force range width over ``{c >= 0 : Jn_C^T c = -g}`` (scene-relative), by linprog.
+
+    Written from the force formulation directly (no library code): the forces of
+    a unique motion are the equilibrium forces on the contacts it keeps closed.
+    """
+    from scipy.optimize import linprog
+
+    closed = np.array([c.normal_velocity <= 1e-9 * problem.scales.velocity for c in sol.contacts], dtype=bool)
+    A = np.asarray(problem.Jn)[closed].T
+    widths = []
+    for i in range(int(closed.sum())):
+        cost = np.zeros(A.shape[1])
+        cost[i] = 1.0
+        low = linprog(cost, A_eq=A, b_eq=-np.asarray(problem.g), bounds=(0, None), method="highs")
+        high = linprog(-cost, A_eq=A, b_eq=-np.asarray(problem.g), bounds=(0, None), method="highs")
+        assert low.status == 0, low.message
+        widths.append(math.inf if high.status == 3 else -high.fun - low.fun)
+    return widths
+
+
+@st.composite
+def supported_boxes(draw: st.DrawFn) -> dict[str, Any]:
+    """A box on a fixed table (2 or 3 to 6 support points on a grid, repeats allowed) between fixed walls,
+    under gravity tilted by up to ~12 degrees, maybe touched by a still or retreating finger: mostly at rest,
+    with unique or indeterminate forces (or toppling, or free to slide along a wall)."""
+    dim = draw(st.sampled_from([2, 3]))
+    k = 3 if dim == 2 else 6
+    grid = st.integers(-2, 2).map(lambda i: i / 20)  # across the 0.2-wide bottom face
+    height = st.integers(1, 3).map(lambda i: i / 40)  # up the 0.1-high side faces
+
+    def spot() -> list[float]:
+        return draw(st.lists(grid, min_size=dim - 1, max_size=dim - 1))
+
+    contacts = [contact("box", "table", [*spot(), 0.0], [0.0] * (dim - 1) + [1.0]) for _ in range(draw(st.integers(dim, 6)))]
+    for axis in range(dim - 1):
+        for side in (-1.0, 1.0):
+            for _ in range(draw(st.integers(dim - 1 if side > 0 else 0, 2))):  # one side may be open
+                point = [*spot(), draw(height)]
+                point[axis] = side * 0.1
+                inward = [0.0] * dim
+                inward[axis] = -side
+                contacts.append(contact("box", "walls", point, inward))
+    movers: dict[str, Any] = {"table": {}, "walls": {}}
+    if draw(st.booleans()):
+        push = [0.0] * k
+        push[0] = -draw(st.integers(0, 2)) / 100  # still or retreating: pushing into the walls would jam
+        movers["finger"] = {"twist": push}
+        contacts.append(contact("box", "finger", [-0.1] + [0.0] * (dim - 2) + [0.05], [1.0] + [0.0] * (dim - 1)))
+    tilt = draw(st.lists(st.integers(-2, 2), min_size=dim - 1, max_size=dim - 1))
+    com = [*spot(), 0.05]
+    return base(dim, gravity=[*map(float, tilt), -G], bodies={"box": {"mass": 1.0, "com": com}}, movers=movers, contacts=contacts)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(st.one_of(supported_boxes(), random_scenes()))
+def test_forces_indeterminate_exactly_when_some_range_is_wide(data: dict[str, Any]) -> None:
+    """The LP path decides ``forces_indeterminate`` by a rank test, without the ranges (they are worked out
+    when read); it must say True exactly when some normal-force range has positive width."""
+    problem = qs.assemble(qs.load_scene(data))
+    sol = qs.solve(problem, method="lp")
+    assume(sol.status == "solved")
+    wide = any(w > 1e-7 for w in _range_widths(problem, sol))
+    event(f"forces indeterminate: {wide}")
+    assert sol.forces_indeterminate is wide
+    ranges = [c.normal_force_range for c in sol.contacts]  # read: worked out now
+    if wide:
+        known = [r for r in ranges if r is not None]
+        assert len(known) == len(ranges)
+        assert any(hi is None or hi - lo > 1e-7 * problem.scales.force for lo, hi in known)
+    else:
+        assert all(r is None for r in ranges)
 
 
 def test_nearly_axis_normal_unstable_scene() -> None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable, Sequence
+from functools import partial
 
 from .adapters import Detection, World
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
@@ -19,7 +20,9 @@ from .errors import QuasistaticError, SolverError
 from .laws import Problem, RawMotion, assemble, free_directions, physical_twists, to_world
 from .model import Scene
 from .solution import Attempt, Mode, Motion, Solution
-from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, get_backend
+from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, get_backend, too_large
+
+Range = tuple[float, float | None]
 
 __all__ = ["solve", "METHODS", "audited_raw_motion", "with_detection"]
 
@@ -123,6 +126,9 @@ def _run(backend: Backend, problem: Problem, options: Options) -> BackendResult:
     extreme numbers, a numerical library's internal error): the user gets the library's
     own exception, with the original chained as its cause.
     """
+    oversized = too_large(problem, backend.name)  # dense matrices past the memory limit: an honest failed
+    if oversized is not None:
+        return oversized
     try:
         return backend.solver(problem, options)
     except QuasistaticError:
@@ -182,21 +188,32 @@ def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFA
     scales = problem.scales
     geometry = problem.scene.derived("motion_geometry", lambda scene: MotionGeometry(scene, problem.scales))
     T, forces = to_world(problem, raw.q, raw.c)
-    ranges = raw.force_ranges
-    physical_ranges = None if ranges is None else [(lo * scales.force, None if hi is None else hi * scales.force) for lo, hi in ranges]
+    ranges: list[Range] | Callable[[], list[Range]] | None = None
+    if raw.force_ranges is not None:
+        ranges = _physical_ranges(raw.force_ranges, scales.force)
+    elif raw.lazy_ranges is not None:
+        ranges = partial(_physical_ranges_of, raw.lazy_ranges, scales.force)
     extremes = tuple(physical_twists(problem, e) for e in raw.extremes)
     return audited_motion(
         geometry,
         scales,
         T,
         forces,
-        ranges=physical_ranges,
+        ranges=ranges,
         extreme_twists=extremes,
         continuum=raw.continuum,
         unbounded=raw.unbounded,
         free_directions=free_directions(problem, raw.free_axes),
         tolerance=tolerance,
     )
+
+
+def _physical_ranges(ranges: Sequence[Range], force: float) -> list[Range]:
+    return [(lo * force, None if hi is None else hi * force) for lo, hi in ranges]
+
+
+def _physical_ranges_of(lazy: Callable[[], Sequence[Range]], force: float) -> list[Range]:
+    return _physical_ranges(lazy(), force)
 
 
 def _audited(
@@ -211,7 +228,7 @@ def _audited(
         str(problem.friction),
         motion=motions[0] if motions else None,
         solutions=tuple(motions) if result.status == "ambiguous" else (),
-        forces_indeterminate=bool(result.motions) and result.motions[0].force_ranges is not None and result.status != "failed",
+        forces_indeterminate=bool(result.motions) and result.motions[0].forces_indeterminate and result.status != "failed",
         certified=result.certified and result.status != "failed",
         diagnosis=result.diagnosis,
         certificate=result.certificate,

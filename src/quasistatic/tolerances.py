@@ -60,6 +60,7 @@ __all__ = [
     "MAX_VALUES",
     "MAX_FILE_BYTES",
     "DETECTION_MARGIN",
+    "MAX_DENSE_BYTES",
 ]
 
 # --------------------------------------------------------------------------- input (physical units)
@@ -250,4 +251,10 @@ would otherwise expand to billions.
 MAX_FILE_BYTES = 16 * 1024 * 1024
 """Largest scene file read [bytes]: about 100 times a 10,000-contact scene. Reading stops one byte past it,
 whatever the file claims to hold (``/dev/zero`` has no end).
+"""
+
+MAX_DENSE_BYTES = 2**30
+"""Largest dense matrix a frictional method may build [bytes]: the polyhedral laws' complementarity matrix
+grows as the square of the contacts (a 3-D box on 10,000 frictional points: 12 GiB, 1,000 points: 0.8 GiB).
+Past it the method is not run and the answer is an honest ``failed`` (:mod:`quasistatic.solvers.oversize`).
 """

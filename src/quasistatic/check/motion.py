@@ -10,6 +10,7 @@ them moves no residual by more than that.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -51,7 +52,7 @@ def audited_motion(
     twists: np.ndarray,
     forces: np.ndarray,
     *,
-    ranges: list[Range] | None = None,
+    ranges: list[Range] | Callable[[], list[Range]] | None = None,
     extreme_twists: tuple[dict[str, np.ndarray], ...] = (),
     continuum: bool = False,
     unbounded: bool = False,
@@ -66,8 +67,9 @@ def audited_motion(
         Physical body twists in scene order [length/time, rad/time].
     forces : (m, d)
         World contact forces on each contact's ``body`` [force].
-    ranges : list of (lo, hi) or None
-        Physical normal-force ranges, when the forces are indeterminate [force].
+    ranges : list of (lo, hi), a function returning one, or None
+        Physical normal-force ranges, when the forces are indeterminate [force]; a
+        function is called when the contacts' results are first read.
     """
     audit, power, evaluation = audit_arrays(geometry.audit, twists, forces, scales, tolerance)
     table = ContactTable(geometry.pairs, forces, evaluation.slips, evaluation.normal, geometry.threshold, ranges, geometry.roundoff)
@@ -103,7 +105,8 @@ class ContactTable:
     forces, slips : (m, d) contact force on ``body`` and tangential relative velocity
     normal : (m, 3) normal velocity, slip speed and normal force of each contact
     threshold : speed below which a contact is not moving [length/time]
-    ranges : physical normal-force ranges, or None
+    ranges : physical normal-force ranges, a function that works them out (called once, when first
+        needed), or None when the forces are unique
     roundoff : per-column magnitudes below which forces, slips and the normal columns are reported as 0
 
     The arrays are kept as the audit measured them; round-off is dropped when results are made.
@@ -118,7 +121,7 @@ class ContactTable:
         slips: np.ndarray,
         normal: np.ndarray,
         threshold: float,
-        ranges: list[Range] | None,
+        ranges: list[Range] | Callable[[], list[Range]] | None,
         roundoff: tuple[np.ndarray, np.ndarray, np.ndarray],
     ) -> None:
         self.pairs, self.forces, self.slips, self.normal = pairs, forces, slips, normal
@@ -126,11 +129,12 @@ class ContactTable:
 
     def __getstate__(self) -> tuple[object, ...]:
         # Floats in lists: pickling a few small arrays costs more than the numbers in them.
+        # Ranges still to be worked out are worked out here: the function holds the solver's data.
         arrays = (self.forces, self.slips, self.normal)
         return (
             self.pairs,
             self.threshold,
-            self.ranges,
+            self.range_list(),
             tuple(r.tolist() for r in self.roundoff),
             *((a.shape, a.ravel().tolist()) for a in arrays),
         )
@@ -144,12 +148,19 @@ class ContactTable:
     def forces_indeterminate(self) -> bool:
         return self.ranges is not None
 
+    def range_list(self) -> list[Range] | None:
+        """The normal-force ranges, worked out now if they were deferred."""
+        if callable(self.ranges):
+            self.ranges = self.ranges()
+        return self.ranges
+
     def modes(self) -> tuple[Mode, ...]:
         threshold = self.threshold
         return tuple(_mode(u_n, speed, threshold) for u_n, speed, _ in self.normal.tolist())
 
     def results(self) -> tuple[ContactResult, ...]:
-        ranges: list[Range | None] = list(self.ranges) if self.ranges else [None] * len(self.pairs)
+        known = self.range_list()
+        ranges: list[Range | None] = list(known) if known is not None else [None] * len(self.pairs)
         force_roundoff, speed_roundoff, normal_roundoff = self.roundoff
         forces = _drop_roundoff(self.forces.copy(), force_roundoff)
         slips = _drop_roundoff(self.slips.copy(), speed_roundoff)

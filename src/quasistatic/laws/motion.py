@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -32,6 +33,10 @@ class RawMotion:
     force_ranges : tuple of (lo, hi) or None
         When the motion is determined but its forces are not: each contact's normal-force
         range over every force distribution consistent with it (``hi`` None when unbounded).
+    lazy_ranges : callable or None
+        Instead of ``force_ranges``: a function that works them out when first
+        read (they cost two LPs per loaded contact, most of a frictionless
+        solve); its presence alone says the forces are indeterminate.
     """
 
     q: FloatArray
@@ -40,10 +45,15 @@ class RawMotion:
     unbounded: bool = False
     free_axes: tuple[int, ...] = ()
     force_ranges: tuple[tuple[float, float | None], ...] | None = None
+    lazy_ranges: Callable[[], tuple[tuple[float, float | None], ...]] | None = field(default=None, repr=False, compare=False)
 
     @property
     def continuum(self) -> bool:
         return bool(self.extremes) or self.unbounded
+
+    @property
+    def forces_indeterminate(self) -> bool:
+        return self.force_ranges is not None or self.lazy_ranges is not None
 
 
 class WorldLayout:

@@ -17,7 +17,10 @@ check out, HiGHS solves the LP and the verdict comes from it as before.
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
+import scipy.sparse as sp
 
 from ..jit import njit
 from ..laws import Problem, RawMotion
@@ -27,14 +30,15 @@ from .certify.diagnose import MESSAGES, kinematic_certificate
 from .numerics.highs import INF, solve_lp
 from .numerics.lcp import PIVOTS_PER_ROW, solve_split_lcp
 from .numerics.lemke import SOLUTION
-from .numerics.ranges import cone_is_trivial, ranges_are_wide, twist_extremes, value_ranges
+from .numerics.ranges import cone_is_trivial, twist_extremes, value_ranges
+from .numerics.rank import full_column_rank
 from .result import BackendResult, Options, Range
 
 __all__ = ["solve_frictionless"]
 
 
 LEMKE_MAX_ROWS = 200  # largest LCP (2 twist entries per dof + contacts) solved by Lemke's method first
-JACOBI_MAX = 24  # largest min(rows, cols) whose rank is found by Jacobi rotations (LAPACK beyond)
+JACOBI_MAX = 24  # largest min(rows, cols) whose rank is found by Jacobi rotations (numerics.rank beyond)
 
 
 def solve_frictionless(problem: Problem, options: Options) -> BackendResult:
@@ -58,18 +62,19 @@ def solve_frictionless(problem: Problem, options: Options) -> BackendResult:
         c = np.zeros((m, problem.dimension))
         c[:, -1] = forces
     assert q is not None and c is not None
-    _, slack, support, tight, closed, motion_unique, forces_unique = analysis
+    _, slack, support, tight, closed, motion_known, forces_known = analysis
+    motion_unique = motion_known > 0 if motion_known >= 0 else full_column_rank(sp.csr_matrix(Jn[support]), MOTION_RANK)
     # {d : Jn_S d = 0, Jn_T d >= 0} is only the origin at once when Jn_S has full column rank.
     if not motion_unique and not cone_is_trivial(Jn[support], Jn[tight]):
         extremes, free = twist_extremes(q.size, Jn[support], bn[support], Jn[~support], bn[~support])
         motion = RawMotion(q, c, tuple(extremes), bool(free), free)
         return BackendResult("ambiguous", _ambiguous_message(bool(free)), (motion,))
-    # Forces are unique when the closed contacts' normals are independent.
-    ranges = None if forces_unique else _force_ranges(Jn, g, slack)
-    if ranges is not None:
-        motion = RawMotion(q, c, force_ranges=tuple(ranges))
-        return BackendResult("solved", "solved: one motion; the contact forces are indeterminate", (motion,))
-    return BackendResult("solved", "solved: one motion with unique contact forces", (RawMotion(q, c),))
+    forces_unique = forces_known > 0 if forces_known >= 0 else full_column_rank(sp.csr_matrix(Jn[closed]).T, FORCE_RANK)
+    if forces_unique:
+        return BackendResult("solved", "solved: one motion with unique contact forces", (RawMotion(q, c),))
+    # The ranges cost two LPs per closed contact (most of a solve): worked out only when first read.
+    motion = RawMotion(q, c, lazy_ranges=partial(_force_ranges, Jn, g, closed))
+    return BackendResult("solved", "solved: one motion; the contact forces are indeterminate", (motion,))
 
 
 class _Frictionless:
@@ -101,7 +106,7 @@ def _lemke_pair(
     zero: float,
     motion_rank: float,
     force_rank: float,
-) -> tuple[int, np.ndarray, np.ndarray, tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool, bool]]:
+) -> tuple[int, np.ndarray, np.ndarray, tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, int]]:
     """Lemke's method on the LP pair's optimality conditions (the fast kernel, no edges), then :func:`_analyse`.
 
     Returns Lemke's status, the twist, the contact-frame forces (normal only;
@@ -119,7 +124,7 @@ def _lemke_pair(
 @njit
 def _analyse(
     Jn: np.ndarray, bn: np.ndarray, g: np.ndarray, q: np.ndarray, forces: np.ndarray, zero: float, motion_rank: float, force_rank: float
-) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool, bool]:
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, int]:
     """What the verdict needs of a primal-dual pair ``(q, forces)``.
 
     Returns the largest violation of the optimality conditions (primal and dual
@@ -128,9 +133,10 @@ def _analyse(
     unloaded, and closed (slack <= ``zero``) contacts, whether the supporting
     normals have full column rank (singular values > ``motion_rank``, as
     :func:`.numerics.ranges.null_space`: then the motion is unique) and whether the closed
-    ones are independent (singular values > ``force_rank``, as ``_force_ranges``: then
-    the forces are unique). One SVD at most in the usual case: independent
-    closed normals make their supporting subset independent too.
+    ones are independent (singular values > ``force_rank``: then the forces are
+    unique), each 1 (yes), 0 (no) or -1 (a matrix too large for Jacobi
+    rotations: the caller decides with a sparse test). One SVD at most in the
+    usual case: independent closed normals make their supporting subset independent too.
     """
     m, n = Jn.shape
     slack = np.empty(m)
@@ -150,22 +156,26 @@ def _analyse(
     closed = slack <= zero
     tight = closed & ~support
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(forces)) and np.all(np.isfinite(slack))):
-        return np.inf, slack, support, tight, closed, False, False
+        return np.inf, slack, support, tight, closed, 0, 0
     k = int(np.sum(closed))
-    forces_unique = k == 0 or (k <= n and _rank(Jn[closed], force_rank) == k)
-    nested = forces_unique and not np.any(support & ~closed)  # supporting rows among independent closed ones
-    motion_unique = int(np.sum(support)) == n if nested else _rank(Jn[support], motion_rank) == n
+    forces_unique = 1 if k == 0 else (0 if k > n else _full_rank(Jn[closed], force_rank, k))
+    n_support = int(np.sum(support))
+    if forces_unique == 1 and not np.any(support & ~closed):  # supporting rows among independent closed ones
+        motion_unique = int(n_support == n)
+    else:
+        motion_unique = 0 if n_support < n else _full_rank(Jn[support], motion_rank, n)
     return residual, slack, support, tight, closed, motion_unique, forces_unique
 
 
 @njit
-def _rank(A: np.ndarray, tol: float) -> int:
-    """Number of singular values of ``A`` above ``tol`` (absolute: the data are scene-relative)."""
+def _full_rank(A: np.ndarray, tol: float, rank: int) -> int:
+    """1 when ``A`` has ``rank`` singular values above ``tol`` (absolute: the data are scene-relative), else 0;
+    -1 when ``A`` is too large for Jacobi rotations (O(k^3) a sweep, and LAPACK's time depends on its threads)."""
     if A.shape[0] == 0 or A.shape[1] == 0:
-        return 0
-    if min(A.shape) > JACOBI_MAX:  # Jacobi sweeps cost O(k^3) each: LAPACK wins on large matrices
-        return int(np.sum(np.linalg.svd(np.ascontiguousarray(A))[1] > tol))
-    return int(np.sum(_singular_values(A) > tol))
+        return int(rank == 0)
+    if min(A.shape) > JACOBI_MAX:
+        return -1
+    return int(np.sum(_singular_values(A) > tol) == rank)
 
 
 @njit
@@ -211,18 +221,26 @@ def _singular_values(A: np.ndarray) -> np.ndarray:
     return sigma
 
 
-def _force_ranges(Jn: np.ndarray, g: np.ndarray, slack: np.ndarray) -> list[Range] | None:
-    """Normal-force ranges over the dual optimal face, or None when the forces are unique.
+def _force_ranges(Jn: np.ndarray, g: np.ndarray, closed: np.ndarray) -> tuple[Range, ...]:
+    """Normal-force ranges over the dual optimal face of a unique motion whose forces are not unique.
 
-    Only closed contacts (zero slack) may carry force on that face.
+    Why "not unique" is decided without these LPs, by the rank of the closed
+    contacts' normals alone: the forces of the motion ``q`` are the dual
+    optimal face ``F = {c >= 0 : Jn^T c = -g, c_i = 0 where contact i is open}``.
+    By Goldman and Tucker's strict complementarity a primal-dual optimal pair
+    exists with ``slack_i + c_i > 0`` for every i, so a contact closed at every
+    primal optimum carries force at some point of ``F``; with the motion
+    unique, every contact closed at ``q`` does. Take ``c*`` in the relative
+    interior of ``F``: it is positive on every closed contact, so ``c* + t z``
+    stays in ``F`` for small ``|t|`` and any ``z`` with ``Jn_C^T z = 0``
+    supported on the closed set ``C``, and ``F``'s dimension is
+    ``|C| - rank(Jn_C)``. So some range has positive width exactly when the
+    closed normals are dependent (``tests/test_frictionless.py`` checks the two
+    agree on random scenes).
     """
-    closed = slack <= ZERO
-    k = int(closed.sum())
-    if np.linalg.matrix_rank(Jn[closed], tol=FORCE_RANK) == k:
-        return None
-    closed_ranges = iter(value_ranges(Jn[closed].T, -g, np.eye(k), np.zeros(k)))
-    ranges = [next(closed_ranges) if is_closed else (0.0, 0.0) for is_closed in closed]
-    return ranges if ranges_are_wide(ranges) else None
+    columns = np.flatnonzero(closed)
+    closed_ranges = iter(value_ranges(sp.csr_matrix(Jn[closed]).T, -g, np.arange(columns.size), np.zeros(columns.size)))
+    return tuple(next(closed_ranges) if is_closed else (0.0, 0.0) for is_closed in closed.tolist())
 
 
 def _verdict(problem: Problem, status: str) -> BackendResult:

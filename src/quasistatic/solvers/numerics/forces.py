@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from ...laws import ModeMasks, Problem, slips
 from ...laws.polyhedral import ForcePolytope, aligned_edges, force_polytope
@@ -22,6 +23,7 @@ from ...tolerances import FORCE_RANK, ZERO
 from ..result import Range
 from .highs import solve_lp
 from .ranges import ranges_are_wide, value_ranges
+from .rank import full_column_rank
 
 __all__ = ["ForcesAtTwist", "forces_at_twist", "force_ranges", "least_normal_forces"]
 
@@ -37,7 +39,7 @@ class ForcesAtTwist:
 
     polytope: ForcePolytope
     edges: np.ndarray
-    A: np.ndarray
+    A: sp.csr_matrix
     rhs: np.ndarray
     fixed: np.ndarray
 
@@ -64,7 +66,10 @@ def forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: M
     weaker = drive < best[:, None] - _MOVING
     fixed[polytope.beta] = (weaker & masks.sliding[:, None]).ravel() | np.repeat(problem.mu <= 0, K)
     fixed[polytope.slack] = masks.sliding
-    A = np.vstack([polytope.A, np.eye(fixed.size)[fixed]])
+    # One unit row per fixed column, sparse: an identity as wide as all the columns would grow as their square.
+    held = np.flatnonzero(fixed)
+    pinned = sp.csr_matrix((np.ones(held.size), (np.arange(held.size), held)), shape=(held.size, fixed.size))
+    A = sp.vstack([sp.csr_matrix(polytope.A), pinned], format="csr")
     rhs = np.r_[polytope.rhs, np.zeros(int(fixed.sum()))]
     return ForcesAtTwist(polytope, edges, A, rhs, fixed)
 
@@ -82,10 +87,10 @@ def force_ranges(problem: Problem, edges: np.ndarray, q: np.ndarray) -> list[Ran
     """Normal-force ranges (scene-relative) over all forces consistent with twist ``q``; None when the forces are unique."""
     forces = forces_at_twist(problem, edges, q, _measured_masks(problem, edges, q))
     free = ~forces.fixed
-    if np.linalg.matrix_rank(forces.A[:, free], tol=FORCE_RANK) == int(free.sum()):
+    if full_column_rank(forces.A.tocsc()[:, free], FORCE_RANK):
         return None
-    columns = forces.fixed.size
-    ranges = value_ranges(forces.A, forces.rhs, np.eye(columns)[forces.polytope.normal], np.zeros(columns))
+    normal = np.arange(forces.fixed.size)[forces.polytope.normal]
+    ranges = value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size))
     return ranges if ranges_are_wide(ranges) else None
 
 

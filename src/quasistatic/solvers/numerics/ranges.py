@@ -7,10 +7,12 @@ Everything here is scene-relative, so absolute thresholds (from
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from ...tolerances import AT_LOWER_BOUND, FORCE_RANK, LP_FEASIBILITY, MOTION_RANK, SAME_TWIST
 from ..result import Range
 from .highs import INF, WarmLP, optimise_each, solve_lp
+from .rank import DENSE_MAX, full_column_rank
 
 __all__ = ["null_space", "cone_is_trivial", "twist_extremes", "value_ranges", "ranges_are_wide"]
 
@@ -32,6 +34,8 @@ def null_space(A: np.ndarray, tol: float = MOTION_RANK) -> np.ndarray:
 def cone_is_trivial(equalities: np.ndarray, inequalities: np.ndarray) -> bool:
     """True when ``{d : E d = 0, I d >= 0}`` is only the origin."""
     n = equalities.shape[1] if equalities.size else inequalities.shape[1]
+    if n > DENSE_MAX:
+        return _large_cone_is_trivial(equalities, inequalities)
     basis = null_space(equalities) if equalities.shape[0] else np.eye(n)
     if basis.shape[1] == 0:
         return True
@@ -39,6 +43,26 @@ def cone_is_trivial(equalities: np.ndarray, inequalities: np.ndarray) -> bool:
     if A.shape[0] == 0 or null_space(A).shape[1] > 0:
         return False
     lp = solve_lp(A.sum(axis=0), A, np.zeros(A.shape[0]), np.ones(A.shape[0]), maximize=True)
+    return lp.status == "optimal" and lp.objective <= LP_FEASIBILITY
+
+
+def _large_cone_is_trivial(E: np.ndarray, I: np.ndarray) -> bool:  # noqa: E741 - the names of the docstring
+    """:func:`cone_is_trivial` without a null-space basis (a dense SVD of a matrix as large as the scene).
+
+    The cone is the origin iff (a) ``[E; I]`` has full column rank (else a
+    nonzero ``d`` has ``E d = 0 = I d``) and (b) no ``d`` in it has ``I d != 0``,
+    i.e. ``max sum(I d)`` over ``E d = 0, 0 <= I d <= 1`` is 0: given (a), a
+    nonzero ``d`` in the cone has ``I d >= 0`` and ``I d != 0``, so a multiple
+    of it scores above 0, and (a) keeps that LP's feasible set bounded.
+    """
+    stacked = sp.vstack([sp.csr_matrix(E), sp.csr_matrix(I)], format="csr")
+    if not full_column_rank(stacked, MOTION_RANK):
+        return False
+    if I.shape[0] == 0:
+        return True
+    e, i = E.shape[0], I.shape[0]
+    lower, upper = np.zeros(e + i), np.r_[np.zeros(e), np.ones(i)]
+    lp = solve_lp(np.asarray(I.sum(axis=0)).ravel(), stacked, lower, upper, maximize=True)
     return lp.status == "optimal" and lp.objective <= LP_FEASIBILITY
 
 
@@ -74,22 +98,24 @@ def twist_extremes(
     return points, tuple(free)
 
 
-def value_ranges(A_eq: np.ndarray, b_eq: np.ndarray, targets: np.ndarray, col_lower: np.ndarray) -> list[Range]:
-    """Range of each linear function ``targets[i] . x`` over ``{A_eq x = b_eq, x >= col_lower}``.
+def value_ranges(A_eq: np.ndarray | sp.spmatrix, b_eq: np.ndarray, columns: np.ndarray, col_lower: np.ndarray) -> list[Range]:
+    """Range of each coordinate ``x[j]``, ``j`` in ``columns``, over ``{A_eq x = b_eq, x >= col_lower}``.
 
-    Two LPs per target at most, fewer where the answer is known without one:
-    a target in the row space of ``A_eq`` is constant on the set (its value at
-    any point), and a single coordinate already seen at its lower bound at
-    an optimal vertex of an earlier LP has that bound as its minimum. In a
-    large statically indeterminate set most minima are found this way.
+    Two LPs per coordinate at most, fewer where the answer is known without
+    one: a coordinate whose unit vector lies in the row space of ``A_eq`` is
+    constant on the set (its value at any point), and a coordinate already
+    seen at its lower bound at an optimal vertex of an earlier LP has that
+    bound as its minimum. In a large statically indeterminate set most
+    minima are found this way.
     """
     model = WarmLP(A_eq, b_eq, b_eq, col_lower)
-    constant = _in_row_space(A_eq, targets)
-    coordinate = [_unit_index(t) for t in targets]
+    constant = _in_row_space(A_eq, columns)
     at_bound = np.zeros(A_eq.shape[1], dtype=bool)  # coordinates seen at their lower bound
     ranges: list[Range] = []
-    for target, fixed, j in zip(targets, constant, coordinate, strict=True):
-        if j >= 0 and at_bound[j]:
+    for j, fixed in zip(columns.tolist(), constant.tolist(), strict=True):
+        target = np.zeros(A_eq.shape[1])
+        target[j] = 1.0
+        if at_bound[j]:
             low: float | None = float(col_lower[j])
         else:
             result = model.optimise(target)
@@ -106,22 +132,27 @@ def value_ranges(A_eq: np.ndarray, b_eq: np.ndarray, targets: np.ndarray, col_lo
     return ranges
 
 
-def _unit_index(target: np.ndarray) -> int:
-    """``j`` when ``target`` is the unit vector e_j (the target is one coordinate), else -1."""
-    nonzero = np.flatnonzero(target)
-    return int(nonzero[0]) if nonzero.size == 1 and target[nonzero[0]] == 1.0 else -1
+def _in_row_space(A: np.ndarray | sp.spmatrix, columns: np.ndarray) -> np.ndarray:
+    """Which coordinates ``x[j]`` are combinations of A's rows (constant wherever ``A x`` is fixed).
 
-
-def _in_row_space(A: np.ndarray, targets: np.ndarray) -> np.ndarray:
-    """Which targets are combinations of A's rows (constant wherever ``A x`` is fixed)."""
-    if A.size == 0:
-        return np.all(targets == 0.0, axis=1)
-    _, sigma, vt = np.linalg.svd(A, full_matrices=False)
+    Only worked out when A's smaller side is small (a thin SVD); on a large
+    matrix every coordinate is taken as variable, which costs one more LP
+    each and never a wrong range.
+    """
+    if min(A.shape) == 0 or min(A.shape) > DENSE_MAX:
+        return np.zeros(columns.size, dtype=bool)
+    dense = _dense(A)
+    _, sigma, vt = np.linalg.svd(dense, full_matrices=False)
     basis = vt[sigma > FORCE_RANK * max(1.0, float(sigma[0]))]
-    residual = targets - (targets @ basis.T) @ basis
-    return np.linalg.norm(residual, axis=1) <= MOTION_RANK * np.maximum(1.0, np.linalg.norm(targets, axis=1))
+    # |e_j - P e_j|^2 = 1 - |P e_j|^2 with P the projector on the row space.
+    outside = 1.0 - np.sum(basis[:, columns] ** 2, axis=0)
+    return np.sqrt(np.maximum(outside, 0.0)) <= MOTION_RANK
 
 
 def ranges_are_wide(ranges: list[Range], tol: float = LP_FEASIBILITY) -> bool:
     """True when some range is unbounded or wider than ``tol`` (scene-relative)."""
     return any(hi is None or hi - lo > tol for lo, hi in ranges)
+
+
+def _dense(A: np.ndarray | sp.spmatrix) -> np.ndarray:
+    return np.asarray(A.toarray() if isinstance(A, sp.spmatrix | sp.sparray) else A, dtype=float)

@@ -16,7 +16,7 @@ import numpy as np
 
 from ...model import Body, Contact, Mover, Scene
 
-__all__ = ["Family", "FAMILIES", "grasp_2d", "grasp_3d", "box_push", "pile"]
+__all__ = ["Family", "FAMILIES", "grasp_2d", "grasp_3d", "box_push", "box_rest", "pile"]
 
 
 @dataclass(frozen=True)
@@ -196,6 +196,23 @@ def box_push(n_support: int, instance: int, friction: str = "exact") -> Scene:
     )
 
 
+def box_rest(n_support: int, instance: int, friction: str = "exact") -> Scene:
+    """A 10 cm cube resting on a table under gravity alone, its support face a square grid of ``n_support`` points.
+
+    mu 0.5; no mover moves. Large grids (10,000 points) are the memory test of
+    the frictional methods: their dense matrices would grow as the square of the
+    contacts, so they answer an honest ``failed`` with the audited rest motion.
+    """
+    side = int(round(n_support**0.5))
+    if side * side != n_support:
+        raise ValueError(f"n_support must be a square number, got {n_support}")
+    half = 0.05
+    grid = np.linspace(-half, half, side) if side > 1 else np.zeros(1)
+    contacts = tuple(Contact("box", "table", point=[x, y, 0.0], normal=[0.0, 0.0, 1.0], mu=0.5) for x in grid for y in grid)
+    body = Body("box", mass=1.0, com=[0.0, 0.0, half])
+    return Scene(dimension=3, bodies=(body,), movers=(Mover("table"),), contacts=contacts, friction=friction)
+
+
 def pile(n_boxes: int, instance: int, friction: str = "exact") -> Scene:
     """A planar pile of ``n_boxes`` 10 cm boxes in columns of at most 10, pushed at the side.
 
@@ -300,6 +317,16 @@ FAMILIES: dict[str, Family] = {
             full_instances=1,
             size_label="support points",
             frictionless=True,
+        ),
+        Family(
+            "box-rest",
+            "10 cm cube resting on a grid of N frictional support points under gravity, exact cones",
+            _variant(box_rest, "exact"),
+            quick_sizes=(),
+            full_sizes=(10000,),
+            quick_instances=1,
+            full_instances=1,
+            size_label="support points",
         ),
         Family(
             "pile",
