@@ -14,11 +14,8 @@ Pinocchio; other joint types (floating, planar, spherical) are rejected.
 
 from __future__ import annotations
 
-import contextlib
-import os
 import sysconfig
-import tempfile
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -27,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import BackendUnavailableError, SceneError
+from ..stdio import captured_stderr, first_lines
 from ..tolerances import MAX_FILE_BYTES, MAX_MAGNITUDE
 from .shapes import Pose, Shape, shape_from_coal
 
@@ -36,7 +34,6 @@ FloatArray = npt.NDArray[np.float64]
 
 ROBOTS_INSTALL_HINT = "install the robots extra: pip install 'quasistatic[robots]'"
 _PACKAGE = "package://"
-_MESSAGE_LINES = 2  # lines of urdfdom's own error text kept in a message
 
 
 def installed_model_folders() -> list[Path]:
@@ -79,18 +76,18 @@ class _Kinematics:
     def __init__(self, urdf: Path, package_dirs: Sequence[Path], field: str) -> None:
         pinocchio = _pinocchio()
         text = _urdf_text(urdf, field)  # bounded read: a device or a huge file never reaches the parser
-        with _captured_stderr() as errors:
+        with captured_stderr() as errors:
             try:
                 self.model = pinocchio.buildModelFromXML(text)
             except (ValueError, RuntimeError) as exc:
-                raise SceneError(field, str(urdf), f"not a valid URDF: {_first_lines(errors(), exc)}") from None
+                raise SceneError(field, str(urdf), f"not a valid URDF: {first_lines(errors()) or exc}") from None
             try:
                 # From the file, not the text: mesh paths relative to the URDF resolve from its folder.
                 self.geometry = pinocchio.buildGeomFromUrdf(
                     self.model, str(urdf), pinocchio.GeometryType.COLLISION, package_dirs=[str(d) for d in package_dirs] or None
                 )
             except (ValueError, RuntimeError) as exc:
-                reason = f"its collision geometry cannot be loaded: {_first_lines(errors(), exc)}"
+                reason = f"its collision geometry cannot be loaded: {first_lines(errors()) or exc}"
                 raise SceneError(field, str(urdf), f"{reason} (package:// paths are resolved in package_dirs)") from None
         self.data = self.model.createData()
         self.geometry_data = pinocchio.GeometryData(self.geometry)
@@ -346,32 +343,3 @@ def _pinocchio() -> Any:
     except ImportError:
         raise BackendUnavailableError("Pinocchio", ROBOTS_INSTALL_HINT, needed_for="URDF robots") from None
     return pinocchio
-
-
-@contextlib.contextmanager
-def _captured_stderr() -> Iterator[Any]:
-    """Redirect file descriptor 2 (where urdfdom and assimp print their errors) to a file while parsing.
-
-    Yields a function that returns what was written, for the error message; nothing reaches the user's terminal.
-    """
-    with tempfile.TemporaryFile(mode="w+b") as sink:
-        saved = os.dup(2)
-        os.dup2(sink.fileno(), 2)
-        try:
-            yield lambda: _read_back(sink)
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-
-
-def _read_back(sink: Any) -> str:
-    sink.flush()
-    sink.seek(0)
-    return str(sink.read(4096).decode("utf-8", "replace"))
-
-
-def _first_lines(captured: str, exc: Exception) -> str:
-    """The library's own words: its first lines on stderr ('File ... does not exist'), else the exception."""
-    lines = [line.strip().removeprefix("Error:").strip() for line in captured.splitlines() if line.strip()]
-    kept = [line for line in lines if not line.startswith("at line")][:_MESSAGE_LINES]
-    return "; ".join(kept) or str(exc)

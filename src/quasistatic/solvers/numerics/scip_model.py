@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import SolverError
+from ...stdio import captured_stderr, first_lines
 from ...tolerances import LP_FEASIBILITY
 
 __all__ = ["new_model", "linear", "optimize", "exclude_box"]
@@ -34,10 +35,12 @@ def linear(row: np.ndarray, x: list[Any]) -> Any:
 
 def optimize(scip: Any, method: str) -> str:
     """Run SCIP; its status as text. A crash inside SCIP becomes the library's :class:`SolverError`."""
-    try:
-        scip.optimize()
-    except Exception as exc:  # SCIP raises bare Exceptions on internal failures
-        raise SolverError(method, f"SCIP failed: {exc}") from exc
+    with captured_stderr() as printed:  # SCIP's internal errors go to descriptor 2: kept for the message, not shown
+        try:
+            scip.optimize()
+        except Exception as exc:  # SCIP raises bare Exceptions on internal failures
+            said = first_lines(printed())
+            raise SolverError(method, f"SCIP failed: {exc}" + (f" ({said})" if said else "")) from exc
     return str(scip.getStatus())
 
 
