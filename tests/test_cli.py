@@ -22,7 +22,6 @@ DEMO = ROOT / "src" / "quasistatic" / "examples" / "two_finger_lift.yaml"
 EXPECTED_STATUS = {
     "box_push_3d.yaml": "ambiguous",
     "box_push_shapes.yaml": "ambiguous",
-    "planar_hand.yaml": "ambiguous",
     "puck_push_3d.yaml": "solved",
     "push_up_slope.yaml": "solved",
     "push_into_wall.yaml": "jammed",

@@ -28,7 +28,6 @@ EXPECTED = {
     "puck_push_3d.yaml": "solved",
     "box_push_3d.yaml": "ambiguous",
     "box_push_shapes.yaml": "ambiguous",
-    "planar_hand.yaml": "ambiguous",
     "push_into_wall.yaml": "jammed",
     "topple.yaml": "unstable",
 }

@@ -1,6 +1,6 @@
 """URDF robots through Pinocchio: joints, forward kinematics, point Jacobians, and bad robot input.
 
-The planar hand of ``examples/models/planar_hand.urdf`` has a Jacobian derived by hand; the Allegro hand
+The planar hand of ``examples/robots/models/planar_hand.urdf`` has a Jacobian derived by hand; the Allegro hand
 and the Panda (``example-robot-data``) are checked against finite differences of forward kinematics.
 """
 
@@ -17,7 +17,7 @@ import quasistatic as qs  # noqa: E402
 from quasistatic.adapters.robot import installed_model_folders  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-HAND = EXAMPLES / "models" / "planar_hand.urdf"
+HAND = EXAMPLES / "robots" / "models" / "planar_hand.urdf"
 LINK = 0.08
 ALLEGRO = "package://example-robot-data/robots/allegro_hand_description/urdf/allegro_right_hand.urdf"
 PANDA = "package://example-robot-data/robots/panda_description/urdf/panda.urdf"

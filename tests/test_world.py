@@ -24,7 +24,8 @@ from quasistatic.model.io import scene_to_dict  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 BOX_PUSH = EXAMPLES / "box_push_shapes.yaml"
-HAND = EXAMPLES / "planar_hand.yaml"
+HAND = EXAMPLES / "robots" / "planar_hand.yaml"
+PANDA = EXAMPLES / "robots" / "panda_gripper.yaml"
 SCRIPT = Path(sys.executable).with_name("quasistatic")
 
 
@@ -199,6 +200,11 @@ def test_the_explicit_twin_round_trips_through_the_file_format() -> None:
         (lambda d: d["bodies"]["box"]["shape"].update(boxx=[1, 1, 1]), "bodies.box.shape.boxx"),
         (lambda d: d.update(robots={"arm": {"urdf": "no/such/arm.urdf"}}), "robots.arm.urdf"),
         (lambda d: d.update(contact_detection={"margin": -1.0}), "contact_detection.margin"),
+        (lambda d: d["contact_detection"]["friction"]["pairs"][0].update(between=["box", "fingr"]), "pairs[0].between"),
+        (
+            lambda d: d.update(robots={"arm": {"urdf": str(EXAMPLES / "robots" / "models" / "planar_hand.urdf"), "q": {"elbow": 0.1}}}),
+            "robots.arm.q.elbow",
+        ),
     ],
 )
 def test_bad_geometry_is_one_error_line_naming_the_field(tmp_path: Path, change: Any, field: str) -> None:
@@ -223,3 +229,33 @@ def test_a_missing_robots_extra_says_how_to_install_it(tmp_path: Path) -> None:
         [sys.executable, "-c", code, "solve", str(EXAMPLES / "squeeze.yaml")], capture_output=True, text=True, timeout=60, check=False
     )
     assert plain.returncode == 0, plain.stderr
+
+
+def _solved_json(path: Path) -> dict[str, Any]:
+    """``quasistatic solve PATH --json`` as a user runs it: exit 0, stdout only JSON, stderr empty."""
+    result = _run("solve", str(path), "--json")
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""  # no solver banner, SCIP error line or URDF parser message
+    data: dict[str, Any] = json.loads(result.stdout)
+    return data
+
+
+def test_planar_hand_example_gives_the_answer_its_comment_derives() -> None:
+    data = _solved_json(HAND)
+    assert data["status"] == "ambiguous" and data["certified"] is True
+    lift = data["solutions"][0]
+    assert np.allclose(lift["bodies"]["box"]["twist"], [0.0, 0.0, 0.00958148, 0.0, 0.0, 0.0], atol=1e-7)
+    assert [c["mode"] for c in lift["contacts"]] == ["rolling", "rolling"]
+    assert np.allclose([c["normal_force"] for c in lift["contacts"]], [3.67875, 3.67875], atol=1e-4)
+
+
+@pytest.mark.slow
+def test_panda_gripper_holds_the_box_with_indeterminate_forces() -> None:
+    """The Panda example: certified at rest, every contact rolling, forces indeterminate (about 10-30 s)."""
+    data = _solved_json(PANDA)
+    assert data["status"] == "solved" and data["certified"] is True and data["forces_indeterminate"] is True
+    assert np.allclose(data["bodies"]["box"]["twist"], np.zeros(6), atol=1e-12)
+    assert {c["mode"] for c in data["contacts"]} == {"rolling"}
+    assert len(data["contacts"]) == 12
+    weight = sum(c["normal_force"] for c in data["contacts"] if c["other"] == "table")
+    assert weight == pytest.approx(0.1 * 9.81, rel=1e-9)

@@ -23,4 +23,4 @@ def import_coal() -> ModuleType:
     try:
         return importlib.import_module("coal")
     except ImportError as error:
-        raise BackendUnavailableError("coal", INSTALL_HINT) from error
+        raise BackendUnavailableError("coal", INSTALL_HINT, needed_for="shapes and contact detection") from error

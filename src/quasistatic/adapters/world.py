@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
+from ..errors import SceneError
 from ..model import Body, Contact, FrictionModel, Mover, Robot, Scene
 from ..tolerances import DETECTION_MARGIN
 from .detect import Collider, ContactPoint, detect, nearest_gaps
@@ -113,6 +114,15 @@ class World:
     detection: ContactDetection = field(default_factory=ContactDetection)
     gravity: npt.ArrayLike | None = None
     friction: FrictionModel | str = "exact"
+
+    def __post_init__(self) -> None:
+        parts: list[SolidBody | ShapedMover] = [*self.bodies, *self.movers]
+        known = {p.name for p in parts} | {r.name for r in self.robots} | set(self._link_robot)
+        for index, pair in enumerate(self.detection.pairs):
+            for name in pair.between:
+                if name not in known:
+                    field = f"contact_detection.friction.pairs[{index}].between"
+                    raise SceneError(field, name, "names no body, mover, robot or robot link (robot/link) of the scene")
 
     def detect(self) -> Detection:
         """The contacts within the margin, as solver contacts (normals into the free body, Jacobians for robot links)."""

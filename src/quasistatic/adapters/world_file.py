@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import MISSING, SceneError
 from ..model import Contact, Robot
 from ..model.io import BodyFile, ContactFile, DetectionFile, MoverFile, PoseFile, RobotFile, SceneFile, ShapeFile
 from ..tolerances import MAX_FRICTION
@@ -100,6 +100,8 @@ def _plain_robot(name: str, entry: RobotFile) -> Robot:
     for key in ("package_dirs", "base", "q"):
         if key in entry.model_fields_set:
             raise SceneError(f"{field}.{key}", getattr(entry, key), "only a robot with a urdf takes this key")
+    if entry.joint_velocities is None:
+        raise SceneError(f"{field}.joint_velocities", MISSING, "required key is missing (or give the robot a urdf)")
     if isinstance(entry.joint_velocities, dict):
         reason = "joints can be named only for a robot with a urdf; give a list, one per Jacobian column"
         raise SceneError(f"{field}.joint_velocities", entry.joint_velocities, reason)

@@ -116,7 +116,7 @@ class MoverFile(_FileModel):
 class RobotFile(_FileModel):
     """Joint velocities (a list, or by joint name for a URDF robot); a URDF robot also has its file, base and joints."""
 
-    joint_velocities: list[_Number] | dict[str, _Number] = []
+    joint_velocities: list[_Number] | dict[str, _Number] | None = None
     urdf: str | None = None
     package_dirs: list[str] = []
     base: PoseFile | None = None
@@ -268,11 +268,11 @@ def _com(name: str, body: BodyFile) -> list[float]:
 
 def _velocity_list(name: str, robot: RobotFile) -> list[float]:
     """Joint velocities of a robot with no model: a list (names mean nothing without a URDF)."""
+    if robot.joint_velocities is None:
+        raise SceneError(f"robots.{name}.joint_velocities", MISSING, "required key is missing")
     if isinstance(robot.joint_velocities, dict):
         reason = "joints can be named only for a robot with a urdf; give a list, one per Jacobian column"
         raise SceneError(f"robots.{name}.joint_velocities", robot.joint_velocities, reason)
-    if "joint_velocities" not in robot.model_fields_set:
-        raise SceneError(f"robots.{name}.joint_velocities", MISSING, "required key is missing")
     return robot.joint_velocities
 
 
