@@ -52,7 +52,8 @@ def resolve_package_path(text: str, folders: Sequence[Path], field: str) -> Path
         if (folder / relative).exists():
             return folder / relative
     searched = ", ".join(str(f) for f in folders) or "none (give package_dirs)"
-    raise SceneError(field, text, f"no such file in the package folders searched: {searched}")
+    hint = "; example-robot-data's models install with: pip install 'quasistatic[models]'" if "example-robot-data" in text else ""
+    raise SceneError(field, text, f"no such file in the package folders searched: {searched}{hint}")
 
 
 def link_owner(robot: str, link: str) -> str:
