@@ -249,9 +249,8 @@ def test_planar_hand_example_gives_the_answer_its_comment_derives() -> None:
     assert np.allclose([c["normal_force"] for c in lift["contacts"]], [3.67875, 3.67875], atol=1e-4)
 
 
-@pytest.mark.slow
 def test_panda_gripper_holds_the_box_with_indeterminate_forces() -> None:
-    """The Panda example: certified at rest, every contact rolling, forces indeterminate (about 10-30 s)."""
+    """The Panda example: certified at rest on the exact cones, every contact rolling, forces indeterminate."""
     data = _solved_json(PANDA)
     assert data["status"] == "solved" and data["certified"] is True and data["forces_indeterminate"] is True
     assert np.allclose(data["bodies"]["box"]["twist"], np.zeros(6), atol=1e-12)

@@ -4,6 +4,9 @@
 2. When the contacts' non-penetration alone leaves one twist (proven by a
    bound, :func:`~.certify.cheap.kinematically_unique`), that motion is the
    only one: ``solved``, for any friction model, exact 3-D cones included.
+   On exact 3-D cones, rest with every mover still is proven the only motion
+   on the circles themselves when it is (:mod:`.certify.rest`: the load cannot
+   do work, so loaded contacts stick, and SCIP finds no other such motion).
 3. Otherwise the complete SCIP search of ``scip`` runs. For polyhedral cones
    it starts from Lemke's point once every law of the search's own form is
    checked there, so SCIP only has to prove that no other motion exists
@@ -20,6 +23,7 @@ from ..laws import Problem, RawMotion
 from ..laws.polyhedral import aligned_edges, polyhedral_form
 from .certify.cheap import exact_motion, kinematically_unique, seed_point
 from .certify.exact_cone import solve_exact_3d, unique_exact_motion
+from .certify.rest import REST_PROOF, rest_is_unique
 from .certify.search import certified_polyhedral, summarise
 from .result import BackendResult, Options
 
@@ -51,4 +55,6 @@ def _exact_cones(problem: Problem, options: Options) -> BackendResult:
     motion = exact_motion(problem)
     if motion is not None and kinematically_unique(problem, motion.q):
         return unique_exact_motion(problem, motion, options, _KINEMATIC)
+    if motion is not None and rest_is_unique(problem, motion.q, options):
+        return unique_exact_motion(problem, motion, options, REST_PROOF)
     return solve_exact_3d(problem, options)
