@@ -258,3 +258,23 @@ def test_panda_gripper_holds_the_box_with_indeterminate_forces() -> None:
     assert len(data["contacts"]) == 12
     weight = sum(c["normal_force"] for c in data["contacts"] if c["other"] == "table")
     assert weight == pytest.approx(0.1 * 9.81, rel=1e-9)
+
+
+def test_allegro_example_turns_the_ball_and_holds_it_when_still(tmp_path: Path) -> None:
+    """The Allegro example: its index finger opening turns the ball (thumb and middle rolling, index sliding), with
+    uniqueness proven for the pyramid only; with every joint still, rest is certified on the exact cones."""
+    pytest.importorskip("pinocchio")
+    allegro = EXAMPLES / "robots" / "allegro_ball.yaml"
+    data = _solved_json(allegro)
+    assert data["status"] == "solved" and data["certified"] is False
+    assert [c["mode"] for c in data["contacts"]] == ["rolling", "sliding", "rolling"]
+    assert np.allclose(data["bodies"]["ball"]["twist"][3:], [-0.438498, -0.131465, -0.0237766], atol=1e-5)
+    import yaml
+
+    still = yaml.safe_load(allegro.read_text(encoding="utf-8"))
+    still["robots"]["hand"]["joint_velocities"] = {}
+    path = tmp_path / "still.yaml"
+    path.write_text(yaml.safe_dump(still), encoding="utf-8")
+    held = _solved_json(path)
+    assert held["status"] == "solved" and held["certified"] is True
+    assert np.allclose(held["bodies"]["ball"]["twist"], np.zeros(6), atol=1e-12)

@@ -135,6 +135,8 @@ def _proof(solution: Solution) -> str:
         return "proof: none (failed)"
     if solution.certified:
         return "proof: certified"
+    if solution.friction == "exact" and solution.search_complete is False and solution.status in ("solved", "ambiguous"):
+        return "proof: NOT certified (complete for the inscribed pyramid, not proven for the exact cones; see the message)"
     return "proof: NOT certified (a motion found, not proven the only one; solve with certify=True)"
 
 
