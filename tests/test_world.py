@@ -173,8 +173,6 @@ def test_planar_hand_grasp_has_the_analytic_jacobians() -> None:
         link = contact.other.removeprefix("hand/")
         assert contact.jacobian is not None
         assert np.allclose(contact.jacobian, hand.point_jacobian(link, contact.point))
-    solution = qs.solve(scene)
-    assert solution.status in ("solved", "ambiguous")
 
 
 def test_explicit_contacts_are_added_to_the_found_ones() -> None:
