@@ -128,9 +128,9 @@ def candidate_pairs(colliders: Sequence[Collider], margin: float = 0.0) -> list[
     low, high = _all_bounds(colliders)
     low, high = low - margin / 2.0, high + margin / 2.0
     if len(colliders) <= _ALL_PAIRS:
-        i, j = np.triu_indices(len(colliders), 1)  # already in order
-        near = np.all((low[j] <= high[i]) & (low[i] <= high[j]), axis=1)
-        return list(zip(i[near].tolist(), j[near].tolist(), strict=True))
+        meet = np.all((low[:, None] <= high[None]) & (low[None] <= high[:, None]), axis=2)
+        i, j = np.nonzero(np.triu(meet, 1))  # row by row: already in order
+        return list(zip(i.tolist(), j.tolist(), strict=True))
     axis = _sweep_axis(low, high)
     order = np.argsort(low[:, axis], kind="stable")
     # Rank r meets the ranks after it that start before it ends along the axis: r+1 .. stops[r]-1.
