@@ -12,11 +12,14 @@ import pytest
 from rich.console import Console
 
 import quasistatic as qs
+from quasistatic.adapters.robot import installed_model_folders
 from quasistatic.tools.bench import (
     FAMILIES,
     BenchConfig,
     Row,
     growth_exponents,
+    markdown_tables,
+    pipeline,
     render_result,
     run_benchmarks,
     runner,
@@ -27,7 +30,7 @@ from quasistatic.tools.bench import (
 
 @pytest.fixture(scope="module")
 def result() -> runner.BenchResult:
-    config = BenchConfig(families=("grasp-3d-nf",), methods=("lp", "scipy-dense"), repeat=2, instances=2, batch=False)
+    config = BenchConfig(families=("grasp-3d-nf",), methods=("lp", "scipy-dense"), repeat=2, instances=2, batch=False, robots=False)
     return run_benchmarks(config)
 
 
@@ -118,3 +121,38 @@ def test_contradictions_are_claims_against_the_certified_answer() -> None:
     one = qs.solve(lift, method="paper")
     assert one.status == "solved" and not runner._contradicts(qs.assemble(lift), one, every)
     assert runner._contradicts(qs.assemble(lift), every, qs.solve(lift, method="scip", modes=["rolling", "rolling"]))
+
+
+def test_robot_rows_are_tabled_and_skips_are_said() -> None:
+    rows = (
+        pipeline.PipelineRow("detect growth", 10, 19, 19, 34, 5, 1e-3, 9e-4, 2e-3),
+        pipeline.PipelineRow("detect growth", 20, 38, 38, 68, 5, 2e-3, 1e-3, 3e-3),
+        pipeline.PipelineRow("detect growth", 40, 76, 76, 136, 5, 4e-3, 3e-3, 5e-3),
+        pipeline.PipelineRow("allegro pipeline (certified)", skipped="coal/pinocchio not installed"),
+    )
+    assert pipeline.growth_exponent(list(rows)) == pytest.approx(1.0)
+    config = BenchConfig(batch=False, robots=False)
+    result = runner.BenchResult(config, runner.machine_info(), (), (), 1.0, pipeline=rows)
+    console = Console(file=io.StringIO(), width=200)
+    render_result(result, console)
+    text = console.file.getvalue()  # type: ignore[attr-defined]
+    assert "robots and geometry" in text and "skipped" in text and "near pairs: n^1.00" in text
+    data = result.to_dict()
+    assert data["detect_growth"] == pytest.approx(1.0) and len(data["pipeline"]) == 4
+    assert "| allegro pipeline (certified) |" in markdown_tables(data)
+
+
+def test_robot_scenes_touch_where_they_should() -> None:
+    pytest.importorskip("coal")
+    world = pipeline.resting_rows(10)
+    detection = world.detect()
+    # 5 spheres (1 point on the table) and 5 cubes (4 corners), 9 sphere-cube neighbours in the row (1 point each).
+    assert len(detection.contacts) == 5 + 20 + 9 and max(abs(g) for g in detection.gaps) < 1e-12
+    pytest.importorskip("pinocchio")
+    if not installed_model_folders():
+        pytest.skip("example-robot-data is not installed")
+    world, _ = pipeline.allegro_grasp()
+    detection = world.detect()
+    tips = {c.other for c in detection.contacts if c.other.endswith("_tip")}
+    assert tips == {f"hand/{link}" for link in pipeline.GRASP_TIPS}
+    assert sum(c.other == "table" for c in detection.contacts) == 4 and max(abs(g) for g in detection.gaps) < 1e-9

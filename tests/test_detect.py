@@ -298,6 +298,28 @@ def test_the_broad_phase_finds_every_pair_within_the_margin() -> None:
     assert found == {(f"s{i}", f"s{j}") for i, j in touching}
 
 
+@pytest.mark.parametrize("count", [5, 40, 49, 150])
+def test_the_sweep_gives_exactly_the_pairs_whose_boxes_meet(count: int) -> None:
+    """Below and above the size where the broad phase switches from all pairs at once to the sweep."""
+    rng = np.random.default_rng(count)
+    shapes = [Box(rng.uniform(0.02, 0.2, size=3)), Sphere(0.05), Capsule(0.02, 0.1)]
+    colliders = [Collider(f"c{i}", shapes[i % 3], Pose(rng.uniform(0, 1, size=3), _rotation(rng))) for i in range(count)]
+    colliders.append(TABLE)
+    corners = []
+    for c in colliders[:-1]:
+        local = {Box: lambda s: s.size / 2, Sphere: lambda s: np.full(3, s.radius), Capsule: lambda s: np.array([0.02, 0.02, 0.07])}
+        half = np.abs(c.pose.rotation) @ local[type(c.shape)](c.shape)
+        corners.append((c.pose.position - half - 0.005, c.pose.position + half + 0.005))
+    expected = [
+        (i, j)
+        for i in range(count)
+        for j in range(i + 1, count)
+        if np.all(corners[i][0] <= corners[j][1]) and np.all(corners[j][0] <= corners[i][1])
+    ]
+    expected = sorted(expected + [(i, count) for i in range(count)])  # the table meets everything
+    assert candidate_pairs(colliders, 0.01) == expected
+
+
 def test_pairs_the_caller_excludes_and_shapes_of_one_owner_never_touch() -> None:
     box = Collider("box", Box(SIZE), Pose((0.0, 0.0, 0.15)))
     assert detect([box, TABLE], pairs=lambda a, b: {a, b} != {"box", "table"}) == []

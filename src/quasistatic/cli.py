@@ -285,6 +285,7 @@ def bench(
     budget: Annotated[float | None, typer.Option(min=0.001, help="Seconds of timed solves aimed at per row.")] = None,
     plot: Annotated[Path | None, typer.Option(help="Write the log-log time-vs-contacts plot here (needs matplotlib).")] = None,
     batch: Annotated[bool, typer.Option("--batch/--no-batch", help="Measure solve_many throughput.")] = True,
+    robots: Annotated[bool, typer.Option("--robots/--no-robots", help="Measure robots and geometry (Allegro, detection).")] = True,
     check: Annotated[bool, typer.Option("--check", help="Exit 1 if a method contradicts the certified answer (CI).")] = False,
 ) -> None:
     """Benchmark every method on generated problem families against baselines measured in the same run."""
@@ -302,6 +303,7 @@ def bench(
             cap=cap if cap is not None else (30.0 if full else 5.0),
             row_budget=budget if budget is not None else (5.0 if full else 2.0),
             batch=batch,
+            robots=robots,
         )
     )
     console = make_console()

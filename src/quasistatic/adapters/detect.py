@@ -27,13 +27,18 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import SceneError, SolverError
 from ..tolerances import CONTACT_SEPARATION, CURVED_PATCH_POINTS, DUPLICATE_POINT, NORMAL_LENGTH, PATCH_THICKNESS
 from ._coal import import_coal
 from .shapes import Box, Capsule, Convex, Cylinder, FloatArray, Halfspace, Mesh, Pose, Shape, Sphere, shape_from_coal
 
+BoolArray = npt.NDArray[np.bool_]
+
 __all__ = ["Collider", "ContactPoint", "candidate_pairs", "detect", "nearest_gaps"]
+
+_ALL_PAIRS = 48  # up to this many colliders, testing every pair at once is cheaper than sorting them first
 
 
 @dataclass(frozen=True, init=False)
@@ -102,8 +107,9 @@ def candidate_pairs(colliders: Sequence[Collider], margin: float = 0.0) -> list[
 
     A sweep along the axis where the boxes are most spread out: each box is
     compared only with those that overlap it along that axis, so ``n`` objects
-    spread over a table cost about ``n log n``, not ``n^2``. A halfspace is
-    unbounded and pairs with every collider.
+    spread over a table cost about ``n log n``, not ``n^2``; a few dozen are
+    tested all at once instead (one array operation beats the sort). A halfspace
+    is unbounded and pairs with every collider.
 
     Parameters
     ----------
@@ -119,18 +125,24 @@ def candidate_pairs(colliders: Sequence[Collider], margin: float = 0.0) -> list[
     margin = _margin(margin)
     if len(colliders) < 2:
         return []
-    bounds = np.array([_bounds(c) for c in colliders])  # (n, 2, 3): lower and upper corners
-    low, high = bounds[:, 0] - margin / 2.0, bounds[:, 1] + margin / 2.0
+    low, high = _all_bounds(colliders)
+    low, high = low - margin / 2.0, high + margin / 2.0
+    if len(colliders) <= _ALL_PAIRS:
+        meet = np.all((low[:, None] <= high[None]) & (low[None] <= high[:, None]), axis=2)
+        i, j = np.nonzero(np.triu(meet, 1))  # row by row: already in order
+        return list(zip(i.tolist(), j.tolist(), strict=True))
     axis = _sweep_axis(low, high)
     order = np.argsort(low[:, axis], kind="stable")
-    starts = low[order, axis]
-    pairs = []
-    for rank, i in enumerate(order):
-        stop = int(np.searchsorted(starts, high[i, axis], side="right"))
-        others = order[rank + 1 : stop]
-        near = np.all((low[others] <= high[i]) & (low[i] <= high[others]), axis=1)
-        pairs += [(min(int(i), int(j)), max(int(i), int(j))) for j in others[near]]
-    return sorted(pairs)
+    # Rank r meets the ranks after it that start before it ends along the axis: r+1 .. stops[r]-1.
+    stops = np.searchsorted(low[order, axis], high[order, axis], side="right")
+    counts = np.maximum(stops - np.arange(len(order)) - 1, 0)
+    first = np.repeat(np.arange(len(order)), counts)
+    second = first + 1 + np.arange(first.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    i, j = order[first], order[second]
+    near = np.all((low[j] <= high[i]) & (low[i] <= high[j]), axis=1)
+    lower, upper = np.minimum(i[near], j[near]), np.maximum(i[near], j[near])
+    kept = np.lexsort((upper, lower))
+    return list(zip(lower[kept].tolist(), upper[kept].tolist(), strict=True))
 
 
 def _sweep_axis(low: FloatArray, high: FloatArray) -> int:
@@ -142,19 +154,22 @@ def _sweep_axis(low: FloatArray, high: FloatArray) -> int:
     return int(np.argmax(np.var(centres, axis=0)))
 
 
-def _bounds(collider: Collider) -> tuple[FloatArray, FloatArray]:
-    """World axis-aligned bounding box (lower, upper corner) of a collider [length]."""
-    if isinstance(collider.shape, Halfspace):
-        return np.full(3, -math.inf), np.full(3, math.inf)
-    centre, half = _local_box(collider.shape)
-    rotation = collider.pose.rotation
-    world_centre = rotation @ centre + collider.pose.position
-    world_half = np.abs(rotation) @ half
-    return world_centre - world_half, world_centre + world_half
+def _all_bounds(colliders: Sequence[Collider]) -> tuple[FloatArray, FloatArray]:
+    """World axis-aligned bounding boxes (lower, upper corners, each (n, 3)) of the colliders [length]; a halfspace's is everything."""
+    rotations = np.array([c.pose.rotation for c in colliders])
+    boxes = np.array([c.shape.derived("box", _local_box) for c in colliders])  # (n, 2, 3): centre, half extents
+    centres = np.einsum("nij,nj->ni", rotations, boxes[:, 0]) + np.array([c.pose.position for c in colliders])
+    halves = np.einsum("nij,nj->ni", np.abs(rotations), boxes[:, 1])
+    low, high = centres - halves, centres + halves
+    unbounded = [isinstance(c.shape, Halfspace) for c in colliders]
+    low[unbounded], high[unbounded] = -math.inf, math.inf
+    return low, high
 
 
 def _local_box(shape: Shape) -> tuple[FloatArray, FloatArray]:
-    """Centre and half extents of a bounded shape's box in its own frame [length]."""
+    """Centre and half extents of a shape's box in its own frame [length]; zero for a halfspace (unbounded: the callers handle it)."""
+    if isinstance(shape, Halfspace):
+        return np.zeros(3), np.zeros(3)
     if isinstance(shape, Mesh):
         shape = shape.convex
     if isinstance(shape, Box):
@@ -165,7 +180,7 @@ def _local_box(shape: Shape) -> tuple[FloatArray, FloatArray]:
         return np.zeros(3), np.array([shape.radius, shape.radius, shape.length / 2.0])
     if isinstance(shape, Capsule):
         return np.zeros(3), np.array([shape.radius, shape.radius, shape.length / 2.0 + shape.radius])
-    assert isinstance(shape, Convex)  # a halfspace has no box; the callers handle it
+    assert isinstance(shape, Convex)
     low, high = shape.vertices.min(axis=0), shape.vertices.max(axis=0)
     return (low + high) / 2.0, (high - low) / 2.0
 
@@ -206,17 +221,36 @@ def detect(
     SolverError
         When coal returns no finite normal even for shapes moved apart.
     """
-    coal = import_coal()
-    margin = _margin(margin)
+    query = _Query(import_coal(), _margin(margin), colliders)
     found: list[ContactPoint] = []
-    for i, j in candidate_pairs(colliders, margin):
+    for i, j in candidate_pairs(colliders, query.margin):
         a, b = colliders[i], colliders[j]
         if a.owner == b.owner or (pairs is not None and not pairs(a.owner, b.owner)):
             continue
         if isinstance(a.shape, Halfspace) and isinstance(b.shape, Halfspace):
             continue  # two unbounded shapes: environment against environment, no contact polygon
-        found += _pair_contacts(coal, a, b, margin)
+        found += _pair_contacts(query, i, j)
     return sorted(found, key=lambda c: (c.first, c.second, tuple(c.point)))
+
+
+class _Query:
+    """coal's objects for one detection: the request and result, reused by every pair, and each collider's transform.
+
+    Building them costs more than coal's own query on two primitives, so they are made once per
+    :func:`detect`, not per pair.
+    """
+
+    def __init__(self, coal: Any, margin: float, colliders: Sequence[Collider]) -> None:
+        self.coal, self.margin, self.colliders = coal, margin, colliders
+        self.request = _request(coal, margin)
+        self.moved_request = _request(coal, margin)  # its margin is set per pair
+        self.result = coal.CollisionResult()
+        self._placed: dict[int, Any] = {}
+
+    def transform(self, index: int) -> Any:
+        if index not in self._placed:
+            self._placed[index] = _transform(self.coal, self.colliders[index].pose)
+        return self._placed[index]
 
 
 def nearest_gaps(
@@ -258,22 +292,27 @@ def _margin(value: Any) -> float:
     return float(value)
 
 
-def _pair_contacts(coal: Any, a: Collider, b: Collider, margin: float) -> list[ContactPoint]:
-    """The contact polygon of one pair within ``margin``, as ContactPoints from ``b`` into ``a``."""
+def _pair_contacts(query: _Query, i: int, j: int) -> list[ContactPoint]:
+    """The contact polygon of colliders ``i`` and ``j`` within the margin, as ContactPoints from ``j`` into ``i``."""
+    coal, margin = query.coal, query.margin
+    a, b = query.colliders[i], query.colliders[j]
     size = min(a.shape.extent, b.shape.extent)
     ga, gb = _geometry(coal, a.shape), _geometry(coal, b.shape)
-    tb = _transform(coal, b.pose)
-    rough = _collide(coal, ga, _transform(coal, a.pose), gb, tb, margin)
+    tb = query.transform(j)
+    rough = _collide(query, ga, query.transform(i), gb, tb)
     if rough is None:
         return []
     direction, gap = rough
+    if direction is not None and _exact_normal(a, b, gap):
+        return _one_point(query, a, b, direction, size)
     if direction is None:
         direction, gap = _least_overlap(a, b)
     # Move a away from b until they are apart by CONTACT_SEPARATION * size: GJK then gives the exact normal.
     shift = max(0.0, CONTACT_SEPARATION * size - gap)
     moved = _transform(coal, a.pose, direction * shift)
-    result = coal.CollisionResult()
-    request = _request(coal, margin + 2.0 * shift)
+    result, request = query.result, query.moved_request
+    request.security_margin = margin + 2.0 * shift
+    result.clear()
     coal.collide(ga, moved, gb, tb, request, result)
     if not result.isCollision() or _unit(result.getContact(0).normal) is None:
         raise SolverError("coal", f"no finite contact normal between {a.owner!r} and {b.owner!r}, even moved apart")
@@ -282,6 +321,28 @@ def _pair_contacts(coal: Any, a: Collider, b: Collider, margin: float) -> list[C
     patches = coal.ContactPatchResult(patch_request)
     coal.computeContactPatch(ga, moved, gb, tb, result, patch_request, patches)
     return _patch_points(a, b, patches.getContactPatch(0), direction * shift, margin, size)
+
+
+def _exact_normal(a: Collider, b: Collider, gap: float) -> bool:
+    """Whether coal's first answer is already exact: a sphere whose centre is outside the other shape.
+
+    coal treats a sphere as its centre grown by the radius, so while the centre is outside the
+    other shape (overlap below the radius) its normal and witness points are those of separate
+    shapes, exact to round-off, and the contact is one point: no move apart, no patch needed.
+    """
+    radii = [c.shape.radius for c in (a, b) if isinstance(c.shape, Sphere)]
+    return bool(radii) and gap > -0.5 * max(radii)
+
+
+def _one_point(query: _Query, a: Collider, b: Collider, direction: FloatArray, size: float) -> list[ContactPoint]:
+    """The single contact point of a pair with a sphere, from coal's witness points."""
+    contact = query.result.getContact(0)
+    on_a, on_b = np.array(contact.getNearestPoint1()), np.array(contact.getNearestPoint2())
+    gap = float((on_a - on_b) @ direction)
+    if not gap <= query.margin + PATCH_THICKNESS * size:
+        return []
+    direction.setflags(write=False)
+    return [ContactPoint(a.owner, b.owner, _frozen((on_a + on_b) / 2.0), direction, gap)]
 
 
 def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margin: float, size: float) -> list[ContactPoint]:
@@ -295,11 +356,11 @@ def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margi
     # coal puts every patch point on one plane, at the pair's deepest gap: find each one's own
     # surfaces along the normal, so a face tilted within the margin gets its true gaps.
     slack = DUPLICATE_POINT * size
-    for k in range(count):
-        mid = (on_a[k] + on_b[k]) / 2.0
-        enter, leave = _along(a, mid, -to_b, slack), _along(b, mid, -to_b, slack)
-        if enter is not None and leave is not None:
-            on_a[k], on_b[k] = mid - enter[0] * to_b, mid - leave[1] * to_b
+    mid = (on_a + on_b) / 2.0
+    enter, _, in_a = _spans(a, mid, -to_b, slack)
+    _, leave, in_b = _spans(b, mid, -to_b, slack)
+    both = in_a & in_b
+    on_a[both], on_b[both] = mid[both] - enter[both, None] * to_b, mid[both] - leave[both, None] * to_b
     gaps = (on_b - on_a) @ to_b
     within = (gaps <= margin + PATCH_THICKNESS * size) & np.all(np.isfinite(on_a + on_b), axis=1)
     points, gaps = ((on_a + on_b) / 2.0)[within], gaps[within]
@@ -313,6 +374,8 @@ def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margi
 
 def _polygon_vertices(points: FloatArray, tolerance: float) -> list[int]:
     """Indices of the corners of a polygon given in order (k, 3): no duplicates, no points along an edge."""
+    if len(points) < 2:
+        return list(range(len(points)))
     apart = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2) > tolerance
     kept: list[int] = []
     for k in range(len(points)):
@@ -320,7 +383,8 @@ def _polygon_vertices(points: FloatArray, tolerance: float) -> list[int]:
             kept.append(k)
     while len(kept) > 2:  # drop one edge point at a time: a removal can make its neighbour an edge point too
         ring = points[kept]
-        before, after = np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0)
+        turn = np.arange(len(kept))
+        before, after = ring[turn - 1], ring[(turn + 1) % len(kept)]
         along = after - before
         t = np.clip(np.einsum("ij,ij->i", ring - before, along) / np.maximum(np.einsum("ij,ij->i", along, along), 1e-300), 0.0, 1.0)
         on_edge = np.flatnonzero(np.linalg.norm(ring - (before + t[:, None] * along), axis=1) <= tolerance)
@@ -333,34 +397,39 @@ def _polygon_vertices(points: FloatArray, tolerance: float) -> list[int]:
 # --------------------------------------------------------------------------- a shape along a line
 
 
-def _along(collider: Collider, origin: FloatArray, direction: FloatArray, slack: float) -> tuple[float, float] | None:
-    """``(t_in, t_out)``: the line ``origin + t * direction`` (unit, world) is in the shape for t between them.
+def _spans(collider: Collider, origins: FloatArray, direction: FloatArray, slack: float) -> tuple[FloatArray, FloatArray, BoolArray]:
+    """``(t_in, t_out, hit)``, each (k,): the line ``origins[k] + t * direction`` (unit, world) is in the shape for t between them.
 
-    None when the line misses the shape by more than ``slack`` [length]. A patch corner lies on an
-    edge, which round-off alone could miss: a line that grazes the shape within ``slack`` still
-    gets the (exact) heights where it passes, so a near miss never shifts a gap.
+    ``hit`` is False where the line misses the shape by more than ``slack`` [length]. A patch corner
+    lies on an edge, which round-off alone could miss: a line that grazes the shape within ``slack``
+    still gets the (exact) heights where it passes, so a near miss never shifts a gap. All the lines
+    of one patch share the direction, so they are measured together.
     """
     shape, pose = collider.shape, collider.pose
-    q, u = pose.rotation.T @ (origin - pose.position), pose.rotation.T @ direction
-    if isinstance(shape, Halfspace):
-        return _in_planes(shape.normal[None, :], np.array([shape.offset]), q, u, slack)
-    if isinstance(shape, Box):
-        return _in_planes(np.vstack([np.eye(3), -np.eye(3)]), np.concatenate([shape.size, shape.size]) / 2.0, q, u, slack)
+    q, u = (origins - pose.position) @ pose.rotation, pose.rotation.T @ direction
     if isinstance(shape, Sphere):
         return _in_ball(q, u, shape.radius, slack)
     if isinstance(shape, Cylinder):
         return _in_tube(q, u, shape.radius, shape.length / 2.0, slack)
     if isinstance(shape, Capsule):
-        ends = (np.array([0.0, 0.0, shape.length / 2.0]), np.array([0.0, 0.0, -shape.length / 2.0]))
-        pieces = [_in_tube(q, u, shape.radius, shape.length / 2.0, slack), *(_in_ball(q - e, u, shape.radius, slack) for e in ends)]
-        hits = [piece for piece in pieces if piece is not None]  # a capsule is their union, and convex: one interval
-        return (min(h[0] for h in hits), max(h[1] for h in hits)) if hits else None
+        ends = np.array([0.0, 0.0, shape.length / 2.0])
+        pieces = [_in_tube(q, u, shape.radius, shape.length / 2.0, slack), _in_ball(q - ends, u, shape.radius, slack)]
+        pieces.append(_in_ball(q + ends, u, shape.radius, slack))
+        # A capsule is the union of the three, and convex: one interval, from the pieces the line meets.
+        enter = np.min([np.where(hit, low, math.inf) for low, _, hit in pieces], axis=0)
+        leave = np.max([np.where(hit, high, -math.inf) for _, high, hit in pieces], axis=0)
+        return enter, leave, np.any([hit for _, _, hit in pieces], axis=0)
     normals, offsets = shape.derived("planes", _planes)
-    return _in_planes(normals, offsets, q, u, slack)
+    return _in_planes(normals, offsets, q, u, slack, shape.extent)
 
 
-def _planes(shape: Convex | Mesh) -> tuple[FloatArray, FloatArray]:
-    """Outward unit normals (m, 3) and offsets (m,) of a convex hull's faces: ``normals @ x <= offsets`` inside."""
+def _planes(shape: Shape) -> tuple[FloatArray, FloatArray]:
+    """Outward unit normals (m, 3) and offsets (m,) of a polytope's faces: ``normals @ x <= offsets`` inside."""
+    if isinstance(shape, Halfspace):
+        return shape.normal[None, :], np.array([shape.offset])
+    if isinstance(shape, Box):
+        return np.vstack([np.eye(3), -np.eye(3)]), np.concatenate([shape.size, shape.size]) / 2.0
+    assert isinstance(shape, (Convex, Mesh))  # the curved shapes have their own tests above
     convex = shape.convex if isinstance(shape, Mesh) else shape
     a, b, c = (convex.vertices[convex.triangles[:, k]] for k in range(3))
     normals = np.cross(b - a, c - a)
@@ -368,43 +437,45 @@ def _planes(shape: Convex | Mesh) -> tuple[FloatArray, FloatArray]:
     return normals, np.einsum("ij,ij->i", normals, a)
 
 
-def _in_planes(normals: FloatArray, offsets: FloatArray, q: FloatArray, u: FloatArray, slack: float) -> tuple[float, float] | None:
-    """Where ``q + t u`` satisfies ``normals @ x <= offsets`` (unit normals)."""
-    rate, room = normals @ u, offsets - normals @ q
-    if np.any((rate == 0.0) & (room < -slack)):
-        return None
-    with np.errstate(divide="ignore", invalid="ignore"):  # planes along the line: rate 0, never read below
+def _in_planes(
+    normals: FloatArray, offsets: FloatArray, q: FloatArray, u: FloatArray, slack: float, length: float
+) -> tuple[FloatArray, FloatArray, BoolArray]:
+    """Where ``q[k] + t u`` satisfies ``normals @ x <= offsets`` (unit normals).
+
+    A plane the line comes nearer to by less than ``slack`` over the shape's ``length`` counts as
+    parallel to it: the line through a corner along the contact normal runs along the side faces, and
+    their bounds ``room / rate`` would be round-off divided by round-off, anything at all.
+    """
+    rate, room = normals @ u, offsets - q @ normals.T  # (m,), (k, m)
+    with np.errstate(divide="ignore", invalid="ignore"):  # 0 * inf for a halfspace, x / 0 for parallel planes: never read
+        parallel = (rate == 0.0) | (np.abs(rate) * length <= slack)
         bound = room / rate
-    low = float(np.max(bound[rate < 0.0], initial=-math.inf))
-    high = float(np.min(bound[rate > 0.0], initial=math.inf))
-    return None if low > high + slack else (low, high)
+    low = np.max(np.where(~parallel & (rate < 0.0), bound, -math.inf), axis=1, initial=-math.inf)
+    high = np.min(np.where(~parallel & (rate > 0.0), bound, math.inf), axis=1, initial=math.inf)
+    outside = np.any(parallel & (room < -slack), axis=1)  # along a plane, outside it
+    return low, high, ~outside & (low <= high + slack)
 
 
-def _in_ball(q: FloatArray, u: FloatArray, radius: float, slack: float) -> tuple[float, float] | None:
-    """Where ``q + t u`` (u unit) is within ``radius`` of the origin."""
-    middle = -float(q @ u)
-    room = middle**2 - float(q @ q) + radius**2
-    if room < radius**2 - (radius + slack) ** 2:
-        return None
-    half = math.sqrt(max(room, 0.0))
-    return middle - half, middle + half
+def _in_ball(q: FloatArray, u: FloatArray, radius: float, slack: float) -> tuple[FloatArray, FloatArray, BoolArray]:
+    """Where ``q[k] + t u`` (u unit) is within ``radius`` of the origin."""
+    middle = -(q @ u)
+    room = middle**2 - np.einsum("ij,ij->i", q, q) + radius**2
+    half = np.sqrt(np.maximum(room, 0.0))
+    return middle - half, middle + half, room >= radius**2 - (radius + slack) ** 2
 
 
-def _in_tube(q: FloatArray, u: FloatArray, radius: float, half_length: float, slack: float) -> tuple[float, float] | None:
-    """Where ``q + t u`` (u unit) is within ``radius`` of the z axis and ``half_length`` of the xy plane."""
-    slab = _in_planes(np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]), np.array([half_length, half_length]), q, u, slack)
-    across, off_axis = float(u[0] ** 2 + u[1] ** 2), float(q[0] ** 2 + q[1] ** 2)
-    if slab is None or (across == 0.0 and off_axis > (radius + slack) ** 2):
-        return None
-    if across == 0.0:
-        return slab
-    middle = -float(q[0] * u[0] + q[1] * u[1]) / across
+def _in_tube(q: FloatArray, u: FloatArray, radius: float, half_length: float, slack: float) -> tuple[FloatArray, FloatArray, BoolArray]:
+    """Where ``q[k] + t u`` (u unit) is within ``radius`` of the z axis and ``half_length`` of the xy plane."""
+    slab = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]), np.array([half_length, half_length])
+    low, high, hit = _in_planes(*slab, q, u, slack, 2.0 * max(radius, half_length))
+    across, off_axis = float(u[0] ** 2 + u[1] ** 2), q[:, 0] ** 2 + q[:, 1] ** 2
+    if across == 0.0:  # along the axis: the slab, where the line is within the radius
+        return low, high, hit & (off_axis <= (radius + slack) ** 2)
+    middle = -(q[:, 0] * u[0] + q[:, 1] * u[1]) / across
     room = middle**2 - (off_axis - radius**2) / across
-    if room < -((radius + slack) ** 2 - radius**2) / across:
-        return None
-    half = math.sqrt(max(room, 0.0))
-    low, high = max(slab[0], middle - half), min(slab[1], middle + half)
-    return None if low > high + slack else (low, high)
+    half = np.sqrt(np.maximum(room, 0.0))
+    low, high = np.maximum(low, middle - half), np.minimum(high, middle + half)
+    return low, high, hit & (room >= -((radius + slack) ** 2 - radius**2) / across) & (low <= high + slack)
 
 
 # --------------------------------------------------------------------------- coal queries
@@ -417,10 +488,14 @@ def _request(coal: Any, margin: float) -> Any:
     return request
 
 
-def _collide(coal: Any, ga: Any, ta: Any, gb: Any, tb: Any, margin: float) -> tuple[FloatArray | None, float] | None:
-    """``(direction from b into a or None if coal's is not a unit vector, signed distance)``, or None when apart."""
-    result = coal.CollisionResult()
-    coal.collide(ga, ta, gb, tb, _request(coal, margin), result)
+def _collide(query: _Query, ga: Any, ta: Any, gb: Any, tb: Any) -> tuple[FloatArray | None, float] | None:
+    """``(direction from b into a or None if coal's is not a unit vector, signed distance)``, or None when apart.
+
+    coal's contact stays in ``query.result`` for the caller.
+    """
+    result = query.result
+    result.clear()
+    query.coal.collide(ga, ta, gb, tb, query.request, result)
     if not result.isCollision():
         return None
     contact = result.getContact(0)
@@ -430,15 +505,15 @@ def _collide(coal: Any, ga: Any, ta: Any, gb: Any, tb: Any, margin: float) -> tu
 
 def _unit(vector: Any) -> FloatArray | None:
     """``vector`` as a float array if it is a finite unit vector (within :data:`NORMAL_LENGTH`), else None."""
-    array = np.array(vector, dtype=float)
-    if not np.all(np.isfinite(array)) or abs(float(np.linalg.norm(array)) - 1.0) > NORMAL_LENGTH:
+    x, y, z = (float(v) for v in vector)
+    length = math.sqrt(x * x + y * y + z * z)  # NaN or inf stay so and fail the test below
+    if not abs(length - 1.0) <= NORMAL_LENGTH:
         return None
-    return array / np.linalg.norm(array)
+    return np.array([x / length, y / length, z / length])
 
 
 def _transform(coal: Any, pose: Pose, shift: FloatArray | None = None) -> Any:
-    position = pose.position if shift is None else pose.position + shift
-    return coal.Transform3s(np.array(pose.rotation), np.array(position))
+    return coal.Transform3s(pose.rotation, pose.position if shift is None else pose.position + shift)
 
 
 def _geometry(coal: Any, shape: Shape) -> Any:

@@ -256,7 +256,7 @@ class UrdfRobot:
         """World velocity of the material point of ``link`` at world ``point``, per unit joint velocity: (3, joints)."""
         joint, _ = self._kinematics.link_in_joint[self._link(link)]
         jacobian = self._placement.jacobian * self._kinematics.chain_columns[joint]
-        local = self.base.inverse().apply(np.asarray(point, dtype=float))
+        local = (np.asarray(point, dtype=float) - self.base.position) @ self.base.rotation  # in the model's root frame
         # v(p) = v(origin) + w x p: the linear rows minus p x (angular rows), then turned into the world.
         in_model = jacobian[:3] - _cross_matrix(local) @ jacobian[3:]
         result: FloatArray = self.base.rotation @ in_model
@@ -283,7 +283,8 @@ def _matrix(placement: Any) -> FloatArray:
 
 
 def _pose(matrix: FloatArray) -> Pose:
-    return Pose(position=matrix[:3, 3].copy(), rotation=matrix[:3, :3].copy())
+    """The pose of a rigid matrix from Pinocchio's forward kinematics: orthonormal to round-off, no check needed."""
+    return Pose.from_trusted_arrays(matrix[:3, 3].copy(), matrix[:3, :3].copy())
 
 
 def _per_joint(values: Any, names: tuple[str, ...], field: str) -> FloatArray:

@@ -141,6 +141,20 @@ class Pose:
         )
 
     @classmethod
+    def from_trusted_arrays(cls, position: FloatArray, rotation: FloatArray) -> Pose:
+        """A pose from arrays computed by this package from validated ones (forward kinematics, an inverse).
+
+        For inner loops over arrays already known good: no check, no projection onto SO(3), which would cost
+        more than the forward kinematics itself (a robot builds one pose per collider per configuration).
+        The arrays are made read-only, not copied: the caller hands them over.
+        """
+        pose = cls.__new__(cls)
+        position.setflags(write=False)
+        rotation.setflags(write=False)
+        _assign(pose, position=position, rotation=rotation)
+        return pose
+
+    @classmethod
     def from_rpy(cls, position: npt.ArrayLike, rpy: npt.ArrayLike, field: str = "pose") -> Pose:
         """A pose from roll, pitch, yaw [rad] about the fixed x, y, z axes: ``R = Rz(yaw) Ry(pitch) Rx(roll)`` (URDF)."""
         roll, pitch, yaw = _vector(rpy, f"{field}.rpy", (3,))
@@ -180,7 +194,7 @@ class Pose:
 
     def inverse(self) -> Pose:
         """The pose that undoes this one: ``self.compose(self.inverse())`` is the identity."""
-        return Pose(-(self.rotation.T @ self.position), self.rotation.T)
+        return Pose.from_trusted_arrays(-(self.rotation.T @ self.position), np.array(self.rotation.T))  # R^T of a rotation is one
 
     def apply(self, points: npt.ArrayLike) -> FloatArray:
         """World coordinates of local points, shape (3,) or (n, 3) [length]."""

@@ -128,21 +128,29 @@ class World:
         """The contacts within the margin, as solver contacts (normals into the free body, Jacobians for robot links)."""
         colliders = self._colliders()
         margin = self._margin()
-        points = detect(colliders, self._may_touch, margin)
-        contacts = tuple(self._contact(point) for point in points)
+        free = frozenset(b.name for b in self.bodies)
+
+        def may_touch(first: str, second: str) -> bool:
+            """Only pairs with a free body constrain its motion; two links of one robot, or two movers, never do."""
+            return first in free or second in free
+
+        points = detect(colliders, may_touch, margin)
+        links = self._robot_links()
+        contacts = tuple(self._contact(point, free, links) for point in points)
         touched = {c.body for c in contacts} | {c.other for c in contacts} | {c.body for c in self.contacts}
         lonely = [b.name for b in self.bodies if b.name not in touched and b.shape is not None]
-        isolated = nearest_gaps(colliders, lonely, self._may_touch) if lonely else {}
+        isolated = nearest_gaps(colliders, lonely, may_touch) if lonely else {}
         return Detection(contacts, tuple(p.gap for p in points), margin, isolated)
 
     def scene(self, detection: Detection | None = None) -> Scene:
         """The point-contact Scene at this instant: detected contacts first, then the explicit ones."""
         detection = detection or self.detect()
         contacts = detection.contacts + self.contacts
-        links = sorted({c.other for c in contacts if c.other in self._link_robot})
+        robot_links = self._robot_links()
+        links = sorted({c.other for c in contacts if c.other in robot_links})
         return Scene(
             bodies=[b.body() for b in self.bodies],
-            movers=[m.mover() for m in self.movers] + [Mover(link, robot=self._link_robot[link]) for link in links],
+            movers=[m.mover() for m in self.movers] + [Mover(link, robot=robot_links[link][0].name) for link in links],
             robots=[Robot(r.name, r.joint_velocities) for r in self.robots] + list(self.explicit_robots),
             contacts=contacts,
             dimension=3,
@@ -152,9 +160,9 @@ class World:
 
     # ----------------------------------------------------------------- parts
 
-    @property
-    def _link_robot(self) -> dict[str, str]:
-        return {link_owner(r.name, link): r.name for r in self.robots for link in r.link_names}
+    def _robot_links(self) -> dict[str, tuple[UrdfRobot, str]]:
+        """Each robot link's name as a mover (``hand/link``): its robot and link."""
+        return {link_owner(r.name, link): (r, link) for r in self.robots for link in r.link_names}
 
     def _colliders(self) -> list[Collider]:
         parts: list[SolidBody | ShapedMover] = [*self.bodies, *self.movers]
@@ -167,27 +175,14 @@ class World:
         sizes = [b.shape.extent for b in self.bodies if b.shape is not None]
         return DETECTION_MARGIN * max(sizes, default=1.0)
 
-    def _may_touch(self, first: str, second: str) -> bool:
-        """Only pairs with a free body constrain its motion; two links of one robot, or two movers, never do."""
-        free = {b.name for b in self.bodies}
-        return first in free or second in free
-
-    def _contact(self, point: ContactPoint) -> Contact:
+    def _contact(self, point: ContactPoint, free: frozenset[str], links: dict[str, tuple[UrdfRobot, str]]) -> Contact:
         """A solver contact: the free body first, its normal into it; a robot link's Jacobian at the point."""
-        free = {b.name for b in self.bodies}
         body, other, normal = point.first, point.second, point.normal
         if body not in free:
             body, other, normal = other, body, -normal
-        robot_link = self._robot_link(other)
+        robot_link = links.get(other)
         jacobian = None if robot_link is None else robot_link[0].point_jacobian(robot_link[1], point.point)
         return Contact(body, other, point.point, normal, mu=self._mu(body, other), jacobian=jacobian)
-
-    def _robot_link(self, owner: str) -> tuple[UrdfRobot, str] | None:
-        for robot in self.robots:
-            prefix = f"{robot.name}/"
-            if owner.startswith(prefix):
-                return robot, owner.removeprefix(prefix)
-        return None
 
     def _mu(self, body: str, other: str) -> float:
         names = {body: {body}, other: {other, *_robot_of(other)}}

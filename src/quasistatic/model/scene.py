@@ -9,7 +9,6 @@ stages can trust a Scene without checking it again.
 
 from __future__ import annotations
 
-import dataclasses
 import difflib
 import math
 from collections.abc import Callable, Collection, Iterable, Mapping
@@ -45,9 +44,10 @@ def _array(value: Any, path: str, ndim: int = 1) -> FloatArray:
         raise SceneError(path, value, f"expected {what}") from None
     if array.ndim != ndim:
         raise SceneError(path, value, f"expected {what}")
-    if not np.all(np.isfinite(array)):
-        raise SceneError(path, value, "every entry must be a finite number (no NaN or inf)")
-    if array.size and float(np.max(np.abs(array))) > MAX_MAGNITUDE:
+    # One reduction for both checks (NaN and inf fail it too): detection builds a few arrays per contact.
+    if array.size and not float(np.abs(array).max()) <= MAX_MAGNITUDE:
+        if not np.all(np.isfinite(array)):
+            raise SceneError(path, value, "every entry must be a finite number (no NaN or inf)")
         raise SceneError(path, value, f"every entry must be at most {MAX_MAGNITUDE:g} in magnitude ({_TOO_LARGE})")
     array.setflags(write=False)
     return array
@@ -85,6 +85,16 @@ def _assign(obj: object, **values: Any) -> None:
     """Set the fields of a frozen part while it is being built (its own ``__init__`` only)."""
     for key, value in values.items():
         object.__setattr__(obj, key, value)
+
+
+def _checked_copy(part: T, **changes: Any) -> T:
+    """A copy of an already validated part with some fields replaced by values the caller has checked.
+
+    ``dataclasses.replace`` would run the part's ``__init__`` again and check every field twice.
+    """
+    copy = object.__new__(type(part))
+    copy.__dict__.update(part.__dict__, **changes)
+    return cast(T, copy)
 
 
 @dataclass(frozen=True, init=False)
@@ -366,7 +376,7 @@ class _Parts:
     def _body(self, body: Body) -> Body:
         path = f"bodies.{body.name}"
         wrench = np.zeros(self.twist_size) if body.wrench is None else body.wrench
-        return dataclasses.replace(
+        return _checked_copy(
             body,
             com=_sized(body.com, self.dimension, f"{path}.com"),
             wrench=_sized(_array(wrench, path), self.twist_size, f"{path}.wrench"),
@@ -383,7 +393,7 @@ class _Parts:
                 raise SceneError(f"{path}.robot", mover.robot, _unknown("robot", mover.robot, self.robot_joints))
         twist = np.zeros(self.twist_size) if mover.twist is None else mover.twist
         origin = np.zeros(self.dimension) if mover.origin is None else mover.origin
-        return dataclasses.replace(
+        return _checked_copy(
             mover,
             twist=_sized(_array(twist, path), self.twist_size, f"{path}.twist"),
             origin=_sized(_array(origin, path), self.dimension, f"{path}.origin"),
@@ -398,7 +408,9 @@ class _Parts:
         length = float(np.linalg.norm(normal))
         if abs(length - 1.0) > NORMAL_LENGTH:
             raise SceneError(f"{path}.normal", normal.tolist(), f"must be a unit vector (its length is {length:.6g})")
-        return dataclasses.replace(contact, point=point, normal=normal / length, jacobian=self._jacobian(contact, path))
+        unit = normal / length
+        unit.setflags(write=False)
+        return _checked_copy(contact, point=point, normal=unit, jacobian=self._jacobian(contact, path))
 
     def _check_pair(self, contact: Contact, path: str) -> None:
         if contact.body not in self.body_names:

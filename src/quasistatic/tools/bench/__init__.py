@@ -8,6 +8,7 @@ print and save it. The problem families live in :data:`FAMILIES`.
 
 from .families import FAMILIES, Family
 from .output import markdown_tables, render_result, write_results, write_scaling_plot
+from .pipeline import PipelineRow
 from .runner import BatchRow, BenchConfig, BenchResult, Row, growth_exponents, machine_info, run_benchmarks
 
 __all__ = [
@@ -16,6 +17,7 @@ __all__ = [
     "BenchConfig",
     "BenchResult",
     "Family",
+    "PipelineRow",
     "Row",
     "growth_exponents",
     "machine_info",

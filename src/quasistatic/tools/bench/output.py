@@ -10,6 +10,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from .pipeline import growth_exponent
 from .runner import BenchResult, Row, format_seconds, format_seconds_range, growth_exponents
 
 __all__ = ["render_result", "write_results", "write_scaling_plot", "markdown_tables", "SCALING_FAMILIES"]
@@ -97,6 +98,9 @@ def render_result(result: BenchResult, console: Console) -> None:
             same = "-" if b.matches_serial is None else ("yes" if b.matches_serial else "NO")
             batch.add_row(b.scenes, b.method, str(b.n_jobs), str(b.problems), f"{b.per_second:,.0f}", _counts(b.statuses), same)
         console.print(batch)
+    if result.pipeline:
+        console.print(_pipeline_table(result))
+        console.print(_detect_growth(growth_exponent(list(result.pipeline))))
     growth = growth_exponents(result.rows)
     for family in SCALING_FAMILIES:
         if family in growth:
@@ -108,6 +112,44 @@ def render_result(result: BenchResult, console: Console) -> None:
         f"at start, effective cores for 2 workers {m.get('effective_cores_for_2_workers', '-')}; "
         f"run took {result.wall_seconds:.0f} s"
     )
+
+
+_PIPELINE_COLUMNS = ("case", "objects", "pairs", "near", "contacts", "median", "IQR", "ratio", "answer", "note")
+
+
+def _pipeline_cells(row: dict[str, Any]) -> list[str]:
+    """One robots-and-geometry row as text cells, from ``PipelineRow.to_dict()``."""
+    if row["skipped"]:
+        return [row["case"], "", "", "", "", "skipped", "", "", row["skipped"], ""]
+    answer = f"{row['status']}, certified {'yes' if row['certified'] else 'no'}" if row["status"] else ""
+    return [
+        row["case"],
+        str(row["objects"]),
+        str(row["pairs"]),
+        str(row["near"]),
+        str(row["contacts"]),
+        format_seconds(row["median"]),
+        format_seconds_range(row["p25"], row["p75"]),
+        "-" if row["ratio"] is None else f"{row['ratio']:.3g}",
+        answer,
+        row["note"],
+    ]
+
+
+_PIPELINE_CAPTION = "pairs: after the broad phase; near: left to coal (one side a free body); ratio: baseline / row median"
+
+
+def _detect_growth(slope: float | None) -> str:
+    return "" if slope is None else f"growth of World.detect time with near pairs: n^{slope:.2f}"
+
+
+def _pipeline_table(result: BenchResult) -> Table:
+    table = Table(title="robots and geometry: joint positions to contacts, Jacobians and answers", caption=_PIPELINE_CAPTION)
+    for name in _PIPELINE_COLUMNS[:-1]:  # the notes (what each row times) are in results.md and results.json
+        table.add_column(name, no_wrap=name != "answer")
+    for row in result.pipeline:
+        table.add_row(*_pipeline_cells(row.to_dict())[:-1])
+    return table
 
 
 def _statuses(row: Row) -> str:
@@ -167,6 +209,10 @@ def markdown_tables(data: dict[str, Any]) -> str:
                 f"| {b['scenes']} | {b['method']} | {b['n_jobs']} | {b['problems']} | {b['per_second']:,.0f} "
                 f"| {_counts(b['statuses'])} | {same} |"
             )
+    if data.get("pipeline"):
+        lines += ["", "| " + " | ".join(_PIPELINE_COLUMNS) + " |", "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |"]
+        lines += ["| " + " | ".join(_pipeline_cells(row)) + " |" for row in data["pipeline"]]
+        lines += ["", _PIPELINE_CAPTION + ". " + _detect_growth(data.get("detect_growth"))]
     return "\n".join(lines) + "\n"
 
 

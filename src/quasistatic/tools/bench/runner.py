@@ -36,6 +36,7 @@ from ...solve import solve
 from ...solvers import BACKENDS
 from .families import FAMILIES, Family, grasp_2d
 from .naive import naive_applicable, solve_naive, to_solution
+from .pipeline import PipelineRow, growth_exponent, run_pipeline
 
 __all__ = ["BenchConfig", "Row", "BatchRow", "BenchResult", "run_benchmarks", "machine_info", "growth_exponents"]
 
@@ -69,6 +70,9 @@ class BenchConfig:
         are made for slow methods [s].
     batch : bool
         Also measure ``solve_many`` throughput on small 2-D scenes.
+    robots : bool
+        Also measure robots and geometry: the Allegro hand's detection, Jacobians and
+        whole pipeline, and detection's growth with the pairs (needs the robots extra).
     """
 
     full: bool = False
@@ -79,6 +83,7 @@ class BenchConfig:
     cap: float = 10.0
     row_budget: float = 3.0
     batch: bool = True
+    robots: bool = True
 
     def __post_init__(self) -> None:
         if self.repeat < 1:
@@ -152,6 +157,7 @@ class BenchResult:
     batch: tuple[BatchRow, ...]
     wall_seconds: float
     left_out: tuple[str, ...] = ()
+    pipeline: tuple[PipelineRow, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -162,6 +168,8 @@ class BenchResult:
             "batch": [b.to_dict() for b in self.batch],
             "left_out": list(self.left_out),
             "growth": growth_exponents(self.rows),
+            "pipeline": [p.to_dict() for p in self.pipeline],
+            "detect_growth": growth_exponent(list(self.pipeline)),
         }
 
 
@@ -183,11 +191,12 @@ def run_benchmarks(config: BenchConfig, progress: Progress | None = None) -> Ben
             continue
         rows += _run_family(FAMILIES[name], config, say)
     batch = tuple(_run_batch(config, say)) if config.batch else ()
+    pipeline = tuple(run_pipeline(config.full, config.row_budget, say)) if config.robots else ()
     machine = machine_info()
     if config.batch:
         machine["effective_cores_for_2_workers"] = effective_cores()
     machine["load_average_at_start"] = load_at_start
-    return BenchResult(config, machine, tuple(rows), batch, time.perf_counter() - start, tuple(left_out))
+    return BenchResult(config, machine, tuple(rows), batch, time.perf_counter() - start, tuple(left_out), pipeline)
 
 
 # --------------------------------------------------------------------------- one family
@@ -518,7 +527,7 @@ def machine_info() -> dict[str, Any]:
         pass
     usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     versions: dict[str, str | None] = {}
-    for package in ("quasistatic", "numpy", "scipy", "highspy", "pyscipopt", "numba", "joblib"):
+    for package in ("quasistatic", "numpy", "scipy", "highspy", "pyscipopt", "numba", "joblib", "pin", "coal"):
         try:
             versions[package] = metadata.version(package)
         except metadata.PackageNotFoundError:
