@@ -117,7 +117,7 @@ class World:
 
     def __post_init__(self) -> None:
         parts: list[SolidBody | ShapedMover] = [*self.bodies, *self.movers]
-        known = {p.name for p in parts} | {r.name for r in self.robots} | set(self._link_robot)
+        known = {p.name for p in parts} | {r.name for r in self.robots} | set(self._robot_links())
         for index, pair in enumerate(self.detection.pairs):
             for name in pair.between:
                 if name not in known:
