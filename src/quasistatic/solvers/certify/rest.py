@@ -16,11 +16,12 @@ holding still, a proof on the circle itself is cheap:
    (frictionless ones may slip).
 2. **No motion away from rest.** A motion ``q`` therefore has forces in the
    cones that balance the load using only contacts that are still under
-   ``q``. A mixed-integer program asks for such ``(q, c)`` with ``q`` at least
-   ``DISTINCT_TWIST`` away from rest in some entry, the cones replaced by the
-   pyramid *circumscribed* about each circle (a superset of the exact forces).
-   SCIP proving it infeasible proves that no exact motion leaves the
-   exclusion box around rest, the same box the complete search uses.
+   ``q``. A mixed-integer program asks for such ``(q, c)`` with ``q`` not
+   rest, the cones replaced by the pyramid *circumscribed* about each circle
+   (a superset of the exact forces).
+   Every condition on ``q`` is homogeneous, so asking for ``|q_j| >= 1`` in
+   some entry asks for any twist other than rest; SCIP proving the program
+   infeasible proves that rest is the only motion.
 
 Neither step uses anything the circle does not satisfy, so the proof holds
 for the exact cones themselves; it says nothing when a mover moves, when the
@@ -36,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from ...laws import Problem
-from ...tolerances import DISTINCT_TWIST, ZERO
+from ...tolerances import ZERO
 from ..numerics.highs import solve_lp
 from ..numerics.scip_model import exclude_box, linear, new_model, optimize
 from ..result import Options
@@ -48,6 +49,7 @@ REST_PROOF = (
     "neither open nor slip, and no motion away from rest balances the load that way (SCIP, circumscribed pyramids)"
 )
 _OUTER_EDGES = 8  # edges of the pyramid circumscribed about each friction circle
+_AWAY = 1.0  # |q_j| a twist away from rest reaches in some entry, after scaling (module docstring, step 2)
 
 
 def rest_is_unique(problem: Problem, q: np.ndarray, options: Options) -> bool:
@@ -78,7 +80,10 @@ def _no_motion_away_from_rest(problem: Problem, options: Options) -> bool:
         scip.addCons(linear(wrench[row], flat) == -float(problem.g[row]))
     for i in range(problem.n_contacts):
         scip.addCons(linear(problem.Jn[i], q) >= 0.0)
-    exclude_box(scip, q, np.zeros(problem.n_dof), DISTINCT_TWIST)
+    scip.addCons(linear(problem.g, q) == 0.0)  # step 1: every motion has g . q = 0 (a valid cut that prunes)
+    # Every constraint on q is homogeneous (scaling q by t > 0 keeps (q, c) feasible), so a twist away from
+    # rest exists exactly when one with some |q_j| >= 1 does: the unit box, better conditioned than a tiny one.
+    exclude_box(scip, q, np.zeros(problem.n_dof), _AWAY)
     return optimize(scip, "certified") == "infeasible"
 
 
