@@ -227,6 +227,9 @@ def test_a_missing_robots_extra_says_how_to_install_it(tmp_path: Path) -> None:
         [sys.executable, "-c", code, "solve", str(EXAMPLES / "squeeze.yaml")], capture_output=True, text=True, timeout=60, check=False
     )
     assert plain.returncode == 0, plain.stderr
+    robot = subprocess.run([sys.executable, "-c", code, "solve", str(PANDA)], capture_output=True, text=True, timeout=60, check=False)
+    assert robot.returncode == 2 and robot.stderr.count("\n") == 1
+    assert "Pinocchio, needed for URDF robots" in robot.stderr and "quasistatic[robots]" in robot.stderr
 
 
 def _solved_json(path: Path) -> dict[str, Any]:

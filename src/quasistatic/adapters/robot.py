@@ -181,6 +181,7 @@ class UrdfRobot:
         field: str | None = None,
     ) -> None:
         field = field or f"robots.{name}"
+        _pinocchio()  # the missing extra first: its install also brings the model folders searched below
         folders = [Path(d) for d in package_dirs] + installed_model_folders()
         path = resolve_package_path(str(urdf), folders, f"{field}.urdf")
         kinematics = _Kinematics(path, folders, f"{field}.urdf")
