@@ -24,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import BackendUnavailableError, SceneError
+from ..model import checked_number
 from ..stdio import captured_stderr, first_lines
 from ..tolerances import MAX_FILE_BYTES, MAX_MAGNITUDE
 from .shapes import Pose, Shape, shape_from_coal
@@ -298,7 +299,7 @@ def _per_joint(values: Any, names: tuple[str, ...], field: str) -> FloatArray:
             if joint not in names:
                 shown = ", ".join(names[:8]) + (", ..." if len(names) > 8 else "")
                 raise SceneError(f"{field}.{joint}", joint, f"no joint of that name; the joints are {shown}")
-            result[names.index(joint)] = _finite(value, f"{field}.{joint}")
+            result[names.index(joint)] = checked_number(value, f"{field}.{joint}")
         return result
     if isinstance(values, (str, bytes)) or np.ndim(values) != 1:
         raise SceneError(field, values, "expected a list of numbers, one per joint, or a mapping by joint name")
@@ -307,17 +308,8 @@ def _per_joint(values: Any, names: tuple[str, ...], field: str) -> FloatArray:
     if isinstance(values, np.ndarray) and values.dtype.kind == "f" and np.all(np.abs(values) <= MAX_MAGNITUDE):
         return values.astype(float)  # a simulation's own arrays: checked at once (NaN fails the comparison)
     for index, value in enumerate(values):
-        result[index] = _finite(value, f"{field}[{index}]")
+        result[index] = checked_number(value, f"{field}[{index}]")
     return result
-
-
-def _finite(value: Any, field: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise SceneError(field, value, "expected a number")
-    number = float(value)
-    if not np.isfinite(number) or abs(number) > MAX_MAGNITUDE:
-        raise SceneError(field, value, f"must be a finite number of magnitude at most {MAX_MAGNITUDE:g}")
-    return number
 
 
 def _cross_matrix(vector: FloatArray) -> FloatArray:

@@ -22,7 +22,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import SceneError
-from ..tolerances import MAX_MAGNITUDE, NORMAL_LENGTH, QUATERNION_NORM, ROTATION_ORTHONORMAL
+from ..model import checked_array, checked_number
+from ..tolerances import NORMAL_LENGTH, QUATERNION_NORM, ROTATION_ORTHONORMAL
 from ._coal import import_coal
 
 __all__ = [
@@ -44,42 +45,20 @@ FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 T = TypeVar("T")
 
-_TOO_LARGE = "larger numbers overflow the solvers' products; choose other units"
 
-
-# --------------------------------------------------------------------------- number checks (local: model's are private)
+# --------------------------------------------------------------------------- number checks (the model's, with shapes)
 
 
 def _vector(value: Any, path: str, shape: tuple[int, ...]) -> FloatArray:
     """A read-only float array of the given shape, every entry finite and within :data:`MAX_MAGNITUDE`."""
-    if isinstance(value, (str, bytes, bool)):
-        raise SceneError(path, value, f"expected an array of shape {shape}")
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError, OverflowError):
-        raise SceneError(path, value, f"expected an array of shape {shape}") from None
+    array = checked_array(value, path, ndim=len(shape))
     if array.shape != shape:
         raise SceneError(path, value, f"expected an array of shape {shape}, got shape {array.shape}")
-    _check_finite(array, value, path)
-    array.setflags(write=False)
     return array
 
 
-def _check_finite(array: FloatArray, value: Any, path: str) -> None:
-    if not np.all(np.isfinite(array)):
-        raise SceneError(path, value, "every entry must be a finite number (no NaN or inf)")
-    if array.size and float(np.max(np.abs(array))) > MAX_MAGNITUDE:
-        raise SceneError(path, value, f"every entry must be at most {MAX_MAGNITUDE:g} in magnitude ({_TOO_LARGE})")
-
-
 def _number(value: Any, path: str) -> float:
-    """A finite float within :data:`MAX_MAGNITUDE`."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise SceneError(path, value, "expected a number")
-    number = float(value)
-    if not math.isfinite(number) or abs(number) > MAX_MAGNITUDE:
-        raise SceneError(path, value, f"must be a finite number of magnitude at most {MAX_MAGNITUDE:g}")
-    return number
+    return checked_number(value, path)
 
 
 def _positive(value: Any, path: str) -> float:
@@ -360,13 +339,11 @@ def _hull(value: Any, path: str) -> tuple[FloatArray, IntArray]:
     """Vertices and outward-facing triangles of the convex hull of ``value`` (n, 3), n >= 4, not all in a plane."""
     from scipy.spatial import ConvexHull, QhullError
 
-    try:
-        points = np.array(value, dtype=float)
-    except (TypeError, ValueError, OverflowError):
-        points = np.empty(0)
-    if isinstance(value, (str, bytes)) or points.ndim != 2 or points.shape[1] != 3 or len(points) < 4:
+    if isinstance(value, (str, bytes)) or np.ndim(value) != 2:
         raise SceneError(path, value, "expected at least 4 points (an array of shape (n, 3))")
-    _check_finite(points, value, path)
+    points = checked_array(value, path, ndim=2)
+    if points.shape[1] != 3 or len(points) < 4:
+        raise SceneError(path, value, "expected at least 4 points (an array of shape (n, 3))")
     try:
         hull = ConvexHull(points)
     except QhullError:

@@ -7,7 +7,7 @@ every other stage reads a :class:`Scene`, which is validated here once.
 from .friction import FrictionModel, parse_friction
 from .io import FORMAT_VERSION, load_scene
 from .scales import Scales, scene_scales
-from .scene import Body, Contact, FloatArray, Mover, Robot, Scene
+from .scene import Body, Contact, FloatArray, Mover, Robot, Scene, checked_array, checked_number
 
 __all__ = [
     "FORMAT_VERSION",
@@ -21,5 +21,7 @@ __all__ = [
     "Scene",
     "load_scene",
     "parse_friction",
+    "checked_array",
+    "checked_number",
     "scene_scales",
 ]

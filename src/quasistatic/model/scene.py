@@ -22,7 +22,7 @@ from ..errors import SceneError
 from ..tolerances import MAX_FRICTION, MAX_MAGNITUDE, MAX_NAME_LENGTH, MAX_PYRAMID_EDGES, NORMAL_LENGTH
 from .friction import FrictionModel, parse_friction
 
-__all__ = ["Body", "Mover", "Robot", "Contact", "Scene", "FloatArray"]
+__all__ = ["Body", "Mover", "Robot", "Contact", "Scene", "FloatArray", "checked_array", "checked_number"]
 
 FloatArray = npt.NDArray[np.float64]
 T = TypeVar("T")
@@ -33,7 +33,7 @@ _SHOWN_NAMES = 10  # known names listed when a name names nothing
 _FRICTION_TEXT_LENGTH = 40  # longer text is no friction model ("pyramid:" and a thousand digits)
 
 
-def _array(value: Any, path: str, ndim: int = 1) -> FloatArray:
+def checked_array(value: Any, path: str, ndim: int = 1) -> FloatArray:
     """A read-only float array of ``ndim`` dimensions, every entry finite and within :data:`MAX_MAGNITUDE`."""
     what = "a list of numbers" if ndim == 1 else "a matrix (list of rows) of numbers"
     if isinstance(value, (str, bytes, bool)):
@@ -53,7 +53,7 @@ def _array(value: Any, path: str, ndim: int = 1) -> FloatArray:
     return array
 
 
-def _number(value: Any, path: str, minimum: float | None = None, maximum: float = MAX_MAGNITUDE, why: str = "") -> float:
+def checked_number(value: Any, path: str, minimum: float | None = None, maximum: float = MAX_MAGNITUDE, why: str = "") -> float:
     """A finite float in ``[minimum, maximum]`` (and within :data:`MAX_MAGNITUDE`); ``why`` explains the maximum."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
         raise SceneError(path, value, "expected a number")
@@ -122,9 +122,9 @@ class Body:
         _assign(
             self,
             name=name,
-            mass=_number(mass, f"{path}.mass", minimum=0.0),
-            com=_array(com, f"{path}.com"),
-            wrench=None if wrench is None else _array(wrench, f"{path}.wrench"),
+            mass=checked_number(mass, f"{path}.mass", minimum=0.0),
+            com=checked_array(com, f"{path}.com"),
+            wrench=None if wrench is None else checked_array(wrench, f"{path}.wrench"),
         )
 
 
@@ -157,8 +157,8 @@ class Mover:
         _assign(
             self,
             name=name,
-            twist=None if twist is None else _array(twist, f"{path}.twist"),
-            origin=None if origin is None else _array(origin, f"{path}.origin"),
+            twist=None if twist is None else checked_array(twist, f"{path}.twist"),
+            origin=None if origin is None else checked_array(origin, f"{path}.origin"),
             robot=None if robot is None else _name(robot, f"{path}.robot"),
         )
 
@@ -174,7 +174,7 @@ class Robot:
         _assign(
             self,
             name=_name(name, "robots"),
-            joint_velocities=_array(joint_velocities, f"robots.{name}.joint_velocities"),
+            joint_velocities=checked_array(joint_velocities, f"robots.{name}.joint_velocities"),
         )
 
 
@@ -219,10 +219,10 @@ class Contact:
             self,
             body=_name(body, "contact.body"),
             other=_name(other, "contact.other"),
-            point=_array(point, "contact.point"),
-            normal=_array(normal, "contact.normal"),
-            mu=_number(mu, "contact.mu", minimum=0.0, maximum=MAX_FRICTION, why=_MU_TOO_LARGE),
-            jacobian=None if jacobian is None else _array(jacobian, "contact.jacobian", ndim=2),
+            point=checked_array(point, "contact.point"),
+            normal=checked_array(normal, "contact.normal"),
+            mu=checked_number(mu, "contact.mu", minimum=0.0, maximum=MAX_FRICTION, why=_MU_TOO_LARGE),
+            jacobian=None if jacobian is None else checked_array(jacobian, "contact.jacobian", ndim=2),
         )
 
 
@@ -266,7 +266,7 @@ class Scene:
         dimension = int(dimension)
         model = _friction(friction, dimension)
         default_gravity = [0.0, -9.81] if dimension == 2 else [0.0, 0.0, -9.81]
-        gravity_vector = _sized(_array(default_gravity if gravity is None else gravity, "gravity"), dimension, "gravity")
+        gravity_vector = _sized(checked_array(default_gravity if gravity is None else gravity, "gravity"), dimension, "gravity")
         parts = _Parts(dimension, tuple(bodies), tuple(movers), tuple(robots))
         _assign(
             self,
@@ -379,7 +379,7 @@ class _Parts:
         return _checked_copy(
             body,
             com=_sized(body.com, self.dimension, f"{path}.com"),
-            wrench=_sized(_array(wrench, path), self.twist_size, f"{path}.wrench"),
+            wrench=_sized(checked_array(wrench, path), self.twist_size, f"{path}.wrench"),
         )
 
     def _mover(self, mover: Mover) -> Mover:
@@ -395,8 +395,8 @@ class _Parts:
         origin = np.zeros(self.dimension) if mover.origin is None else mover.origin
         return _checked_copy(
             mover,
-            twist=_sized(_array(twist, path), self.twist_size, f"{path}.twist"),
-            origin=_sized(_array(origin, path), self.dimension, f"{path}.origin"),
+            twist=_sized(checked_array(twist, path), self.twist_size, f"{path}.twist"),
+            origin=_sized(checked_array(origin, path), self.dimension, f"{path}.origin"),
         )
 
     def contact(self, contact: Contact, path: str) -> Contact:
