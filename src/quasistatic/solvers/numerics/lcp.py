@@ -62,15 +62,7 @@ def solve_split_lcp(
     """
     m, d, n = J.shape
     f = frictional.shape[0]
-    Jn = np.ascontiguousarray(J[:, d - 1, :])
-    bn = np.ascontiguousarray(b[:, d - 1])
-    Jt = np.empty((f, d - 1, n))
-    bt = np.empty((f, d - 1))
-    mu_f = np.empty(f)
-    for a in range(f):
-        Jt[a] = J[frictional[a], : d - 1, :]
-        bt[a] = b[frictional[a], : d - 1]
-        mu_f[a] = mu[frictional[a]]
+    Jn, bn, Jt, bt, mu_f = _split_rows(J, b, mu, frictional)
     offsets = np.zeros(f)
     edges = _edges(base, offsets, d - 1)
     M, qv = _assemble(Jn, Jt, bn, bt, mu_f, g, edges, frictional)
@@ -121,6 +113,25 @@ def solve_split_lcp(
 
 
 @njit
+def _split_rows(
+    J: np.ndarray, b: np.ndarray, mu: np.ndarray, frictional: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Normal rows of every contact; tangent rows and mu of the frictional ones (the LCP's blocks)."""
+    m, d, n = J.shape
+    f = frictional.shape[0]
+    Jn = np.ascontiguousarray(J[:, d - 1, :])
+    bn = np.ascontiguousarray(b[:, d - 1])
+    Jt = np.empty((f, d - 1, n))
+    bt = np.empty((f, d - 1))
+    mu_f = np.empty(f)
+    for a in range(f):
+        Jt[a] = J[frictional[a], : d - 1, :]
+        bt[a] = b[frictional[a], : d - 1]
+        mu_f[a] = mu[frictional[a]]
+    return Jn, bn, Jt, bt, mu_f
+
+
+@njit
 def split_lcp_point(
     J: np.ndarray,
     b: np.ndarray,
@@ -139,15 +150,7 @@ def split_lcp_point(
     """
     m, d, n = J.shape
     f = frictional.shape[0]
-    Jn = np.ascontiguousarray(J[:, d - 1, :])
-    bn = np.ascontiguousarray(b[:, d - 1])
-    Jt = np.empty((f, d - 1, n))
-    bt = np.empty((f, d - 1))
-    mu_f = np.empty(f)
-    for a in range(f):
-        Jt[a] = J[frictional[a], : d - 1, :]
-        bt[a] = b[frictional[a], : d - 1]
-        mu_f[a] = mu[frictional[a]]
+    Jn, bn, Jt, bt, mu_f = _split_rows(J, b, mu, frictional)
     edges = _edges(base, np.zeros(f), d - 1)
     M, qv = _assemble(Jn, Jt, bn, bt, mu_f, g, edges, frictional)
     status, z, _, _ = lemke(M, qv, np.ones(qv.shape[0]), pivots_per_row * qv.shape[0], pivot_tol)
