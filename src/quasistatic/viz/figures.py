@@ -259,8 +259,10 @@ def _mover_places(frame: _Frame) -> dict[str, FloatArray]:
 
 def _name(ax: Axes, frame: _Frame, where: FloatArray, name: str) -> None:
     if len(frame.scene.bodies) + len(frame.scene.movers) <= _LABEL_LIMIT:
+        right = where[0] > frame.projection(frame.centre)[0, 0]  # names point away from the middle, into the margin
         offset = 0.02 * frame.size
-        ax.text(where[0] + offset, where[1] + offset, name, fontsize=7, color=EDGE_COLOUR, zorder=7, clip_on=True)
+        x = where[0] - offset if right else where[0] + offset
+        ax.text(x, where[1] + offset, name, fontsize=7, color=EDGE_COLOUR, zorder=7, clip_on=True, ha="right" if right else "left")
 
 
 def _draw_contacts(ax: Axes, frame: _Frame, motion: Motion | None, legend: _Legend) -> None:
@@ -343,7 +345,7 @@ def _draw_twist(ax: Axes, frame: _Frame, name: str, twist: FloatArray, legend: _
 def _finish(ax: Axes, frame: _Frame, label: str, page: list[FloatArray]) -> None:
     points = np.vstack([*page, frame.projection(np.array([lifted(c.point) for c in frame.scene.contacts] or [frame.centre]))])
     low, high = points.min(axis=0), points.max(axis=0)
-    margin = 0.08 * max(float(np.max(high - low)), frame.size * 0.1)
+    margin = 0.12 * max(float(np.max(high - low)), frame.size * 0.1)  # room for the names beside the points
     ax.set_xlim(low[0] - margin, high[0] + margin)
     ax.set_ylim(low[1] - margin, high[1] + margin)
     ax.set_aspect("equal", adjustable="box")
@@ -376,8 +378,9 @@ def _decorate(figure: Figure, axes: list[Axes], solution: Solution, panels: int,
     title = headline(solution)
     if solution.status == "ambiguous" and len(solution.solutions) > panels:
         title += f" (showing {panels} of {len(solution.solutions)} motions)"
-    if solution.forces_indeterminate or any(m.forces_indeterminate for m in solution.solutions):
-        title += " Forces are indeterminate: one consistent distribution is drawn."
+    indeterminate = solution.forces_indeterminate or any(m.forces_indeterminate for m in solution.solutions)
+    if indeterminate:
+        title += " (forces drawn: one consistent distribution)"
     handles = list(legend.handles.values())
     if not own_figure:
         axes[0].set_title(wrapped(title, 60), loc="left")
