@@ -26,8 +26,12 @@ ALLOWED = {
     "solvers": {"model", "laws"},
     "adapters": {"model"},
     "sim": {"model", "adapters", "laws", "solve"},
-    "viz": {"model", "sim"},
+    "viz": {"model", "sim", "adapters"},
 }
+# The ways into viz/ from outside it, besides the CLI: the package root re-exports ``plot`` (matplotlib is
+# loaded only when drawing), and ``Solution._repr_png_`` (a notebook's picture) calls ``viz.chart``, which
+# imports no value type, so the leaf stays free of cycles.
+PICTURE_ENTRIES = {("quasistatic", "quasistatic.viz"), ("quasistatic.solution", "quasistatic.viz.chart")}
 FRONT_DOORS = {"quasistatic.solvers.lp", "quasistatic.solvers.fast", "quasistatic.solvers.scip", "quasistatic.solvers.paper"}
 
 
@@ -92,17 +96,22 @@ def test_each_stage_imports_only_what_it_may(stage: str) -> None:
 
 
 def test_leaves_import_nothing_of_the_package() -> None:
-    bad = [f"{name} imports {target}" for name, target, _ in _edges() if name in LEAVES and target not in LEAVES]
+    bad = [
+        f"{name} imports {target}"
+        for name, target, _ in _edges()
+        if name in LEAVES and target not in LEAVES and (name, target) not in PICTURE_ENTRIES
+    ]
     assert not bad, bad
 
 
 @pytest.mark.parametrize("outer", ["tools", "viz"])
 def test_the_core_never_imports_tools_or_pictures(outer: str) -> None:
-    """tools/ (validation, bench) and viz/ use the library from outside; only the CLI may call them."""
+    """tools/ (validation, bench) and viz/ use the library from outside; only the CLI may call them (and viz's
+    PICTURE_ENTRIES: ``qs.plot`` and a Solution's notebook picture)."""
     bad = [
         f"{name} imports {target}"
         for name, target, _ in _edges()
-        if _stage(target) == outer and _stage(name) != outer and name != "quasistatic.cli"
+        if _stage(target) == outer and _stage(name) != outer and name != "quasistatic.cli" and (name, target) not in PICTURE_ENTRIES
     ]
     assert not bad, bad
 

@@ -26,6 +26,7 @@ from .loading import load_scene, load_world
 from .model import Body, Contact, FrictionModel, Mover, Robot, Scene
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
+from .viz import plot
 
 __version__ = "0.1.0"
 
@@ -67,6 +68,7 @@ __all__ = [
     "assemble",
     "load_scene",
     "load_world",
+    "plot",
     "solve",
     "solve_many",
 ]

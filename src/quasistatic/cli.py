@@ -1,4 +1,4 @@
-"""Command line: ``quasistatic demo | solve SCENE | check SCENE | contacts SCENE | validate | bench``. A thin layer, no physics.
+"""Command line: ``quasistatic demo | solve | plot | check | contacts | validate | bench``. A thin layer, no physics.
 
 Exit codes: 0 when the library gave an answer (``solved``, ``ambiguous``,
 ``jammed`` or ``unstable``: a diagnosis is an answer), 1 when the solve
@@ -105,12 +105,18 @@ def solve_command(
 
 def _loaded(scene_file: Path) -> tuple[Scene, Detection | None]:
     """The scene of a file; for shapes and URDF robots, with the contacts found and what detection saw."""
+    scene, detection, _ = _loaded_world(scene_file)
+    return scene, detection
+
+
+def _loaded_world(scene_file: Path) -> tuple[Scene, Detection | None, World | None]:
+    """As :func:`_loaded`, and the World of shapes the scene came from (None for a file that lists its contacts)."""
     loaded = _guarded(lambda: load_world(scene_file))
     if isinstance(loaded, Scene):
-        return loaded, None
+        return loaded, None, None
     world: World = loaded
     detection = _guarded(world.detect)
-    return _guarded(lambda: world.scene(detection)), detection
+    return _guarded(lambda: world.scene(detection)), detection, world
 
 
 class _StatusLine:
@@ -138,6 +144,38 @@ class _StatusLine:
             self.status.start()
         else:
             self.status.update(text)
+
+
+_PICTURE_FORMATS = (".png", ".svg", ".pdf")
+
+
+@app.command()
+def plot(
+    scene_file: SceneArgument,
+    output: Annotated[Path, typer.Option("--output", "-o", help="Picture file: .png, .svg or .pdf (by its extension).")],
+    method: Annotated[str, typer.Option(help=f"Solver: {', '.join(METHODS)}.")] = "auto",
+    view: Annotated[str, typer.Option(help="How a 3-D scene is seen: iso, xy, xz or yz (a 2-D one: its plane).")] = "iso",
+) -> None:
+    """Solve a scene file and draw the answer: contact modes, forces and slips to scale, the twist (docs/pictures.md)."""
+    from .viz import VIEWS, require_matplotlib, save
+    from .viz import plot as draw
+
+    if output.suffix.lower() not in _PICTURE_FORMATS:
+        _fail(f"--output {str(output)!r}: the extension must be one of {', '.join(_PICTURE_FORMATS)}")
+    if view not in VIEWS:
+        _fail(f"--view {view!r} is not one of {', '.join(VIEWS)}")
+    _guarded(require_matplotlib)
+    scene, detection, world = _loaded_world(scene_file)
+    solution = _guarded(lambda: solve(scene, method=method))
+    if detection is not None:
+        solution = with_detection(solution, detection)
+    figure = _guarded(lambda: draw(solution, world or scene, view=view))
+    try:
+        save(figure, output)
+    except OSError as exc:
+        _fail(f"cannot write {str(output)!r}: {exc.strerror or exc}")
+    typer.echo(f"wrote {output}: {solution.status}")
+    raise typer.Exit(1 if solution.status == "failed" else 0)
 
 
 @app.command()

@@ -422,6 +422,13 @@ class Solution:
             out["fallback"] = {attempt.method: attempt.message for attempt in self.fallback}
         return out
 
+    def _repr_png_(self) -> bytes | None:
+        """Jupyter's picture of this answer: each contact's normal force coloured by its mode (a Solution holds no
+        geometry; ``quasistatic.viz.plot(solution, scene)`` draws it on its scene). None without matplotlib."""
+        from .viz.chart import summary_png  # the one way from a value to the pictures; chart imports no value type
+
+        return summary_png(self)
+
     def to_dict(self) -> dict[str, Any]:
         """Exactly what ``quasistatic solve --json`` prints."""
         out: dict[str, Any] = {
