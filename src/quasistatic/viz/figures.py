@@ -290,9 +290,9 @@ def _draw_arrows(ax: Axes, frame: _Frame, motion: Motion, legend: _Legend, page:
     forces = [(p, lifted(c.force) * frame.force_scale) for p, c in zip(points, motion.contacts, strict=True)]
     slips = [(p, lifted(c.slip) * frame.velocity_scale) for p, c in zip(points, motion.contacts, strict=True) if c.mode == "sliding"]
     if _quiver(ax, frame, forces, FORCE_COLOUR, page):
-        legend.add(f"contact force on the body (1 N = {frame.force_scale:.3g} m)", color=FORCE_COLOUR, **_ARROW)
+        legend.add(f"contact force on the body (x {frame.force_scale:.3g})", color=FORCE_COLOUR, **_ARROW)
     if _quiver(ax, frame, slips, SLIP_COLOUR, page):
-        legend.add(f"slip (1 m/s = {frame.velocity_scale:.3g} m)", color=SLIP_COLOUR, **_ARROW)
+        legend.add(f"slip (x {frame.velocity_scale:.3g})", color=SLIP_COLOUR, **_ARROW)
 
 
 _ARROW: dict[str, Any] = {"linewidth": 2.0, "marker": ">", "markersize": 6}
@@ -321,7 +321,7 @@ def _draw_twist(ax: Axes, frame: _Frame, name: str, twist: FloatArray, legend: _
     tiny = _ZERO * frame.speed
     if float(np.linalg.norm(v)) > tiny:
         _quiver(ax, frame, [(com, v * frame.velocity_scale)], TWIST_COLOUR, page)
-        legend.add(f"com velocity (1 m/s = {frame.velocity_scale:.3g} m)", color=TWIST_COLOUR, **_ARROW)
+        legend.add(f"com velocity (x {frame.velocity_scale:.3g})", color=TWIST_COLOUR, **_ARROW)
     rate = float(np.linalg.norm(w))
     if rate * frame.size <= tiny:
         return
@@ -357,8 +357,8 @@ def _finish(ax: Axes, frame: _Frame, label: str, page: list[FloatArray]) -> None
         _triad(ax, frame.projection)
         return
     names = ("x", "y") if frame.projection.name == "plane" else tuple(frame.projection.name)
-    ax.set_xlabel(f"{names[0]} [m]")
-    ax.set_ylabel(f"{names[1]} [m]")
+    ax.set_xlabel(f"{names[0]} (scene units)")
+    ax.set_ylabel(f"{names[1]} (scene units)")
 
 
 def _triad(ax: Axes, projection: Projection) -> None:
