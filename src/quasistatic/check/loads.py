@@ -128,13 +128,13 @@ class LoadTable:
 
     def _robot(self, robot: _RobotMap) -> RobotLoad:
         torques = _clean(np.einsum("jid,id->j", robot.matrix, self.forces), robot.scale)
-        ranges = None if self.force_set is None else tuple(self.force_set.ranges(robot.matrix))
+        ranges = None if self.force_set is None else _clean_bounds(self.force_set.ranges(robot.matrix), robot.scale)
         exceeded = () if robot.limits is None else self._exceeded(robot, robot.limits, torques, ranges)
         return RobotLoad(robot.robot, robot.joints, torques, ranges, robot.limits, exceeded)
 
     def _mover(self, mover: _MoverMap) -> MoverWrench:
         values = _clean(np.einsum("kid,id->k", mover.matrix, self.forces), mover.scale)
-        ranges = None if self.force_set is None else tuple(self.force_set.ranges(mover.matrix))
+        ranges = None if self.force_set is None else _clean_bounds(self.force_set.ranges(mover.matrix), mover.scale)
         d = self.scene.dimension
         return MoverWrench(mover.mover, mover.origin, values[:d], values[d:], ranges)
 
@@ -168,6 +168,15 @@ def _conflict(force_set: ForceFunctionals, matrix: np.ndarray, allowed: np.ndarr
         if not force_set.feasible(matrix[trial], -allowed[trial], allowed[trial]):
             kept = trial
     return kept
+
+
+def _clean_bounds(ranges: list[Bounds], scale: np.ndarray) -> tuple[Bounds, ...]:
+    """:func:`_clean` for the ends of ranges (an unbounded end, None, stays)."""
+    return tuple((_clean_end(lo, s), _clean_end(hi, s)) for (lo, hi), s in zip(ranges, scale.tolist(), strict=True))
+
+
+def _clean_end(end: float | None, scale: float) -> float | None:
+    return None if end is None else (0.0 if abs(end) <= ROUNDOFF * scale else end)
 
 
 def _clean(values: np.ndarray, scale: np.ndarray) -> np.ndarray:
