@@ -16,7 +16,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ..model import Mover, Robot, Scales, Scene
-from ..solution import Bounds, LoadList, MoverWrench, RobotLoad
+from ..solution import Bounds, MoverWrench, RobotLoad
 from ..tolerances import ROUNDOFF, TORQUE_LIMIT
 
 __all__ = ["ForceFunctionals", "LoadMap", "LoadTable"]
@@ -104,21 +104,28 @@ class LoadTable:
     """A :class:`~quasistatic.solution.LoadSource` over one audited motion's world forces (m, d).
 
     ``force_set`` is None when the forces are unique (or not known to be otherwise): the
-    values are then the only ones, with no ranges. Pickled, it becomes a
-    :class:`~quasistatic.solution.LoadList` of its values (the force set holds solver data).
+    values are then the only ones, with no ranges. Pickled, it keeps its maps instead of
+    the scene, and its force set, so a batch worker ships the LPs' data, not their
+    results: ranges are worked out only where they are read.
     """
 
-    __slots__ = ("scene", "scales", "forces", "force_set")
+    __slots__ = ("scene", "scales", "forces", "force_set", "load_map")
 
     def __init__(self, scene: Scene, scales: Scales, forces: np.ndarray, force_set: ForceFunctionals | None) -> None:
         self.scene, self.scales, self.forces, self.force_set = scene, scales, forces, force_set
+        self.load_map: LoadMap | None = None
 
-    def __reduce__(self) -> tuple[Any, ...]:
-        return (LoadList, (self.robot_loads(), self.mover_wrenches()))
+    def __getstate__(self) -> tuple[Any, ...]:
+        return (self._map(), self.forces, self.force_set)
+
+    def __setstate__(self, state: tuple[Any, ...]) -> None:
+        self.load_map, self.forces, self.force_set = state
 
     def _map(self) -> LoadMap:
-        scales = self.scales
-        return self.scene.derived("load_map", lambda scene: LoadMap(scene, scales))
+        if self.load_map is None:
+            scales = self.scales
+            self.load_map = self.scene.derived("load_map", lambda scene: LoadMap(scene, scales))
+        return self.load_map
 
     def robot_loads(self) -> tuple[RobotLoad, ...]:
         return tuple(self._robot(robot) for robot in self._map().robots)
@@ -135,7 +142,7 @@ class LoadTable:
     def _mover(self, mover: _MoverMap) -> MoverWrench:
         values = _clean(np.einsum("kid,id->k", mover.matrix, self.forces), mover.scale)
         ranges = None if self.force_set is None else _clean_bounds(self.force_set.ranges(mover.matrix), mover.scale)
-        d = self.scene.dimension
+        d = self.forces.shape[1]
         return MoverWrench(mover.mover, mover.origin, values[:d], values[d:], ranges)
 
     def _exceeded(self, robot: _RobotMap, limits: np.ndarray, torques: np.ndarray, ranges: tuple[Bounds, ...] | None) -> tuple[str, ...]:
