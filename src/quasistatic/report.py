@@ -16,7 +16,7 @@ from rich.table import Table
 from rich.text import Text
 
 from .model import Contact
-from .solution import Certificate, CertificateKind, ContactResult, Motion, Solution
+from .solution import Bounds, Certificate, CertificateKind, ContactResult, Motion, MoverWrench, RobotLoad, Solution
 from .tolerances import DISPLAY_ZERO
 
 __all__ = ["render_solution", "render_contacts", "make_console", "format_float", "format_vector"]
@@ -90,14 +90,21 @@ def render_solution(solution: Solution, console: Console) -> None:
     if ambiguous:
         _render_solutions(solution.solutions, console)
     suffix = " (motion 1)" if ambiguous else ""
-    for table in (
+    tables = [
         _twist_table(motion.twists, f"body twists{suffix}"),
         _contact_table(motion.contacts, solution.forces_indeterminate, f"contacts{suffix}"),
-        _power_table(motion),
-        _audit_table(motion),
-    ):
+    ]
+    if motion.robot_loads:
+        tables.append(_torque_table(motion.robot_loads, f"robot joint torques{suffix}"))
+    if motion.mover_wrenches:
+        tables.append(_wrench_table(motion.mover_wrenches, f"mover wrenches{suffix}"))
+    for table in (*tables, _power_table(motion), _audit_table(motion)):
         console.print()
         console.print(table)
+    for robot, joints in motion.torque_limits_exceeded.items():
+        console.print(
+            Text(f"infeasible for robot {robot}: no consistent force distribution keeps {', '.join(joints)} within the torque limits")
+        )
 
 
 def render_contacts(contacts: Sequence[Contact], gaps: Sequence[float], notes: Sequence[str], console: Console) -> None:
@@ -206,6 +213,52 @@ def _format_range(bounds: tuple[float, float | None] | None) -> str:
     return f"[{format_float(lo)}, inf)" if hi is None else f"[{format_float(lo)}, {format_float(hi)}]"
 
 
+def _torque_table(loads: Sequence[RobotLoad], title: str) -> Table:
+    table = _table(title)
+    table.caption = "J^T f: what each joint supplies"
+    table.caption_justify = "left"
+    with_ranges = any(load.torque_ranges is not None for load in loads)
+    with_limits = any(load.torque_limits is not None for load in loads)
+    columns = ["robot", "joint", "torque", *(["range"] if with_ranges else []), *(["limit"] if with_limits else [])]
+    for name in columns:
+        table.add_column(name, justify="left" if name in ("robot", "joint") else "right", overflow="fold")
+    for load in loads:
+        scale = float(np.max(np.abs(load.torques), initial=0.0))
+        for j, joint in enumerate(load.joints):
+            row: list[str | Text] = [Text(load.robot), Text(joint), format_float(load.torques[j], scale)]
+            if with_ranges:
+                row.append(_format_bounds(None if load.torque_ranges is None else load.torque_ranges[j]))
+            if with_limits:
+                over = joint in load.limits_exceeded
+                limit = "-" if load.torque_limits is None else format_float(load.torque_limits[j])
+                row.append(Text(f"{limit} EXCEEDED" if over else limit, style="bold red" if over else ""))
+            table.add_row(*row)
+    return table
+
+
+def _wrench_table(wrenches: Sequence[MoverWrench], title: str) -> Table:
+    table = _table(title)
+    table.caption = "applied to the bodies; moment about origin"
+    table.caption_justify = "left"
+    with_ranges = any(w.ranges is not None for w in wrenches)
+    for name in ("mover", "origin", "force", "moment", *(["ranges (force, moment)"] if with_ranges else [])):
+        table.add_column(name, justify="left" if name == "mover" else "right", overflow="fold")
+    for wrench in wrenches:
+        moment = format_float(wrench.moment[0]) if wrench.moment.size == 1 else format_vector(wrench.moment)
+        row: list[str | Text] = [Text(wrench.mover), format_vector(wrench.origin), format_vector(wrench.force), moment]
+        if with_ranges:
+            row.append("-" if wrench.ranges is None else ", ".join(_format_bounds(b) for b in wrench.ranges))
+        table.add_row(*row)
+    return table
+
+
+def _format_bounds(bounds: Bounds | None) -> str:
+    if bounds is None:
+        return "-"
+    lo, hi = bounds
+    return f"{'(-inf' if lo is None else '[' + format_float(lo)}, {'inf)' if hi is None else format_float(hi) + ']'}"
+
+
 def _power_table(motion: Motion) -> Table:
     table = _table("power balance")
     for name in ("input", "gravity", "dissipation", "residual"):
@@ -244,6 +297,9 @@ def _render_solutions(motions: Sequence[Motion], console: Console) -> None:
         if motion.forces_indeterminate:
             ranges = ", ".join(_format_range(c.normal_force_range) for c in motion.contacts)
             console.print(Text(f"    forces indeterminate; normal-force ranges: {ranges}"))
+        for load in motion.robot_loads:
+            exceeded = f" (torque limits exceeded: {', '.join(load.limits_exceeded)})" if load.limits_exceeded else ""
+            console.print(Text(f"    {load.robot} joint torques: {format_vector(load.torques)}{exceeded}"))
         if motion.continuum and motion.extreme_twists:
             console.print(Text("    extreme twists:"))
             for extreme in motion.extreme_twists:

@@ -21,6 +21,11 @@ __all__ = [
     "Attempt",
     "ContactResult",
     "ContactSource",
+    "RobotLoad",
+    "MoverWrench",
+    "LoadSource",
+    "LoadList",
+    "Bounds",
     "PowerBalance",
     "Audit",
     "Motion",
@@ -29,6 +34,8 @@ __all__ = [
 
 Status = Literal["solved", "ambiguous", "jammed", "unstable", "failed"]
 Mode = Literal["rolling", "sliding", "separating"]
+Bounds = tuple[float | None, float | None]
+"""``(lo, hi)`` of a quantity over every consistent force distribution; None where it is unbounded."""
 
 
 class Diagnosis(enum.Enum):
@@ -135,6 +142,124 @@ class ContactResult:
             lo, hi = self.normal_force_range
             out["normal_force_range"] = [float(lo), None if hi is None else float(hi)]
         return out
+
+
+@dataclass(frozen=True)
+class RobotLoad:
+    """The joint torques a robot must supply to hold one motion's contact forces.
+
+    Sign: ``torques = sum_i J_i^T f_i`` over the robot's contacts, with ``f_i`` the
+    contact force on the free body (:attr:`ContactResult.force`), which is the force the
+    robot's link applies, and ``J_i`` the contact's ``jacobian`` (world velocity of the
+    link's point per unit joint velocity). Then ``torques . qdot = sum_i f_i . (J_i qdot)``:
+    the power the robot puts in through its contacts. A robot holding a weight up sees the
+    torque that raising it would need. Gravity on the robot's own links is not included
+    (the scene does not model their masses).
+
+    Attributes
+    ----------
+    robot : str
+    joints : tuple of str
+        One label per joint, in Jacobian column order: the joint names of a URDF robot (or
+        of ``Robot(joint_names=...)``), else ``joint[0]``, ``joint[1]``, ...
+    torques : array (n_joints,)
+        The torques of the motion's reported force distribution [force x length per
+        radian for a revolute joint, force for a prismatic one].
+    torque_ranges : tuple of (lo, hi) or None
+        When the forces are indeterminate: each torque's range over every force
+        distribution consistent with the motion (None for an unbounded side).
+    torque_limits : array (n_joints,) or None
+        The robot's limits ``|torque_j| <= limit_j``, when the scene gives them.
+    limits_exceeded : tuple of str
+        Joints whose limits no consistent force distribution can meet: the motion is
+        infeasible for this robot. When no joint fails alone but several cannot be met
+        together, a smallest such set of joints. The motion's status is unchanged: the
+        rigid model still predicts it.
+    """
+
+    robot: str
+    joints: tuple[str, ...]
+    torques: np.ndarray
+    torque_ranges: tuple[Bounds, ...] | None = None
+    torque_limits: np.ndarray | None = None
+    limits_exceeded: tuple[str, ...] = ()
+
+    @property
+    def within_limits(self) -> bool:
+        """False when the motion needs more torque than the limits allow at some joint."""
+        return not self.limits_exceeded
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "robot": self.robot,
+            "joints": list(self.joints),
+            "torques": _floats(self.torques),
+            "torque_ranges": _bounds(self.torque_ranges),
+            "torque_limits": None if self.torque_limits is None else _floats(self.torque_limits),
+            "within_limits": self.within_limits,
+            "limits_exceeded": list(self.limits_exceeded),
+        }
+
+
+@dataclass(frozen=True)
+class MoverWrench:
+    """The net wrench a mover applies to the free bodies through its contacts, in one motion.
+
+    Sign: the sum of the contact forces on the bodies (:attr:`ContactResult.force`) at
+    the mover's contacts, and their moment about the mover's ``origin``; what the mover's
+    drive must supply to hold its prescribed motion. The mover itself feels the opposite.
+    A table carrying a box's weight ``m g`` applies ``-m g``.
+
+    Attributes
+    ----------
+    mover : str
+    origin : array (d,)
+        The point the moment is taken about: the mover's ``origin`` (world origin by default) [length].
+    force : array (d,)
+        Net force [force].
+    moment : array (1,) in 2-D (about z) or (3,) in 3-D
+        Net moment about ``origin`` [force x length].
+    ranges : tuple of (lo, hi) or None
+        When the forces are indeterminate: the range of each entry of ``[force, moment]``
+        over every force distribution consistent with the motion.
+    """
+
+    mover: str
+    origin: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    ranges: tuple[Bounds, ...] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "mover": self.mover,
+            "origin": _floats(self.origin),
+            "force": _floats(self.force),
+            "moment": _floats(self.moment),
+            "ranges": _bounds(self.ranges),
+        }
+
+
+class LoadSource(Protocol):
+    """Where a Motion's robot loads and mover wrenches come from: worked out when first read."""
+
+    def robot_loads(self) -> tuple[RobotLoad, ...]: ...
+
+    def mover_wrenches(self) -> tuple[MoverWrench, ...]: ...
+
+
+@dataclass(frozen=True)
+class LoadList:
+    """A :class:`LoadSource` that already holds its values."""
+
+    robots: tuple[RobotLoad, ...] = ()
+    movers: tuple[MoverWrench, ...] = ()
+
+    def robot_loads(self) -> tuple[RobotLoad, ...]:
+        return self.robots
+
+    def mover_wrenches(self) -> tuple[MoverWrench, ...]:
+        return self.movers
 
 
 @dataclass(frozen=True)
@@ -259,6 +384,8 @@ class Motion:
     free_directions : tuple of str
         For an unbounded continuum: the twist entries that grow (``+``) or fall (``-``)
         without bound, e.g. ``("box v_x +",)``.
+    loads : LoadSource
+        The robot loads and mover wrenches, read through :attr:`robot_loads` and :attr:`mover_wrenches`.
     """
 
     twists: dict[str, np.ndarray]
@@ -269,6 +396,7 @@ class Motion:
     extreme_twists: tuple[dict[str, np.ndarray], ...] = ()
     unbounded: bool = False
     free_directions: tuple[str, ...] = ()
+    loads: LoadSource = field(default=LoadList(), repr=False, compare=False)
 
     def __getstate__(self) -> dict[str, Any]:
         # Twists as floats in lists: pickling small arrays costs more than the numbers in them.
@@ -295,6 +423,21 @@ class Motion:
         """The motion is determined but its contact forces are not: each contact carries ``normal_force_range``."""
         return self.source.forces_indeterminate()
 
+    @cached_property
+    def robot_loads(self) -> tuple[RobotLoad, ...]:
+        """Each robot's joint torques (and their ranges and limits), in scene order."""
+        return self.loads.robot_loads()
+
+    @cached_property
+    def mover_wrenches(self) -> tuple[MoverWrench, ...]:
+        """The net wrench of each mover that touches a free body, in scene order."""
+        return self.loads.mover_wrenches()
+
+    @property
+    def torque_limits_exceeded(self) -> dict[str, tuple[str, ...]]:
+        """Robot name -> the joints whose torque limits this motion cannot meet; empty when every limit holds."""
+        return {load.robot: load.limits_exceeded for load in self.robot_loads if load.limits_exceeded}
+
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {
             "bodies": {name: {"twist": _floats(t)} for name, t in self.twists.items()},
@@ -303,6 +446,8 @@ class Motion:
             "power": self.power.to_dict(),
             "audit": self.audit.to_dict(),
             "forces_indeterminate": self.forces_indeterminate,
+            "robot_loads": [load.to_dict() for load in self.robot_loads],
+            "mover_wrenches": [wrench.to_dict() for wrench in self.mover_wrenches],
         }
         if self.continuum:
             out["continuum"] = True
@@ -388,6 +533,16 @@ class Solution:
         return self.motion.power if self.motion else None
 
     @property
+    def robot_loads(self) -> tuple[RobotLoad, ...]:
+        """The reported motion's joint torques per robot (see :class:`RobotLoad`)."""
+        return self.motion.robot_loads if self.motion else ()
+
+    @property
+    def mover_wrenches(self) -> tuple[MoverWrench, ...]:
+        """The reported motion's net wrench per loaded mover (see :class:`MoverWrench`)."""
+        return self.motion.mover_wrenches if self.motion else ()
+
+    @property
     def audit(self) -> Audit | None:
         return self.motion.audit if self.motion else None
 
@@ -445,8 +600,11 @@ class Solution:
             out["contacts"] = motion["contacts"]
             out["power"] = motion["power"]
             out["audit"] = motion["audit"]
+            out["robot_loads"] = motion["robot_loads"]
+            out["mover_wrenches"] = motion["mover_wrenches"]
         else:
             out["bodies"], out["contacts"], out["power"], out["audit"] = {}, [], None, None
+            out["robot_loads"], out["mover_wrenches"] = [], []
         out["solutions"] = [m.to_dict() for m in self.solutions]
         out["diagnosis"] = None if self.diagnosis is None else self.diagnosis.value
         out["certificate"] = None if self.certificate is None else self.certificate.to_dict()
@@ -457,6 +615,12 @@ class Solution:
         if details:
             out["details"] = details
         return out
+
+
+def _bounds(ranges: tuple[Bounds, ...] | None) -> list[list[float | None]] | None:
+    if ranges is None:
+        return None
+    return [[None if lo is None else float(lo) + 0.0, None if hi is None else float(hi) + 0.0] for lo, hi in ranges]
 
 
 def _floats(array: np.ndarray) -> list[float]:

@@ -17,7 +17,7 @@ from functools import partial
 from .adapters import Detection, World
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
 from .errors import QuasistaticError, SolverError
-from .laws import Problem, RawMotion, assemble, free_directions, physical_twists, to_world
+from .laws import Problem, RawMotion, WorldForceSet, assemble, free_directions, physical_twists, to_world
 from .model import Scene
 from .solution import Attempt, Mode, Motion, Solution
 from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, get_backend, too_large
@@ -204,6 +204,7 @@ def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFA
         continuum=raw.continuum,
         unbounded=raw.unbounded,
         free_directions=free_directions(problem, raw.free_axes),
+        force_set=None if raw.force_set is None else WorldForceSet(problem, raw.force_set),
         tolerance=tolerance,
     )
 

@@ -21,6 +21,7 @@ __all__ = [
     "MODE_SPEED",
     "ROUNDOFF",
     "DISPLAY_ZERO",
+    "TORQUE_LIMIT",
     "ZERO",
     "SAME_TWIST",
     "DISTINCT_TWIST",
@@ -84,6 +85,11 @@ ROUNDOFF = 1e-12
 
 DISPLAY_ZERO = 1e-12
 """Entries below this fraction of a column's largest one are printed as 0 (round-off, not data) [-]."""
+
+TORQUE_LIMIT = 1e-6
+"""A joint torque exceeds its limit only by more than this fraction of the scene's force scale times the joint's
+largest lever arm (the largest Jacobian column entry at its contacts): the forces themselves are audited to
+:data:`AUDIT` of the force scale, so a torque exactly at its limit is not called infeasible on round-off [-]."""
 
 # --------------------------------------------------------------------------- solvers: linear algebra and LPs
 

@@ -166,6 +166,9 @@ class UrdfRobot:
         (unnamed joints at 0). Zero by default.
     joint_velocities : list or mapping, optional
         Joint velocities, in the same forms. Zero by default.
+    torque_limits : list or mapping, optional
+        Largest torque magnitude of each joint, in the same forms (a mapping names every joint);
+        a motion that needs more is reported as infeasible for this robot. None: no limits.
     field : str, optional
         Where the robot is in a scene file, for error messages (``robots.hand``).
     """
@@ -179,6 +182,7 @@ class UrdfRobot:
         base: Pose | None = None,
         q: Sequence[float] | Mapping[str, float] | None = None,
         joint_velocities: Sequence[float] | Mapping[str, float] | None = None,
+        torque_limits: Sequence[float] | Mapping[str, float] | None = None,
         field: str | None = None,
     ) -> None:
         field = field or f"robots.{name}"
@@ -187,6 +191,7 @@ class UrdfRobot:
         path = resolve_package_path(str(urdf), folders, f"{field}.urdf")
         kinematics = _Kinematics(path, folders, f"{field}.urdf")
         self._build(name, path, kinematics, base or Pose(), q, joint_velocities, field)
+        self.torque_limits = _limits(torque_limits, kinematics.joint_names, f"{field}.torque_limits")
 
     def _build(
         self,
@@ -216,6 +221,7 @@ class UrdfRobot:
     ) -> UrdfRobot:
         """The same robot at another configuration (what is not given is kept); the URDF is not parsed again."""
         robot = UrdfRobot.__new__(UrdfRobot)
+        robot.torque_limits = self.torque_limits
         robot._build(
             self.name,
             self.urdf,
@@ -310,6 +316,16 @@ def _per_joint(values: Any, names: tuple[str, ...], field: str) -> FloatArray:
     for index, value in enumerate(values):
         result[index] = checked_number(value, f"{field}[{index}]")
     return result
+
+
+def _limits(values: Any, names: tuple[str, ...], field: str) -> FloatArray | None:
+    """Torque limits as :func:`_per_joint` reads them, except that a mapping must name every joint (no limit is not 0)."""
+    if values is None:
+        return None
+    if isinstance(values, Mapping) and set(values) != set(names) and set(values) <= set(names):
+        missing = ", ".join(n for n in names if n not in values)
+        raise SceneError(field, dict(values), f"name every joint (missing: {missing})")
+    return _per_joint(values, names, field)
 
 
 def _cross_matrix(vector: FloatArray) -> FloatArray:

@@ -151,7 +151,7 @@ class World:
         return Scene(
             bodies=[b.body() for b in self.bodies],
             movers=[m.mover() for m in self.movers] + [Mover(link, robot=robot_links[link][0].name) for link in links],
-            robots=[Robot(r.name, r.joint_velocities) for r in self.robots] + list(self.explicit_robots),
+            robots=[_robot(r) for r in self.robots] + list(self.explicit_robots),
             contacts=contacts,
             dimension=3,
             gravity=self.gravity,
@@ -196,3 +196,8 @@ class World:
 def _robot_of(owner: str) -> Iterable[str]:
     """``hand`` for ``hand/link``: a friction pair may name the whole robot."""
     return owner.split("/", 1)[:1] if "/" in owner else ()
+
+
+def _robot(robot: UrdfRobot) -> Robot:
+    """The solver's view of a URDF robot: its joint velocities, names and torque limits."""
+    return Robot(robot.name, robot.joint_velocities, joint_names=robot.joint_names, torque_limits=robot.torque_limits)

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import MISSING, SceneError
 from ..model import Contact, Robot
-from ..model.io import BodyFile, ContactFile, DetectionFile, MoverFile, PoseFile, RobotFile, SceneFile, ShapeFile
+from ..model.io import BodyFile, ContactFile, DetectionFile, MoverFile, PoseFile, RobotFile, SceneFile, ShapeFile, plain_robot
 from ..tolerances import MAX_FRICTION
 from .robot import UrdfRobot
 from .shapes import Box, Capsule, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere
@@ -82,6 +82,8 @@ def _mover(name: str, entry: MoverFile | None, folder: Path) -> ShapedMover:
 def _robot(name: str, entry: RobotFile, folder: Path) -> UrdfRobot:
     field = f"robots.{name}"
     assert entry.urdf is not None
+    if entry.joint_names is not None:
+        raise SceneError(f"{field}.joint_names", entry.joint_names, "a robot with a urdf has its own joint names")
     with _within(field):
         return UrdfRobot(
             name,
@@ -90,6 +92,7 @@ def _robot(name: str, entry: RobotFile, folder: Path) -> UrdfRobot:
             base=_pose(entry.base, f"{field}.base"),
             q=entry.q,
             joint_velocities=entry.joint_velocities,
+            torque_limits=entry.torque_limits,
             field=field,
         )
 
@@ -105,7 +108,7 @@ def _plain_robot(name: str, entry: RobotFile) -> Robot:
     if isinstance(entry.joint_velocities, dict):
         reason = "joints can be named only for a robot with a urdf; give a list, one per Jacobian column"
         raise SceneError(f"{field}.joint_velocities", entry.joint_velocities, reason)
-    return Robot(name, entry.joint_velocities)
+    return plain_robot(name, entry)
 
 
 def _shape(entry: ShapeFile, folder: Path, field: str) -> Shape:

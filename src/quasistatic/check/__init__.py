@@ -5,12 +5,16 @@ only: no assembly and no solver code, so a bug there cannot hide here.
 """
 
 from .audit import DEFAULT_TOLERANCE, AuditGeometry, audit_motion, audit_motion_velocities, power_balance, relative_velocities
+from .loads import ForceFunctionals, LoadMap, LoadTable
 from .motion import ContactTable, MotionGeometry, audited_motion
 
 __all__ = [
     "DEFAULT_TOLERANCE",
     "AuditGeometry",
     "ContactTable",
+    "ForceFunctionals",
+    "LoadMap",
+    "LoadTable",
     "MotionGeometry",
     "audit_motion",
     "audit_motion_velocities",

@@ -20,6 +20,7 @@ from ..model import Scales, Scene
 from ..solution import ContactResult, Mode, Motion, PowerBalance
 from ..tolerances import AUDIT, MODE_SPEED, ROUNDOFF
 from .audit import AuditGeometry, audit_arrays
+from .loads import ForceFunctionals, LoadTable
 
 __all__ = ["audited_motion", "ContactTable", "MotionGeometry"]
 
@@ -33,6 +34,7 @@ class MotionGeometry:
     """
 
     def __init__(self, scene: Scene, scales: Scales) -> None:
+        self.scene = scene
         self.audit = AuditGeometry.of(scene)
         self.names = tuple(b.name for b in scene.bodies)
         self.pairs = tuple((c.body, c.other) for c in scene.contacts)
@@ -57,6 +59,7 @@ def audited_motion(
     continuum: bool = False,
     unbounded: bool = False,
     free_directions: tuple[str, ...] = (),
+    force_set: ForceFunctionals | None = None,
     tolerance: float = AUDIT,
 ) -> Motion:
     """Audit one motion on the original scene data and name each contact's mode.
@@ -70,11 +73,16 @@ def audited_motion(
     ranges : list of (lo, hi), a function returning one, or None
         Physical normal-force ranges, when the forces are indeterminate [force]; a
         function is called when the contacts' results are first read.
+    force_set : ForceFunctionals, optional
+        With indeterminate forces: every world force distribution consistent with the motion,
+        for the ranges of robot torques and mover wrenches (:mod:`.loads`).
     """
     audit, power, evaluation = audit_arrays(geometry.audit, twists, forces, scales, tolerance)
     table = ContactTable(geometry.pairs, forces, evaluation.slips, evaluation.normal, geometry.threshold, ranges, geometry.roundoff)
     named = dict(zip(geometry.names, _drop_roundoff(np.array(twists, dtype=float), geometry.twist_roundoff), strict=True))
-    return Motion(named, table, _clean_power(power, geometry.power_roundoff), audit, continuum, extreme_twists, unbounded, free_directions)
+    loads = LoadTable(geometry.scene, scales, forces, force_set)
+    power = _clean_power(power, geometry.power_roundoff)
+    return Motion(named, table, power, audit, continuum, extreme_twists, unbounded, free_directions, loads)
 
 
 @njit

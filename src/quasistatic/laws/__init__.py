@@ -6,6 +6,18 @@ type aliases) only. Every solver builds on these; the audit never does.
 
 from .assemble import Problem, assemble
 from .modes import ModeMasks, contact_modes, slips
-from .motion import RawMotion, free_directions, physical_twists, to_world
+from .motion import ForceSet, RawMotion, WorldForceSet, free_directions, physical_twists, to_world
 
-__all__ = ["ModeMasks", "Problem", "RawMotion", "assemble", "contact_modes", "free_directions", "physical_twists", "slips", "to_world"]
+__all__ = [
+    "ForceSet",
+    "ModeMasks",
+    "Problem",
+    "RawMotion",
+    "WorldForceSet",
+    "assemble",
+    "contact_modes",
+    "free_directions",
+    "physical_twists",
+    "slips",
+    "to_world",
+]

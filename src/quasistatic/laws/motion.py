@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -11,7 +12,24 @@ from ..jit import HAVE_NUMBA, njit
 from ..model import FloatArray
 from .assemble import Problem
 
-__all__ = ["RawMotion", "WorldLayout", "to_world", "physical_twists", "free_directions"]
+__all__ = ["RawMotion", "ForceSet", "WorldForceSet", "WorldLayout", "to_world", "physical_twists", "free_directions"]
+
+Bounds = tuple[float | None, float | None]
+
+
+class ForceSet(Protocol):
+    """Every force distribution consistent with one motion, as a solver knows it (scene-relative, contact frames).
+
+    ``functionals`` (r, m, d) weigh each contact's contact-frame force ``c`` (tangent(s), then normal).
+    """
+
+    def ranges(self, functionals: FloatArray) -> list[Bounds]:
+        """Min and max of each ``sum_i functionals[r, i] . c_i`` over the set (None for an unbounded side)."""
+        ...
+
+    def feasible(self, functionals: FloatArray, lower: FloatArray, upper: FloatArray) -> bool:
+        """Whether some distribution in the set has ``lower <= functionals . c <= upper``."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -37,6 +55,9 @@ class RawMotion:
         Instead of ``force_ranges``: a function that works them out when first
         read (they cost two LPs per loaded contact, most of a frictionless
         solve); its presence alone says the forces are indeterminate.
+    force_set : ForceSet or None
+        With indeterminate forces: the set of consistent forces itself, for the ranges
+        of robot torques and mover wrenches (LPs run only when those are read).
     """
 
     q: FloatArray
@@ -46,6 +67,7 @@ class RawMotion:
     free_axes: tuple[int, ...] = ()
     force_ranges: tuple[tuple[float, float | None], ...] | None = None
     lazy_ranges: Callable[[], tuple[tuple[float, float | None], ...]] | None = field(default=None, repr=False, compare=False)
+    force_set: ForceSet | None = field(default=None, repr=False, compare=False)
 
     @property
     def continuum(self) -> bool:
@@ -68,6 +90,29 @@ class WorldLayout:
         self.names = tuple(b.name for b in scene.bodies)
         self.units = np.array([scales.velocity] * d + [scales.velocity / scales.length] * (k - d))
         self.frames = np.ascontiguousarray(problem.frames, dtype=float)
+
+
+class WorldForceSet:
+    """A :class:`ForceSet` read in physical units and world frame: functionals (r, m, d) on world forces [force].
+
+    A world force is ``f_i = F R_i^T c_i`` (``R_i`` the contact frame's rows, ``F`` the force
+    scale), so ``w_i . f_i = (F R_i w_i) . c_i``: the functionals are turned into contact
+    frames and scaled, and the values come out physical.
+    """
+
+    def __init__(self, problem: Problem, raw: ForceSet) -> None:
+        self.frames = _layout(problem).frames
+        self.force = problem.scales.force
+        self.raw = raw
+
+    def _relative(self, functionals: FloatArray) -> FloatArray:
+        return np.einsum("isj,rij->ris", self.frames, np.asarray(functionals, dtype=float)) * self.force
+
+    def ranges(self, functionals: FloatArray) -> list[Bounds]:
+        return self.raw.ranges(self._relative(functionals))
+
+    def feasible(self, functionals: FloatArray, lower: FloatArray, upper: FloatArray) -> bool:
+        return self.raw.feasible(self._relative(functionals), lower, upper)
 
 
 def _layout(problem: Problem) -> WorldLayout:

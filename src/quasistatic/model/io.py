@@ -29,7 +29,7 @@ from ..errors import MISSING, SceneError
 from ..tolerances import MAX_DEPTH, MAX_FILE_BYTES, MAX_VALUES
 from .scene import Body, Contact, Mover, Robot, Scene
 
-__all__ = ["load_scene", "read_scene_file", "scene_from_file", "scene_to_dict", "SceneFile", "FORMAT_VERSION"]
+__all__ = ["load_scene", "read_scene_file", "scene_from_file", "scene_to_dict", "plain_robot", "SceneFile", "FORMAT_VERSION"]
 
 FORMAT_VERSION = 1
 
@@ -114,9 +114,14 @@ class MoverFile(_FileModel):
 
 
 class RobotFile(_FileModel):
-    """Joint velocities (a list, or by joint name for a URDF robot); a URDF robot also has its file, base and joints."""
+    """Joint velocities (a list, or by joint name for a URDF robot); a URDF robot also has its file, base and joints.
+
+    Optional: torque limits (one magnitude per joint); joint names for a robot without a URDF (its own otherwise).
+    """
 
     joint_velocities: list[_Number] | dict[str, _Number] | None = None
+    torque_limits: list[_Number] | dict[str, _Number] | None = None
+    joint_names: list[str] | None = None
     urdf: str | None = None
     package_dirs: list[str] = []
     base: PoseFile | None = None
@@ -223,9 +228,17 @@ def scene_from_file(parsed: SceneFile) -> Scene:
         friction=parsed.friction,
         bodies=tuple(Body(name, b.mass, _com(name, b), b.wrench) for name, b in parsed.bodies.items()),
         movers=tuple(Mover(name, m.twist, m.origin, m.robot) if m is not None else Mover(name) for name, m in parsed.movers.items()),
-        robots=tuple(Robot(name, _velocity_list(name, r)) for name, r in parsed.robots.items()),
+        robots=tuple(plain_robot(name, r) for name, r in parsed.robots.items()),
         contacts=tuple(_contact(c, index) for index, c in enumerate(parsed.contacts)),
     )
+
+
+def plain_robot(name: str, robot: RobotFile) -> Robot:
+    """The Robot of a file entry without a URDF: joint velocities and torque limits as lists."""
+    if isinstance(robot.torque_limits, dict):
+        reason = "joints can be named only for a robot with a urdf; give a list, one per Jacobian column"
+        raise SceneError(f"robots.{name}.torque_limits", robot.torque_limits, reason)
+    return Robot(name, _velocity_list(name, robot), joint_names=robot.joint_names, torque_limits=robot.torque_limits)
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
@@ -237,9 +250,18 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "friction": str(scene.friction),
         "bodies": {b.name: {"mass": b.mass, "com": b.com.tolist(), "wrench": _listed(b.wrench)} for b in scene.bodies},
         "movers": {m.name: _mover_entry(m) for m in scene.movers},
-        "robots": {r.name: {"joint_velocities": r.joint_velocities.tolist()} for r in scene.robots},
+        "robots": {r.name: _robot_entry(r) for r in scene.robots},
         "contacts": [_contact_entry(c) for c in scene.contacts],
     }
+
+
+def _robot_entry(robot: Robot) -> dict[str, Any]:
+    entry: dict[str, Any] = {"joint_velocities": robot.joint_velocities.tolist()}
+    if robot.joint_names is not None:
+        entry["joint_names"] = list(robot.joint_names)
+    if robot.torque_limits is not None:
+        entry["torque_limits"] = robot.torque_limits.tolist()
+    return entry
 
 
 def _mover_entry(mover: Mover) -> dict[str, Any]:

@@ -165,17 +165,66 @@ class Mover:
 
 @dataclass(frozen=True, init=False)
 class Robot:
-    """A robot given by its joint velocities [rad/s or length/s per joint]."""
+    """A robot given by its joint velocities, one per column of its contacts' Jacobians.
+
+    Attributes
+    ----------
+    name : str
+    joint_velocities : array (n_joints,)
+        [rad/time for a revolute joint, length/time for a prismatic one].
+    joint_names : tuple of str or None
+        One name per joint, for reports (a URDF robot's own); None labels them ``joint[j]``.
+    torque_limits : array (n_joints,) or None
+        Largest joint torque magnitude each joint can supply [force x length, or force for a
+        prismatic joint], >= 0; a motion that needs more is reported as infeasible for this robot.
+    """
 
     name: str
     joint_velocities: FloatArray
+    joint_names: tuple[str, ...] | None
+    torque_limits: FloatArray | None
 
-    def __init__(self, name: str, joint_velocities: npt.ArrayLike) -> None:
+    def __init__(
+        self,
+        name: str,
+        joint_velocities: npt.ArrayLike,
+        *,
+        joint_names: Iterable[str] | None = None,
+        torque_limits: npt.ArrayLike | None = None,
+    ) -> None:
+        path = f"robots.{_name(name, 'robots')}"
+        velocities = checked_array(joint_velocities, f"{path}.joint_velocities")
         _assign(
             self,
-            name=_name(name, "robots"),
-            joint_velocities=checked_array(joint_velocities, f"robots.{name}.joint_velocities"),
+            name=name,
+            joint_velocities=velocities,
+            joint_names=None if joint_names is None else _joint_names(joint_names, velocities.size, f"{path}.joint_names"),
+            torque_limits=None if torque_limits is None else _torque_limits(torque_limits, velocities.size, f"{path}.torque_limits"),
         )
+
+    def joint_labels(self) -> tuple[str, ...]:
+        """The joint names, or ``joint[0]``, ``joint[1]``, ... when none were given."""
+        return self.joint_names or tuple(f"joint[{j}]" for j in range(self.joint_velocities.size))
+
+
+def _joint_names(names: Iterable[str], count: int, path: str) -> tuple[str, ...]:
+    if isinstance(names, str):
+        raise SceneError(path, names, "expected a list of names, one per joint")
+    checked = tuple(_name(n, path) for n in names)
+    if len(checked) != count:
+        raise SceneError(path, list(checked), f"expected {count} names, one per joint")
+    if len(set(checked)) != count:
+        raise SceneError(path, list(checked), "joint names must be unique")
+    return checked
+
+
+def _torque_limits(limits: npt.ArrayLike, count: int, path: str) -> FloatArray:
+    array = checked_array(limits, path)
+    if array.shape != (count,):
+        raise SceneError(path, array.tolist(), f"expected {count} numbers, one per joint (as joint_velocities)")
+    if np.any(array < 0.0):
+        raise SceneError(path, array.tolist(), "every limit is a torque magnitude: >= 0")
+    return array
 
 
 @dataclass(frozen=True, init=False)

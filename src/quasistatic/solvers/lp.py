@@ -27,6 +27,7 @@ from ..laws import Problem, RawMotion
 from ..solution import Certificate, CertificateKind, Diagnosis
 from ..tolerances import FORCE_RANK, JACOBI_ORTHOGONAL, LEMKE_PAIR, LP_FEASIBILITY, MODE_SPEED, MOTION_RANK, PIVOT, ZERO
 from .certify.diagnose import MESSAGES, kinematic_certificate
+from .numerics.forces import FrictionlessForces
 from .numerics.highs import INF, solve_lp
 from .numerics.lcp import PIVOTS_PER_ROW, solve_split_lcp
 from .numerics.lemke import SOLUTION
@@ -73,7 +74,8 @@ def solve_frictionless(problem: Problem, options: Options) -> BackendResult:
     if forces_unique:
         return BackendResult("solved", "solved: one motion with unique contact forces", (RawMotion(q, c),))
     # The ranges cost two LPs per closed contact (most of a solve): worked out only when first read.
-    motion = RawMotion(q, c, lazy_ranges=partial(_force_ranges, Jn, g, closed))
+    consistent = FrictionlessForces(Jn, g, closed, problem.dimension)
+    motion = RawMotion(q, c, lazy_ranges=partial(_force_ranges, Jn, g, closed), force_set=consistent)
     return BackendResult("solved", "solved: one motion; the contact forces are indeterminate", (motion,))
 
 

@@ -75,8 +75,11 @@ def _with_force_ranges(form: LCPForm, motion: RawMotion) -> RawMotion:
     """A single motion with its normal-force ranges when its forces are indeterminate (a continuum's forces vary along it)."""
     if motion.continuum:
         return motion
-    ranges = force_ranges(form.problem, form.edges, motion.q)
-    return motion if ranges is None else dataclasses.replace(motion, force_ranges=tuple(ranges))
+    found = force_ranges(form.problem, form.edges, motion.q)
+    if found is None:
+        return motion
+    ranges, consistent = found
+    return dataclasses.replace(motion, force_ranges=tuple(ranges), force_set=consistent)
 
 
 @dataclass

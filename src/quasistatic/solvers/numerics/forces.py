@@ -7,12 +7,16 @@ maximum-dissipation face of its friction polygon, a rolling one anywhere in
 its polygon, and together they balance the load. The set is a polytope; the
 certified search reports each normal force's range over it
 (:func:`force_ranges`), the exact-cone refinement picks its point of least
-total normal force (:func:`least_normal_forces`).
+total normal force (:func:`least_normal_forces`). A :class:`ConsistentForces`
+keeps the set with the motion, for the ranges of what else the forces
+determine (a robot's joint torques, a mover's wrench) and whether limits on
+them can be met, worked out only when they are read.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -22,10 +26,10 @@ from ...laws.polyhedral import ForcePolytope, aligned_edges, force_polytope
 from ...tolerances import FORCE_RANK, ZERO
 from ..result import Range
 from .highs import solve_lp
-from .ranges import ranges_are_wide, value_ranges
+from .ranges import Bounds, linear_ranges, ranges_are_wide, rows_feasible, value_ranges
 from .rank import full_column_rank
 
-__all__ = ["ForcesAtTwist", "forces_at_twist", "force_ranges", "least_normal_forces"]
+__all__ = ["ForcesAtTwist", "ConsistentForces", "FrictionlessForces", "forces_at_twist", "force_ranges", "least_normal_forces"]
 
 _MOVING = ZERO * 10  # scene-relative speed or dissipation rate above which a contact opens or slides
 
@@ -48,6 +52,70 @@ class ForcesAtTwist:
         p = self.polytope
         beta = x[p.beta].reshape(p.m, p.K)
         return np.column_stack([np.einsum("mk,mkt->mt", beta, self.edges), x[p.normal]])
+
+    def consistent(self) -> ConsistentForces:
+        """The same set, with the linear map :meth:`contact_forces` as a sparse matrix."""
+        p = self.polytope
+        m, K, t = self.edges.shape
+        d = t + 1
+        contact = np.repeat(np.arange(m), K * t)
+        rows = contact * d + np.tile(np.arange(t), m * K)  # tangent entry t of contact i
+        cols = p.beta.start + np.repeat(np.arange(m * K), t)
+        rows = np.r_[rows, np.arange(m) * d + t]  # then each normal force
+        cols = np.r_[cols, np.arange(m) + p.normal.start]
+        values = np.r_[self.edges.ravel(), np.ones(m)]
+        M = sp.csr_matrix((values, (rows, cols)), shape=(m * d, self.fixed.size))
+        return ConsistentForces(self.A, self.rhs, M)
+
+
+@dataclass(frozen=True)
+class ConsistentForces:
+    """Every force distribution consistent with one motion: ``{x >= 0 : A x = rhs}``, contact-frame forces ``c = M x``.
+
+    ``c`` is scene-relative, flattened (m d,), contact-major with the normal last, as a
+    backend's forces. A :class:`~quasistatic.laws.ForceSet`.
+    """
+
+    A: sp.csr_matrix
+    rhs: np.ndarray
+    M: sp.csr_matrix
+
+    def ranges(self, functionals: np.ndarray) -> list[Bounds]:
+        """Range of each ``functionals[r] . c`` (functionals (r, m, d)) over the set; None for an unbounded side."""
+        return linear_ranges(self.A, self.rhs, self._rows(functionals), np.zeros(self.A.shape[1]))
+
+    def feasible(self, functionals: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
+        """Whether some point of the set has ``lower <= functionals . c <= upper``."""
+        return rows_feasible(self.A, self.rhs, self._rows(functionals), lower, upper, np.zeros(self.A.shape[1]))
+
+    def _rows(self, functionals: np.ndarray) -> np.ndarray:
+        return np.asarray((sp.csr_matrix(functionals.reshape(functionals.shape[0], -1)) @ self.M).toarray())
+
+
+class FrictionlessForces:
+    """The forces of a frictionless motion: normal forces ``c >= 0`` on the ``closed`` contacts with ``Jn_C^T c = -g``.
+
+    A :class:`~quasistatic.laws.ForceSet` whose matrices are built when it is first read
+    (a frictionless solve takes about 0.1 ms; most callers never ask).
+    """
+
+    def __init__(self, Jn: np.ndarray, g: np.ndarray, closed: np.ndarray, dimension: int) -> None:
+        self.Jn, self.g, self.closed, self.dimension = Jn, g, closed, dimension
+
+    @cached_property
+    def _set(self) -> ConsistentForces:
+        columns = np.flatnonzero(self.closed)
+        normal_rows = columns * self.dimension + self.dimension - 1
+        M = sp.csr_matrix(
+            (np.ones(columns.size), (normal_rows, np.arange(columns.size))), shape=(self.closed.size * self.dimension, columns.size)
+        )
+        return ConsistentForces(sp.csr_matrix(self.Jn[self.closed]).T.tocsr(), -self.g, M)
+
+    def ranges(self, functionals: np.ndarray) -> list[Bounds]:
+        return self._set.ranges(functionals)
+
+    def feasible(self, functionals: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
+        return self._set.feasible(functionals, lower, upper)
 
 
 def forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: ModeMasks) -> ForcesAtTwist:
@@ -83,15 +151,15 @@ def _measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeM
     return ModeMasks(closed, closed & ~sliding & (problem.mu > 0), sliding)
 
 
-def force_ranges(problem: Problem, edges: np.ndarray, q: np.ndarray) -> list[Range] | None:
-    """Normal-force ranges (scene-relative) over all forces consistent with twist ``q``; None when the forces are unique."""
+def force_ranges(problem: Problem, edges: np.ndarray, q: np.ndarray) -> tuple[list[Range], ConsistentForces] | None:
+    """Normal-force ranges (scene-relative) over all forces consistent with twist ``q``, and that set; None when the forces are unique."""
     forces = forces_at_twist(problem, edges, q, _measured_masks(problem, edges, q))
     free = ~forces.fixed
     if full_column_rank(forces.A.tocsc()[:, free], FORCE_RANK):
         return None
     normal = np.arange(forces.fixed.size)[forces.polytope.normal]
     ranges = value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size))
-    return ranges if ranges_are_wide(ranges) else None
+    return (ranges, forces.consistent()) if ranges_are_wide(ranges) else None
 
 
 def least_normal_forces(problem: Problem, q: np.ndarray, masks: ModeMasks, edge_count: int) -> np.ndarray | None:

@@ -14,7 +14,9 @@ from ..result import Range
 from .highs import INF, WarmLP, optimise_each, solve_lp
 from .rank import DENSE_MAX, full_column_rank
 
-__all__ = ["null_space", "cone_is_trivial", "twist_extremes", "value_ranges", "ranges_are_wide"]
+__all__ = ["null_space", "cone_is_trivial", "twist_extremes", "value_ranges", "ranges_are_wide", "linear_ranges", "rows_feasible"]
+
+Bounds = tuple[float | None, float | None]
 
 
 def null_space(A: np.ndarray, tol: float = MOTION_RANK) -> np.ndarray:
@@ -130,6 +132,44 @@ def value_ranges(A_eq: np.ndarray | sp.spmatrix, b_eq: np.ndarray, columns: np.n
             at_bound |= result.x <= col_lower + AT_LOWER_BOUND
         ranges.append((max(low or 0.0, 0.0), result.objective if result.status == "optimal" else None))
     return ranges
+
+
+def linear_ranges(A_eq: sp.spmatrix, b_eq: np.ndarray, objectives: np.ndarray, col_lower: np.ndarray) -> list[Bounds]:
+    """Range of each ``objectives[r] . x`` over ``{A_eq x = b_eq, x >= col_lower}`` (None for an unbounded side).
+
+    Each objective is divided by its largest entry for the LP, so HiGHS's
+    absolute tolerances see a scene-relative problem whatever its units, and
+    the optimum is scaled back. The set must not be empty (it holds the motion's forces).
+    """
+    objectives = np.atleast_2d(objectives)
+    model = WarmLP(A_eq, b_eq, b_eq, col_lower)
+    ranges: list[Bounds] = []
+    for row in objectives:
+        scale = float(np.max(np.abs(row), initial=0.0))
+        if scale == 0.0:  # a quantity no force reaches (a joint that moves no contact point)
+            ranges.append((0.0, 0.0))
+            continue
+        low, high = (model.optimise(row / scale, maximize=maximize) for maximize in (False, True))
+        ranges.append(
+            (low.objective * scale if low.status == "optimal" else None, high.objective * scale if high.status == "optimal" else None)
+        )
+    return ranges
+
+
+def rows_feasible(
+    A_eq: sp.spmatrix, b_eq: np.ndarray, rows: np.ndarray, lower: np.ndarray, upper: np.ndarray, col_lower: np.ndarray
+) -> bool:
+    """Whether some ``x >= col_lower`` with ``A_eq x = b_eq`` has ``lower <= rows x <= upper`` (each row scaled as in
+    :func:`linear_ranges`; a bound within :data:`LP_FEASIBILITY` of that row's scale is met)."""
+    scale = np.max(np.abs(rows), axis=1, initial=0.0)
+    reached = scale > 0.0
+    if np.any(~reached & ((lower > 0.0) | (upper < 0.0))):
+        return False  # a row no force reaches is 0, outside its bounds
+    rows, scale = rows[reached], scale[reached]
+    A = sp.vstack([sp.csr_matrix(A_eq), sp.csr_matrix(rows / scale[:, None])], format="csr")
+    row_lower = np.r_[b_eq, lower[reached] / scale - LP_FEASIBILITY]
+    row_upper = np.r_[b_eq, upper[reached] / scale + LP_FEASIBILITY]
+    return solve_lp(np.zeros(A.shape[1]), A, row_lower, row_upper, col_lower).status == "optimal"
 
 
 def _in_row_space(A: np.ndarray | sp.spmatrix, columns: np.ndarray) -> np.ndarray:
