@@ -101,9 +101,15 @@ def render_solution(solution: Solution, console: Console) -> None:
     for table in (*tables, _power_table(motion), _audit_table(motion)):
         console.print()
         console.print(table)
+    # On exact 3-D cones the force set searched is the inscribed pyramid's: a verdict, not a proof.
+    spatial = any(np.asarray(t).size == 6 for t in motion.twists.values())
+    caveat = " (forces of the inscribed 8-edge pyramid; not proven for the exact cones)" if spatial and solution.friction == "exact" else ""
     for robot, joints in motion.torque_limits_exceeded.items():
         console.print(
-            Text(f"infeasible for robot {robot}: no consistent force distribution keeps {', '.join(joints)} within the torque limits")
+            Text(
+                f"infeasible for robot {robot}: no consistent force distribution keeps {', '.join(joints)} within the torque limits"
+                + caveat
+            )
         )
 
 
