@@ -192,13 +192,18 @@ def test_the_explicit_twin_round_trips_through_the_file_format() -> None:
     [
         (lambda d: d["bodies"]["box"]["shape"].update(box=[0.1, -0.1, 0.1]), "bodies.box.shape.box"),
         (lambda d: d["bodies"]["box"]["shape"].update(sphere=0.1), "bodies.box.shape"),
-        (lambda d: d["bodies"]["box"]["pose"].update(rotation={"quaternion": [1.0, 1.0, 0.0, 0.0]}), "bodies.box.pose.rotation"),
+        (lambda d: d["bodies"]["box"]["pose"].update(rotation={"quaternion": [1.0, 1.0, 0.0, 0.0]}), "bodies.box.pose.rotation.quaternion"),
         (lambda d: d["movers"]["finger"]["shape"].update(sphere=0.0, **{}), "movers.finger.shape.sphere"),
         (lambda d: d["bodies"]["box"]["shape"].update(box=None, mesh="no/such/part.obj"), "bodies.box.shape.mesh"),
         (lambda d: d["bodies"]["box"]["shape"].update(boxx=[1, 1, 1]), "bodies.box.shape.boxx"),
+        (lambda d: d["bodies"]["box"]["shape"].update(box=None, mesh="/dev/zero"), "bodies.box.shape.mesh"),
+        (lambda d: d["bodies"]["box"]["pose"].update(rotation={"rpy": [0.0, "a", 0.0]}), "bodies.box.pose.rotation.rpy[1]"),
         (lambda d: d.update(robots={"arm": {"urdf": "no/such/arm.urdf"}}), "robots.arm.urdf"),
         (lambda d: d.update(contact_detection={"margin": -1.0}), "contact_detection.margin"),
-        (lambda d: d["contact_detection"]["friction"]["pairs"][0].update(between=["box", "fingr"]), "pairs[0].between"),
+        (
+            lambda d: d["contact_detection"]["friction"]["pairs"][0].update(between=["box", "fingr"]),
+            "contact_detection.friction.pairs[0].between",
+        ),
         (
             lambda d: d.update(robots={"arm": {"urdf": str(EXAMPLES / "robots" / "models" / "planar_hand.urdf"), "q": {"elbow": 0.1}}}),
             "robots.arm.q.elbow",
@@ -213,7 +218,7 @@ def test_bad_geometry_is_one_error_line_naming_the_field(tmp_path: Path, change:
     result = _run("solve", str(path))
     assert result.returncode == 2, result.stdout + result.stderr
     lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: ") and field in lines[0], lines
+    assert len(lines) == 1 and lines[0].startswith(f"error: {field}: "), lines  # the field exactly as the file spells it
 
 
 def test_a_missing_robots_extra_says_how_to_install_it(tmp_path: Path) -> None:

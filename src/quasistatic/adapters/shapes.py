@@ -393,7 +393,8 @@ class Mesh(_Derived):
         is_number = isinstance(scale, (int, float, np.integer, np.floating)) and not isinstance(scale, bool)
         factors = _positive_vector([scale] * 3 if is_number else scale, f"{field}.scale")
         if not os.path.isfile(text):
-            raise SceneError(f"{field}.path", text, "no such file")
+            reason = "not a regular file (a folder, device or pipe)" if os.path.exists(text) else "no such file"
+            raise SceneError(f"{field}.path", text, reason)
         vertices = _mesh_vertices(text, factors, f"{field}.path")
         try:
             convex = Convex(vertices, field)

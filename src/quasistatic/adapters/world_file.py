@@ -119,19 +119,27 @@ def _shape(entry: ShapeFile, folder: Path, field: str) -> Shape:
     kind = given[0]
     if entry.scale is not None and kind != "mesh":
         raise SceneError(f"{field}.scale", entry.scale, "only a mesh takes a scale")
-    with _within(f"{field}.{kind}"):
-        if entry.box is not None:
-            return Box(entry.box)
-        if entry.sphere is not None:
-            return Sphere(entry.sphere)
-        if entry.cylinder is not None:
-            return Cylinder(entry.cylinder.radius, entry.cylinder.length)
-        if entry.capsule is not None:
-            return Capsule(entry.capsule.radius, entry.capsule.length)
-        if entry.halfspace is not None:
-            return Halfspace(entry.halfspace.normal, entry.halfspace.offset)
-        assert entry.mesh is not None
-        return Mesh(_path(entry.mesh, folder), 1.0 if entry.scale is None else entry.scale)
+    try:
+        return _built_shape(entry, kind, folder)
+    except SceneError as exc:
+        # The shape classes name their own parts (``box.size``, ``mesh.path``): report the file's key instead.
+        key = "scale" if exc.field.endswith(".scale") else kind
+        raise SceneError(f"{field}.{key}", exc.value, exc.reason) from None
+
+
+def _built_shape(entry: ShapeFile, kind: str, folder: Path) -> Shape:
+    if entry.box is not None:
+        return Box(entry.box)
+    if entry.sphere is not None:
+        return Sphere(entry.sphere)
+    if entry.cylinder is not None:
+        return Cylinder(entry.cylinder.radius, entry.cylinder.length)
+    if entry.capsule is not None:
+        return Capsule(entry.capsule.radius, entry.capsule.length)
+    if entry.halfspace is not None:
+        return Halfspace(entry.halfspace.normal, entry.halfspace.offset)
+    assert entry.mesh is not None and kind == "mesh"
+    return Mesh(_path(entry.mesh, folder), 1.0 if entry.scale is None else entry.scale)
 
 
 def _pose(entry: PoseFile | None, field: str) -> Pose:
@@ -144,12 +152,14 @@ def _pose(entry: PoseFile | None, field: str) -> Pose:
     given = [key for key in ("rpy", "quaternion", "matrix") if getattr(rotation, key) is not None]
     if len(given) != 1:
         raise SceneError(f"{field}.rotation", given or None, "give exactly one of rpy, quaternion (w, x, y, z) or matrix")
-    with _within(f"{field}.rotation.{given[0]}"):
+    try:
         if rotation.rpy is not None:
             return Pose.from_rpy(position, rotation.rpy)
         if rotation.quaternion is not None:
             return Pose.from_quaternion(position, rotation.quaternion)
         return Pose(position, np.array(rotation.matrix, dtype=float))
+    except SceneError as exc:  # Pose names its own parts (``pose.quaternion``): report the file's key
+        raise SceneError(f"{field}.rotation.{given[0]}", exc.value, exc.reason) from None
 
 
 def _vector(values: list[float], field: str) -> np.ndarray:
