@@ -191,3 +191,18 @@ def test_a_solution_shows_itself_in_a_notebook(box_push: tuple[qs.Scene, qs.Solu
     assert png is not None and png.startswith(b"\x89PNG") and len(png) > 5_000
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if the figures extra were not installed
     assert solution._repr_png_() is None
+
+
+def test_robot_links_are_drawn_behind_the_scene(tmp_path: Path) -> None:
+    """A URDF robot's collision shapes appear (translucent robot fill over white); a scene without one has none."""
+    pytest.importorskip("pinocchio")
+    from matplotlib.colors import to_hex, to_rgb
+
+    from quasistatic.viz.style import ROBOT_FILL
+
+    over_white = to_hex(0.6 * np.array(to_rgb(ROBOT_FILL)) + 0.4)  # alpha 0.6 on the white page
+    robot, plain = tmp_path / "allegro.png", tmp_path / "box.png"
+    assert _plot(EXAMPLES / "robots" / "allegro_ball.yaml", robot).returncode == 0
+    assert _plot("box_push_shapes.yaml", plain).returncode == 0
+    drawn, stray = _count(_above_the_legend(_pixels(robot)), over_white), _count(_above_the_legend(_pixels(plain)), over_white)
+    assert drawn > 100 * _PRESENT and stray < _PRESENT, (drawn, stray)  # whole links, against antialiased edges

@@ -26,6 +26,7 @@ from .style import (
     MODE_COLOURS,
     MOVER_FILL,
     NO_MOTION_COLOUR,
+    ROBOT_FILL,
     SLIP_COLOUR,
     TWIST_COLOUR,
     headline,
@@ -203,6 +204,8 @@ def _draw_parts(ax: Axes, frame: _Frame, page: list[FloatArray]) -> None:
     from matplotlib.patches import Polygon
 
     shaped = set() if frame.world is None else {b.name for b in frame.world.bodies if b.shape is not None}
+    for outline in _robot_links(frame):  # behind everything, and left out of the page: an arm would dwarf the part
+        ax.add_patch(Polygon(outline, closed=True, facecolor=ROBOT_FILL, edgecolor=EDGE_COLOUR, linewidth=0.5, alpha=0.6, zorder=0.5))
     for outline, fill in [*_world_parts(frame), *_contact_outlines(frame, shaped)]:
         ax.add_patch(Polygon(outline, closed=True, facecolor=fill, edgecolor=EDGE_COLOUR, linewidth=0.8, zorder=1))
         page.append(outline)
@@ -229,6 +232,14 @@ def _world_parts(frame: _Frame) -> list[tuple[FloatArray, str]]:
             outline = shape_outline(part.shape, part.pose, frame.projection)
             out += [] if outline is None else [(outline, fill)]
     return out
+
+
+def _robot_links(frame: _Frame) -> list[FloatArray]:
+    """The collision shapes of every URDF robot's links at its configuration, projected."""
+    if frame.world is None:
+        return []
+    outlines = [shape_outline(c.shape, c.pose, frame.projection) for r in frame.world.robots for c in r.colliders]
+    return [o for o in outlines if o is not None]
 
 
 def _shape_outlines(world: World | None, projection: Projection) -> list[FloatArray | None]:

@@ -45,6 +45,7 @@ SLIP_COLOUR = "#E69F00"
 TWIST_COLOUR = "#CC79A7"
 BODY_FILL = "#E4E4E4"
 MOVER_FILL = "#B0B0B0"
+ROBOT_FILL = "#9FB4CC"  # robot links: a bluish grey, told apart from movers and drawn translucent behind them
 EDGE_COLOUR = "#404040"
 FIGURES_INSTALL_HINT = 'install matplotlib with pip install "quasistatic[figures]"'
 
