@@ -27,21 +27,14 @@ Everything numeric runs in one kernel, compiled by numba when it is installed.
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..laws import Problem, RawMotion
-from ..tolerances import BASIS_FEASIBILITY, FRICTION_ALIGNMENT, MODE_SPEED, PIVOT
-from .numerics.lcp import NOT_CONVERGED, PIVOTS_PER_ROW, solve_split_lcp
+from .numerics.lcp import FAST_EDGES, NOT_CONVERGED, lemke_motion
 from .numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION
 from .result import BackendResult, Options
 
 __all__ = ["solve_fast", "FAST_EDGES"]
 
-FAST_EDGES = 6  # pyramid edges for exact 3-D cones (Newton then solves the circle; 6 was 2-3x faster than 8 on 3-D grasps, same successes)
-REALIGNMENTS = 20  # most edge re-alignments for exact 3-D cones
-
 _SOLVED = "solved: one motion (fast path; uniqueness and force ranges not checked)"
-_PLANAR_EDGES = np.array([1.0, -1.0])
 _EXACT_STAGES = (  # how an exact 3-D answer was reached, by the kernel's stage
     f"{FAST_EDGES}-edge pyramid: every sliding contact's slip already opposed an edge",
     "pyramid edges re-aligned with the slips",
@@ -67,50 +60,13 @@ def solve_fast(problem: Problem, options: Options) -> BackendResult:
     """
     if options.modes is not None:
         return BackendResult("failed", "failed: the fast path (Lemke's method) cannot prescribe contact modes", certified=False)
-    data = problem.derived("fast", _Inputs)
-    status, stage, q, c, pivots, realignments = solve_split_lcp(
-        data.J,
-        data.b,
-        data.mu,
-        data.g,
-        data.frictional,
-        data.base,
-        data.exact,
-        REALIGNMENTS,
-        FRICTION_ALIGNMENT,
-        MODE_SPEED,
-        PIVOT,
-        BASIS_FEASIBILITY,
-        PIVOTS_PER_ROW,
-    )
+    status, stage, q, c, pivots, realignments = lemke_motion(problem)
     if status != SOLUTION:
         return _failed(int(status), int(stage), int(pivots))
     notes: tuple[tuple[str, object], ...] = (("method", "lemke"), ("pivots", int(pivots)), ("realignments", int(realignments)))
-    if data.exact:
+    if problem.dimension == 3 and not problem.friction.is_polyhedral(3):
         notes += (("exact_cone", _EXACT_STAGES[int(stage)]),)
     return BackendResult("solved", _SOLVED, (RawMotion(q, c),), certified=False, notes=notes)
-
-
-class _Inputs:
-    """The kernel's inputs derived from a problem (kept with it by :meth:`Problem.derived`).
-
-    Attributes
-    ----------
-    J, b, mu, g : contiguous float copies of the problem's
-    frictional : (f,) indices of the contacts with mu > 0
-    base : (K,) edge signs (2-D) or unrotated edge angles (3-D)
-    exact : exact 3-D cones (edges re-aligned with the slips)
-    """
-
-    def __init__(self, problem: Problem) -> None:
-        self.exact = problem.dimension == 3 and not problem.friction.is_polyhedral(3)
-        if problem.dimension == 2:
-            self.base = _PLANAR_EDGES
-        else:
-            count = FAST_EDGES if self.exact else problem.friction.edges
-            self.base = 2.0 * np.pi * np.arange(count) / count
-        self.J, self.b, self.mu, self.g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.mu, problem.g))
-        self.frictional = np.flatnonzero(self.mu > 0.0)
 
 
 def _failed(status: int, stage: int, pivots: int) -> BackendResult:

@@ -37,9 +37,7 @@ import numpy as np
 from ...laws import Problem, RawMotion
 from ...laws.polyhedral import LCPForm
 from ...tolerances import (
-    BASIS_FEASIBILITY,
     DISTINCT_TWIST,
-    FRICTION_ALIGNMENT,
     LP_FEASIBILITY,
     MODE_SPEED,
     MOTION_RANK,
@@ -47,13 +45,10 @@ from ...tolerances import (
     SAME_TWIST,
     ZERO,
 )
-from ..numerics.lcp import PIVOTS_PER_ROW, solve_split_lcp, split_lcp_point
+from ..numerics.lcp import PIVOTS_PER_ROW, LemkeInputs, lemke_motion, split_lcp_point
 from ..numerics.lemke import SOLUTION
 
 __all__ = ["seed_point", "exact_motion", "kinematically_unique", "kinematic_radius"]
-
-EXACT_EDGES = 6  # the fast path's pyramid for exact 3-D cones, before its edges turn with the slips
-REALIGNMENTS = 20  # most edge re-alignments, as on the fast path
 
 
 def seed_point(form: LCPForm) -> np.ndarray | None:
@@ -64,13 +59,12 @@ def seed_point(form: LCPForm) -> np.ndarray | None:
     """
     problem = form.problem
     m, K = form.edges.shape[:2]
-    J, b, mu, g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.mu, problem.g))
-    frictional = np.flatnonzero(mu > 0.0)
+    data = problem.derived("fast", LemkeInputs)  # the fast path's contiguous copies, kept with the problem
     base = np.array([1.0, -1.0]) if problem.dimension == 2 else 2.0 * np.pi * np.arange(K) / K
-    status, z = split_lcp_point(J, b, mu, g, frictional, base, PIVOT, PIVOTS_PER_ROW)
+    status, z = split_lcp_point(data.J, data.b, data.mu, data.g, data.frictional, base, PIVOT, PIVOTS_PER_ROW)
     if status != SOLUTION:
         return None
-    x = _form_point(form, z, frictional)
+    x = _form_point(form, z, data.frictional)
     return x if _satisfies(form, x) else None
 
 
@@ -79,23 +73,7 @@ def exact_motion(problem: Problem) -> RawMotion | None:
 
     Only a candidate: the caller proves it unique, and the audit checks its laws.
     """
-    J, b, mu, g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.mu, problem.g))
-    base = 2.0 * np.pi * np.arange(EXACT_EDGES) / EXACT_EDGES
-    status, _, q, c, _, _ = solve_split_lcp(
-        J,
-        b,
-        mu,
-        g,
-        np.flatnonzero(mu > 0.0),
-        base,
-        True,
-        REALIGNMENTS,
-        FRICTION_ALIGNMENT,
-        MODE_SPEED,
-        PIVOT,
-        BASIS_FEASIBILITY,
-        PIVOTS_PER_ROW,
-    )
+    status, _, q, c, _, _ = lemke_motion(problem)
     return RawMotion(q, c) if status == SOLUTION else None
 
 

@@ -24,14 +24,64 @@ from __future__ import annotations
 import numpy as np
 
 from ...jit import njit
+from ...laws import Problem
 from ...laws.fixed_modes import columns, system
-from ...tolerances import CONE_ROUNDOFF, NEWTON_DAMPING, NEWTON_STOP
+from ...tolerances import BASIS_FEASIBILITY, CONE_ROUNDOFF, FRICTION_ALIGNMENT, MODE_SPEED, NEWTON_DAMPING, NEWTON_STOP, PIVOT
 from .lemke import SOLUTION, lemke
 
-__all__ = ["solve_split_lcp", "split_lcp_point", "NOT_CONVERGED", "PIVOTS_PER_ROW"]
+__all__ = ["solve_split_lcp", "split_lcp_point", "lemke_motion", "LemkeInputs", "NOT_CONVERGED", "PIVOTS_PER_ROW", "FAST_EDGES"]
 
 PIVOTS_PER_ROW = 20  # Lemke pivot cap per LCP row
 NOT_CONVERGED = 3  # kernel status beyond Lemke's: neither re-alignment nor Newton's method reached the exact cone
+FAST_EDGES = 6  # pyramid edges for exact 3-D cones (Newton then solves the circle; 6 was 2-3x faster than 8 on 3-D grasps, same successes)
+REALIGNMENTS = 20  # most edge re-alignments for exact 3-D cones
+_PLANAR_EDGES = np.array([1.0, -1.0])
+
+
+class LemkeInputs:
+    """The kernel's inputs derived from a problem (kept with it by :meth:`Problem.derived`).
+
+    Attributes
+    ----------
+    J, b, mu, g : contiguous float copies of the problem's
+    frictional : (f,) indices of the contacts with mu > 0
+    base : (K,) edge signs (2-D) or unrotated edge angles (3-D)
+    exact : exact 3-D cones (edges re-aligned with the slips)
+    """
+
+    def __init__(self, problem: Problem) -> None:
+        self.exact = problem.dimension == 3 and not problem.friction.is_polyhedral(3)
+        if problem.dimension == 2:
+            self.base = _PLANAR_EDGES
+        else:
+            count = FAST_EDGES if self.exact else problem.friction.edges
+            self.base = 2.0 * np.pi * np.arange(count) / count
+        self.J, self.b, self.mu, self.g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.mu, problem.g))
+        self.frictional = np.flatnonzero(self.mu > 0.0)
+
+
+def lemke_motion(problem: Problem) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
+    """The fast path's kernel on ``problem`` with the library's tolerances (inputs kept with the problem).
+
+    Returns status, stage, twist ``q``, contact-frame forces ``c``, pivots and re-alignments, as
+    :func:`solve_split_lcp`.
+    """
+    data = problem.derived("fast", LemkeInputs)
+    return solve_split_lcp(
+        data.J,
+        data.b,
+        data.mu,
+        data.g,
+        data.frictional,
+        data.base,
+        data.exact,
+        REALIGNMENTS,
+        FRICTION_ALIGNMENT,
+        MODE_SPEED,
+        PIVOT,
+        BASIS_FEASIBILITY,
+        PIVOTS_PER_ROW,
+    )
 
 
 @njit
