@@ -25,8 +25,9 @@ import numpy.typing as npt
 
 from ..errors import BackendUnavailableError, SceneError
 from ..model import checked_number
+from ..model.io import read_text
 from ..stdio import captured_stderr, first_lines
-from ..tolerances import MAX_FILE_BYTES, MAX_MAGNITUDE
+from ..tolerances import MAX_MAGNITUDE
 from .shapes import Pose, Shape, shape_from_coal
 
 __all__ = ["UrdfRobot", "RobotCollider", "ROBOTS_INSTALL_HINT", "link_owner", "installed_model_folders", "resolve_package_path"]
@@ -77,7 +78,7 @@ class _Kinematics:
 
     def __init__(self, urdf: Path, package_dirs: Sequence[Path], field: str) -> None:
         pinocchio = _pinocchio()
-        text = _urdf_text(urdf, field)  # bounded read: a device or a huge file never reaches the parser
+        text = read_text(urdf, field, "the URDF")  # bounded read: a device or a huge file never reaches the parser
         with captured_stderr() as errors:
             try:
                 self.model = pinocchio.buildModelFromXML(text)
@@ -331,21 +332,6 @@ def _limits(values: Any, names: tuple[str, ...], field: str) -> FloatArray | Non
 def _cross_matrix(vector: FloatArray) -> FloatArray:
     x, y, z = vector
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-
-
-def _urdf_text(urdf: Path, field: str) -> str:
-    """The URDF's text, read up to :data:`MAX_FILE_BYTES`; a missing or unreadable file is a SceneError."""
-    try:
-        with urdf.open("rb") as stream:
-            raw = stream.read(MAX_FILE_BYTES + 1)
-    except OSError as exc:
-        raise SceneError(field, str(urdf), f"cannot read the URDF: {exc.strerror or exc}") from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise SceneError(field, str(urdf), f"the URDF is larger than {MAX_FILE_BYTES // 2**20} MiB")
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise SceneError(field, str(urdf), "the URDF is not UTF-8 text") from None
 
 
 def _pinocchio() -> Any:

@@ -324,7 +324,7 @@ def _contact(entry: ContactFile, index: int) -> Contact:
 def _read(path: str | Path) -> Any:
     """The data of a scene file: JSON for ``.json``, YAML otherwise."""
     path = Path(path)
-    text = _read_text(path)
+    text = read_text(path)
     try:
         if path.suffix.lower() == ".json":
             return _parse_json(text)
@@ -343,19 +343,22 @@ def _read(path: str | Path) -> Any:
         raise SceneError("", str(path), f"not valid {'JSON' if path.suffix.lower() == '.json' else 'YAML'}: {exc}") from None
 
 
-def _read_text(path: Path) -> str:
-    """The file's text, read up to one byte past :data:`MAX_FILE_BYTES` (a device or pipe may never end)."""
+def read_text(path: Path, field: str = "", what: str = "the scene file") -> str:
+    """A text file read up to one byte past :data:`MAX_FILE_BYTES` (a device or pipe may never end), as UTF-8.
+
+    ``what`` names the file in the messages ("the URDF"); ``field`` is where it was named.
+    """
     try:
         with path.open("rb") as stream:
             raw = stream.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
-        raise SceneError("", str(path), f"cannot read the scene file: {exc.strerror or exc}") from None
+        raise SceneError(field, str(path), f"cannot read {what}: {exc.strerror or exc}") from None
     if len(raw) > MAX_FILE_BYTES:
-        raise SceneError("", str(path), f"the scene file is larger than {MAX_FILE_BYTES // 2**20} MiB")
+        raise SceneError(field, str(path), f"{what} is larger than {MAX_FILE_BYTES // 2**20} MiB")
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError:
-        raise SceneError("", str(path), "the scene file is not UTF-8 text") from None
+        raise SceneError(field, str(path), f"{what} is not UTF-8 text") from None
 
 
 def _huge_integer(text: str) -> float | None:
