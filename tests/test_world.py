@@ -284,3 +284,16 @@ def test_allegro_example_turns_the_ball_and_holds_it_when_still(tmp_path: Path) 
     held = _solved_json(path)
     assert held["status"] == "solved" and held["certified"] is True
     assert np.allclose(held["bodies"]["ball"]["twist"], np.zeros(6), atol=1e-12)
+
+
+def test_friction_pairs_may_name_a_robot_or_one_of_its_links() -> None:
+    import yaml
+
+    data = yaml.safe_load(HAND.read_text(encoding="utf-8"))
+    data["robots"]["hand"]["urdf"] = str(HAND.parent / data["robots"]["hand"]["urdf"])
+    data["contact_detection"]["friction"]["pairs"] = [
+        {"between": ["hand/left_tip", "box"], "mu": 0.2},
+        {"between": ["box", "hand"], "mu": 0.3},
+    ]
+    mu = {c.other: c.mu for c in qs.load_scene(data).contacts}
+    assert mu == {"hand/left_tip": 0.2, "hand/right_tip": 0.3}  # the first pair that names the contact wins

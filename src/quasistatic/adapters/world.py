@@ -14,7 +14,7 @@ the body frame is the world frame, as in an explicit scene.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -182,20 +182,17 @@ class World:
             body, other, normal = other, body, -normal
         robot_link = links.get(other)
         jacobian = None if robot_link is None else robot_link[0].point_jacobian(robot_link[1], point.point)
-        return Contact(body, other, point.point, normal, mu=self._mu(body, other), jacobian=jacobian)
+        # A friction pair may name a robot link's whole robot.
+        others = {other} if robot_link is None else {other, robot_link[0].name}
+        return Contact(body, other, point.point, normal, mu=self._mu(body, others), jacobian=jacobian)
 
-    def _mu(self, body: str, other: str) -> float:
-        names = {body: {body}, other: {other, *_robot_of(other)}}
+    def _mu(self, body: str, others: set[str]) -> float:
+        """The first friction pair naming ``body`` and one of ``others``, else the default."""
         for pair in self.detection.pairs:
             a, b = pair.between
-            if (a in names[body] and b in names[other]) or (b in names[body] and a in names[other]):
+            if (a == body and b in others) or (b == body and a in others):
                 return pair.mu
         return self.detection.mu
-
-
-def _robot_of(owner: str) -> Iterable[str]:
-    """``hand`` for ``hand/link``: a friction pair may name the whole robot."""
-    return owner.split("/", 1)[:1] if "/" in owner else ()
 
 
 def _robot(robot: UrdfRobot) -> Robot:
