@@ -5,7 +5,7 @@ every other stage reads a :class:`Scene`, which is validated here once.
 """
 
 from .friction import FrictionModel, parse_friction
-from .io import FORMAT_VERSION, load_scene
+from .io import FORMAT_VERSION
 from .scales import Scales, scene_scales
 from .scene import Body, Contact, FloatArray, Mover, Robot, Scene, checked_array, checked_number
 
@@ -19,7 +19,6 @@ __all__ = [
     "Robot",
     "Scales",
     "Scene",
-    "load_scene",
     "parse_friction",
     "checked_array",
     "checked_number",

@@ -29,7 +29,7 @@ from ..errors import MISSING, SceneError
 from ..tolerances import MAX_DEPTH, MAX_FILE_BYTES, MAX_VALUES
 from .scene import Body, Contact, Mover, Robot, Scene
 
-__all__ = ["load_scene", "read_scene_file", "scene_from_file", "scene_to_dict", "plain_robot", "SceneFile", "FORMAT_VERSION"]
+__all__ = ["read_scene_file", "read_text", "scene_from_file", "scene_to_dict", "plain_robot", "SceneFile", "FORMAT_VERSION"]
 
 FORMAT_VERSION = 1
 
@@ -202,22 +202,6 @@ def read_scene_file(source: str | Path | Mapping[str, Any]) -> tuple[SceneFile, 
         raise _scene_error(exc) from None
 
 
-def load_scene(source: str | Path | Mapping[str, Any]) -> Scene:
-    """Load and validate a scene that lists its contacts, from a YAML/JSON file path or a dict of the file's keys.
-
-    A scene with shapes or URDF robots needs its contacts found: ``quasistatic.load_scene`` does that.
-
-    Raises
-    ------
-    SceneError
-        As :func:`read_scene_file`, or for a value its part rejects.
-    """
-    parsed, _ = read_scene_file(source)
-    if parsed.is_geometric:
-        raise SceneError("", "shapes or URDF robots", "this scene's contacts must be found first: use quasistatic.load_scene")
-    return scene_from_file(parsed)
-
-
 def scene_from_file(parsed: SceneFile) -> Scene:
     """The Scene of a file that lists its contacts."""
     if "contacts" not in parsed.model_fields_set:
@@ -242,7 +226,7 @@ def plain_robot(name: str, robot: RobotFile) -> Robot:
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
-    """The scene file (format version 1) that lists this scene's contacts: :func:`load_scene` reads it back as an equal Scene."""
+    """The scene file (format version 1) that lists this scene's contacts; ``quasistatic.load_scene`` reads it back equal."""
     return {
         "quasistatic": FORMAT_VERSION,
         "dimension": scene.dimension,
