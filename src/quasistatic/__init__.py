@@ -24,6 +24,7 @@ from .errors import BackendUnavailableError, QuasistaticError, SceneError, Solve
 from .laws import Problem, assemble
 from .loading import load_scene, load_world
 from .model import Body, Contact, FrictionModel, Mover, Robot, Scene
+from .sim import Inputs, InputTable, Trajectory, simulate
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
 from .viz import plot
@@ -46,6 +47,8 @@ __all__ = [
     "Diagnosis",
     "FrictionModel",
     "FrictionPair",
+    "InputTable",
+    "Inputs",
     "Halfspace",
     "METHODS",
     "Mesh",
@@ -63,12 +66,14 @@ __all__ = [
     "Solution",
     "SolverError",
     "Sphere",
+    "Trajectory",
     "UrdfRobot",
     "World",
     "assemble",
     "load_scene",
     "load_world",
     "plot",
+    "simulate",
     "solve",
     "solve_many",
 ]

@@ -1,4 +1,4 @@
-"""Command line: ``quasistatic demo | solve | plot | check | contacts | validate | bench``. A thin layer, no physics.
+"""Command line: ``quasistatic demo | solve | simulate | plot | check | contacts | validate | bench``. A thin layer, no physics.
 
 Exit codes: 0 when the library gave an answer (``solved``, ``ambiguous``,
 ``jammed`` or ``unstable``: a diagnosis is an answer), 1 when the solve
@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, NoReturn, TypeVar
 
 import typer
 from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.status import Status
 
 from .adapters import Detection, World
@@ -25,7 +27,7 @@ from .errors import QuasistaticError, SolverError
 from .loading import load_scene, load_world
 from .model import Scene
 from .model.io import scene_to_dict
-from .report import make_console, render_contacts, render_solution
+from .report import make_console, render_contacts, render_solution, render_trajectory
 from .solution import Mode, Solution
 from .solve import METHODS, solve, with_detection
 from .solvers import SearchProgress
@@ -176,6 +178,57 @@ def plot(
         _fail(f"cannot write {str(output)!r}: {exc.strerror or exc}")
     typer.echo(f"wrote {output}: {solution.status}")
     raise typer.Exit(1 if solution.status == "failed" else 0)
+
+
+@app.command()
+def simulate(
+    scene_file: SceneArgument,
+    duration: Annotated[float, typer.Option(help="Length of the run [s].")],
+    dt: Annotated[float, typer.Option(help="Largest time step [s]; shortened where surfaces close in, bisected at events.")] = 0.01,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Save the trajectory: .npz or .jsonl.")] = None,
+    ambiguous: Annotated[
+        str, typer.Option(help="At an ambiguous answer: stop, or min-power (go on with the least-power motion).")
+    ] = "stop",
+    method: Annotated[str, typer.Option(help=f"Solver at every step: {', '.join(METHODS)}.")] = "auto",
+) -> None:
+    """Follow a scene of shapes or URDF robots over time: contacts found again and a certified solve at every step (docs/simulation.md)."""
+    from .sim import Trajectory
+    from .sim import simulate as run
+
+    policies = {"stop": "stop", "min-power": "min_power", "min_power": "min_power"}
+    if ambiguous not in policies:
+        _fail(f"--ambiguous {ambiguous!r} is not one of stop, min-power")
+    if out is not None and out.suffix not in (".npz", ".jsonl"):
+        _fail(f"--out {str(out)!r}: a trajectory is saved as .npz or .jsonl")
+    world = _guarded(lambda: load_world(scene_file))
+    console = make_console()
+    with _progress_bar(console, duration) as advance:
+        trajectory: Trajectory = _guarded(
+            lambda: run(world, duration, dt, ambiguous=policies[ambiguous], method=method, progress=advance)  # type: ignore[arg-type]
+        )
+    if out is not None:
+        try:
+            trajectory.save(out)
+        except OSError as exc:
+            _fail(f"cannot write {str(out)!r}: {exc.strerror or exc}")
+    render_trajectory(trajectory, console, saved=str(out or ""))
+    raise typer.Exit(1 if trajectory.status == "failed" else 0)
+
+
+@contextmanager
+def _progress_bar(console: Console, duration: float) -> Iterator[Callable[[float, float], None]]:
+    """A progress bar over simulated time, on stderr, shown once a run has taken a second."""
+    with Progress(
+        TextColumn("simulating"),
+        BarColumn(),
+        TextColumn("t = {task.completed:.4g} / {task.total:.4g} s"),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        transient=True,
+        disable=not console.is_terminal,
+    ) as progress:
+        task = progress.add_task("run", total=duration)
+        yield lambda time, _: progress.update(task, completed=time)
 
 
 @app.command()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from rich import box
@@ -18,6 +19,9 @@ from rich.text import Text
 from .model import Contact
 from .solution import Bounds, Certificate, CertificateKind, ContactResult, Motion, MoverWrench, RobotLoad, Solution
 from .tolerances import DISPLAY_ZERO
+
+if TYPE_CHECKING:
+    from .sim import Trajectory
 
 __all__ = ["render_solution", "render_contacts", "make_console", "format_float", "format_vector"]
 
@@ -311,3 +315,32 @@ def _render_solutions(motions: Sequence[Motion], console: Console) -> None:
             for extreme in motion.extreme_twists:
                 text = "; ".join(f"{name} {format_vector(t)}" for name, t in extreme.items())
                 console.print(Text(f"      {text}"))
+
+
+def render_trajectory(trajectory: Trajectory, console: Console, saved: str = "") -> None:
+    """A run's ending, its proof, the deepest penetration and a table of its events."""
+    steps = trajectory.steps
+    taken = sum(1 for s in steps if s.dt > 0)
+    console.print(Text(f"{trajectory.status}: {trajectory.message}", style="bold"))
+    proof = (
+        "every step certified"
+        if trajectory.certified
+        else f"NOT certified: {sum(not s.certified for s in steps)} of {len(steps)} answers unproven"
+    )
+    console.print(Text(f"{taken} steps to t = {trajectory.final.time:.6g} s; proof: {proof}"))
+    choices = sum(1 for s in steps if s.choice)
+    if choices:
+        console.print(Text(f"{choices} steps chose one motion among several (ambiguous answers; see the events)"))
+    console.print(Text(f"deepest penetration before correction: {format_float(trajectory.max_penetration)} (length units of the scene)"))
+    table = _table("events")
+    for column in ("time", "event", "between", "what"):
+        table.add_column(column)
+    for event in trajectory.events:
+        between = " / ".join(event.pair) if event.pair[0] else "scene"
+        table.add_row(f"{event.time:.6g}", event.kind, between, event.detail)
+    if trajectory.events:
+        console.print(table)
+    else:
+        console.print(Text("no events: the contacts and their modes stayed the same"))
+    if saved:
+        console.print(Text(f"wrote {saved}"))

@@ -61,6 +61,10 @@ __all__ = [
     "MAX_VALUES",
     "MAX_FILE_BYTES",
     "DETECTION_MARGIN",
+    "SIM_LOOKAHEAD",
+    "SIM_APPROACH",
+    "SIM_PENETRATION",
+    "SIM_EVENT_TIME",
     "MAX_DENSE_BYTES",
 ]
 
@@ -211,6 +215,32 @@ DETECTION_MARGIN = 1e-4
 as contacts. Geometry from CAD or forward kinematics is exact to far better than this, so a part resting
 on another is found touching, while parts a ten-thousandth of their size apart (a 0.01 mm gap on a 10 cm
 part) are not: a user who wants a looser test gives ``contact_detection.margin`` in length units.
+"""
+
+# --------------------------------------------------------------------------- simulation (sim/)
+
+SIM_LOOKAHEAD = 0.05
+"""Width of the band around each body in which a simulation tracks surfaces not yet touching, relative to
+the largest free body's size [-]. A step is shortened so that no point moves farther than the band, and so
+that no tracked surface closes its gap within the step: a thin part cannot be passed through in one step.
+"""
+
+SIM_APPROACH = 0.5
+"""A surface closing in is stopped at this fraction of the contact margin [-]: inside the margin, so it is
+a contact at the next step, with room left for the step's second-order error (a step moves along the
+tangent of a curved path).
+"""
+
+SIM_PENETRATION = 0.5
+"""Penetration corrected at the start of a step, as a fraction of the contact margin [-]. A step follows
+the exact screw of its twist, but a contact point that slides over a rotating face drifts by the square of
+the step; the bodies are then moved out along the contact normals by the least motion that closes it, so
+penetration never accumulates. The largest depth before correction is recorded at every step.
+"""
+
+SIM_EVENT_TIME = 1.0 / 64.0
+"""Default time tolerance of an event (a contact made or broken, a mode or status change), as a fraction
+of the time step [-]: the step where it happens is bisected until the event lies in a window this wide.
 """
 
 # --------------------------------------------------------------------------- input limits (what a scene may hold at all)

@@ -158,6 +158,16 @@ class World:
             friction=self.friction,
         )
 
+    @property
+    def contact_margin(self) -> float:
+        """Gaps up to this count as contacts [length]: ``detection.margin``, or the default relative to the bodies' size."""
+        return self._margin()
+
+    @property
+    def size(self) -> float:
+        """The largest free body's size [length] (1 when no body has a shape)."""
+        return max((b.shape.extent for b in self.bodies if b.shape is not None), default=1.0)
+
     # ----------------------------------------------------------------- parts
 
     def _robot_links(self) -> dict[str, tuple[UrdfRobot, str]]:
@@ -172,8 +182,7 @@ class World:
     def _margin(self) -> float:
         if self.detection.margin is not None:
             return self.detection.margin
-        sizes = [b.shape.extent for b in self.bodies if b.shape is not None]
-        return DETECTION_MARGIN * max(sizes, default=1.0)
+        return DETECTION_MARGIN * self.size
 
     def _contact(self, point: ContactPoint, free: frozenset[str], links: dict[str, tuple[UrdfRobot, str]]) -> Contact:
         """A solver contact: the free body first, its normal into it; a robot link's Jacobian at the point."""

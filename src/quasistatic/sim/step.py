@@ -1,0 +1,355 @@
+"""One quasi-static time step: find the contacts, solve, move.
+
+:func:`evaluate` answers the forward problem at a state (contacts found again, the same
+audited :func:`quasistatic.solve` as a single answer); :func:`advance` moves the state along
+that answer for a time ``h``; :func:`step` is the two together, a pure function over frozen
+values that a planner can call in its own loop. :func:`quasistatic.sim.simulate` adds events
+and the choice of step length.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from ..adapters import Detection, World
+from ..errors import SceneError
+from ..model import Contact
+from ..solution import Mode, Motion, Solution, Status
+from ..solve import solve
+from ..tolerances import SIM_APPROACH, SIM_LOOKAHEAD, SIM_PENETRATION
+from .rigid import advance_pose, point_velocity
+from .state import Inputs, State
+
+__all__ = ["AmbiguityPolicy", "StepOptions", "SimModel", "ContactRecord", "Evaluation", "StepResult", "evaluate", "advance", "step"]
+
+FloatArray = npt.NDArray[np.float64]
+AmbiguityPolicy = Literal["stop", "min_power"]
+MOVING: frozenset[Status] = frozenset({"solved", "ambiguous"})
+
+
+@dataclass(frozen=True)
+class StepOptions:
+    """How each step is solved.
+
+    ``ambiguous``: ``stop`` ends the run at an ambiguous answer; ``min_power`` goes on with the motion of
+    least input power among those listed (the paper's choice), and records that a choice was made.
+    ``method``, ``certify``, ``time_limit``: passed to :func:`quasistatic.solve`.
+    """
+
+    dt: float = 0.01
+    ambiguous: AmbiguityPolicy = "stop"
+    method: str = "auto"
+    certify: bool = True
+    time_limit: float = 60.0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.dt) and self.dt > 0):
+            raise SceneError("dt", self.dt, "must be a positive number of seconds")
+        if self.ambiguous not in ("stop", "min_power"):
+            raise SceneError("ambiguous", self.ambiguous, "must be 'stop' or 'min_power'")
+
+
+@dataclass(frozen=True)
+class SimModel:
+    """What does not change over a run: the World (shapes, masses, parsed robots, friction) and the step options."""
+
+    world: World
+    options: StepOptions = field(default_factory=StepOptions)
+
+    def __post_init__(self) -> None:
+        if self.world.contacts or self.world.explicit_robots:
+            raise SceneError(
+                "contacts",
+                len(self.world.contacts),
+                "a simulation finds its contacts again at every step: give shapes, not listed contacts",
+            )
+
+
+@dataclass(frozen=True)
+class ContactRecord:
+    """One contact at one instant: where, its normal (into ``body``), gap, force on ``body`` and mode."""
+
+    body: str
+    other: str
+    point: FloatArray
+    normal: FloatArray
+    gap: float
+    force: FloatArray
+    mode: Mode | None  # None where the answer has no motion (jammed, unstable, failed)
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The forward problem answered at one state: the contacts, the Solution and the motion taken from it."""
+
+    state: State  # after any penetration was corrected
+    inputs: Inputs
+    world: World
+    detection: Detection
+    near: tuple[tuple[Contact, float], ...]  # surfaces within the look-ahead band, not yet touching, and their gaps
+    solution: Solution
+    motion: Motion | None  # None: the run cannot go on (jammed, unstable, failed, or ambiguous under "stop")
+    choice: str  # how the motion was chosen among several, or ""
+    penetration: float  # the largest depth found before correction [length]
+
+    @property
+    def status(self) -> Status:
+        return self.solution.status
+
+    @property
+    def certified(self) -> bool:
+        return self.solution.certified
+
+    def twist(self, body: str) -> FloatArray:
+        """The body's twist [v of its centre of mass, w]; zero for a body the motion does not move."""
+        if self.motion is None or body not in self.motion.twists:
+            return np.zeros(6)
+        return np.asarray(self.motion.twists[body], dtype=float)
+
+    def contact_records(self) -> tuple[ContactRecord, ...]:
+        """Each contact with its force and mode in the motion taken (no forces when there is none)."""
+        contacts = self.detection.contacts
+        if self.motion is None:
+            return tuple(
+                ContactRecord(c.body, c.other, c.point, c.normal, g, np.zeros(3), None)
+                for c, g in zip(contacts, self.detection.gaps, strict=True)
+            )
+        results = self.motion.contacts
+        return tuple(
+            ContactRecord(c.body, c.other, c.point, c.normal, g, np.asarray(r.force, dtype=float), r.mode)
+            for c, g, r in zip(contacts, self.detection.gaps, results, strict=True)
+        )
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """What happened at one state of a run, and the step taken from it (``dt`` is 0 for the last state)."""
+
+    time: float
+    dt: float
+    status: Status
+    certified: bool
+    message: str
+    twists: Mapping[str, FloatArray]
+    contacts: tuple[ContactRecord, ...]
+    choice: str = ""
+    penetration: float = 0.0
+    events: tuple[Event, ...] = ()
+
+    @classmethod
+    def of(cls, evaluation: Evaluation, dt: float) -> StepResult:
+        twists = {b.name: evaluation.twist(b.name) for b in evaluation.world.bodies}
+        solution = evaluation.solution
+        return cls(
+            evaluation.state.time,
+            dt,
+            solution.status,
+            solution.certified,
+            solution.message,
+            twists,
+            evaluation.contact_records(),
+            evaluation.choice,
+            evaluation.penetration,
+        )
+
+
+@dataclass(frozen=True)
+class Event:
+    """Something that changed during a run, located in time within ``window``.
+
+    ``kind``: ``contact made``, ``contact broken``, ``mode change``, or the status that ended or
+    continued the run (``jammed``, ``unstable``, ``ambiguous``, ``failed``); ``pair`` the two
+    names involved (empty for a whole-scene status), ``detail`` one sentence.
+    """
+
+    time: float
+    kind: str
+    pair: tuple[str, str]
+    detail: str
+    window: tuple[float, float]
+
+
+# --------------------------------------------------------------------------- evaluate
+
+
+def evaluate(model: SimModel, state: State, inputs: Inputs) -> Evaluation:
+    """Contacts found at ``state`` (penetration corrected first), the certified answer, and the motion to follow."""
+    inputs.check(model.world)
+    world = inputs.applied(state.applied(model.world))
+    margin = world.contact_margin
+    band = margin + SIM_LOOKAHEAD * world.size
+    found = _lookahead(world, band).detect()
+    state, world, found, penetration = _corrected(model, state, inputs, world, found, band, margin)
+    touching = [i for i, g in enumerate(found.gaps) if g <= margin]
+    near = tuple((found.contacts[i], found.gaps[i]) for i, g in enumerate(found.gaps) if g > margin)
+    detection = Detection(
+        tuple(found.contacts[i] for i in touching), tuple(found.gaps[i] for i in touching), margin, _isolated(world, found, touching)
+    )
+    options = model.options
+    solution = solve(world.scene(detection), options.method, certify=options.certify, time_limit=options.time_limit)
+    motion, choice = _chosen(solution, options.ambiguous)
+    return Evaluation(state, inputs, world, detection, near, solution, motion, choice, penetration)
+
+
+def _lookahead(world: World, band: float) -> World:
+    return replace(world, detection=replace(world.detection, margin=band))
+
+
+def _isolated(world: World, found: Detection, touching: list[int]) -> Mapping[str, tuple[str, float]]:
+    """Bodies with no contact: the nearest surface the wider search saw, else what detection said."""
+    touched = {found.contacts[i].body for i in touching} | {found.contacts[i].other for i in touching}
+    isolated = dict(found.isolated)
+    for contact, gap in zip(found.contacts, found.gaps, strict=True):
+        if contact.body not in touched and (contact.body not in isolated or gap < isolated[contact.body][1]):
+            isolated[contact.body] = (contact.other, gap)
+    return {name: isolated[name] for name in isolated if name not in touched and any(b.name == name for b in world.bodies)}
+
+
+def _chosen(solution: Solution, policy: AmbiguityPolicy) -> tuple[Motion | None, str]:
+    if solution.status == "solved":
+        return solution.motion, ""
+    if solution.status != "ambiguous" or policy == "stop" or not solution.solutions:
+        return None, ""
+    motions = solution.solutions
+    best = min(range(len(motions)), key=lambda i: motions[i].power.input)
+    complete = "" if solution.search_complete else " (the list is not proven complete)"
+    return motions[best], f"ambiguous: took motion {best + 1} of {len(motions)}, the least input power{complete}"
+
+
+# --------------------------------------------------------------------------- penetration
+
+
+def _corrected(
+    model: SimModel, state: State, inputs: Inputs, world: World, found: Detection, band: float, margin: float
+) -> tuple[State, World, Detection, float]:
+    """Move the free bodies out of any penetration deeper than the tolerance, by the least motion (twice at most)."""
+    depth = max((-g for g in found.gaps), default=0.0)
+    first_depth = max(depth, 0.0)
+    for _ in range(2):
+        deep = [(c, g) for c, g in zip(found.contacts, found.gaps, strict=True) if g < -SIM_PENETRATION * margin]
+        if not deep:
+            break
+        state = _pushed_out(state, world, deep)
+        world = inputs.applied(state.applied(model.world))
+        found = _lookahead(world, band).detect()
+    return state, world, found, first_depth
+
+
+def _pushed_out(state: State, world: World, deep: list[tuple[Contact, float]]) -> State:
+    """Least-norm body displacements (6 per body, rotations scaled by the body's size) that close each gap."""
+    bodies = {b.name: b for b in world.bodies}
+    names = sorted({c.body for c, _ in deep} | {c.other for c, _ in deep if c.other in bodies})
+    column = {name: 6 * i for i, name in enumerate(names)}
+    size = world.size
+    rows = np.zeros((len(deep), 6 * len(names)))
+    for row, (contact, _) in enumerate(deep):
+        for name, sign in ((contact.body, 1.0), (contact.other, -1.0)):
+            if name in column:
+                com = bodies[name].body().com
+                j = column[name]
+                rows[row, j : j + 3] = sign * contact.normal
+                rows[row, j + 3 : j + 6] = sign * np.cross(contact.point - com, contact.normal) / size
+    closing = np.array([-g for _, g in deep])
+    displacement = np.linalg.lstsq(rows, closing, rcond=None)[0]
+    poses = dict(state.bodies)
+    for name in names:
+        d = displacement[column[name] : column[name] + 6]
+        com = bodies[name].body().com
+        poses[name] = advance_pose(poses[name], np.concatenate([d[:3], d[3:] / size]), com, 1.0)
+    return replace(state, bodies=poses)
+
+
+# --------------------------------------------------------------------------- advance
+
+
+def advance(evaluation: Evaluation, h: float) -> State:
+    """The state after following the evaluation's motion for a time ``h``: screws for bodies and movers, joints integrated."""
+    state, world = evaluation.state, evaluation.world
+    bodies = {b.name: advance_pose(state.bodies[b.name], evaluation.twist(b.name), b.body().com, h) for b in world.bodies}
+    movers = {m.name: advance_pose(state.movers[m.name], _mover_twist(m.twist), m.pose.position, h) for m in world.movers}
+    robots = {r.name: state.robots[r.name] + h * np.asarray(r.joint_velocities, dtype=float) for r in world.robots}
+    return State(state.time + h, bodies, movers, robots)
+
+
+def _mover_twist(twist: npt.ArrayLike | None) -> FloatArray:
+    return np.zeros(6) if twist is None else np.asarray(twist, dtype=float)
+
+
+def step(model: SimModel, state: State, inputs: Inputs, h: float | None = None) -> tuple[State, StepResult]:
+    """One step from ``state``: the answer there and the state ``h`` later (``model.options.dt`` by default).
+
+    Where the answer has no motion to follow (``jammed``, ``unstable``, ``failed``, or ``ambiguous`` under the
+    ``stop`` policy) the state is returned unchanged, with ``dt`` 0 in the result.
+    """
+    evaluation = evaluate(model, state, inputs)
+    if evaluation.motion is None:
+        return evaluation.state, StepResult.of(evaluation, 0.0)
+    h = model.options.dt if h is None else h
+    return advance(evaluation, h), StepResult.of(evaluation, h)
+
+
+# --------------------------------------------------------------------------- step length
+
+
+def safe_step(evaluation: Evaluation, h: float) -> float:
+    """``h`` shortened so no point moves farther than the look-ahead band, and no approaching surface closes its gap."""
+    world = evaluation.world
+    band = SIM_LOOKAHEAD * world.size
+    speed = _fastest_point(evaluation)
+    if speed > 0:
+        h = min(h, band / speed)
+    margin = world.contact_margin
+    for contact, gap in evaluation.near:
+        closing = -float(contact.normal @ (_velocity(evaluation, contact.body, contact) - _velocity(evaluation, contact.other, contact)))
+        if closing > 0:
+            h = min(h, max(gap - SIM_APPROACH * margin, 0.0) / closing)
+    return h
+
+
+def _velocity(evaluation: Evaluation, name: str, contact: Contact) -> FloatArray:
+    """World velocity of the material point of ``name`` at the contact point."""
+    world = evaluation.world
+    for body in world.bodies:
+        if body.name == name:
+            return point_velocity(evaluation.twist(name), body.body().com, contact.point)
+    for mover in world.movers:
+        if mover.name == name:
+            return point_velocity(_mover_twist(mover.twist), mover.pose.position, contact.point)
+    if contact.jacobian is not None:  # a robot link
+        robot = next(r for r in world.robots if contact.other.startswith(f"{r.name}/"))
+        return np.asarray(contact.jacobian @ robot.joint_velocities, dtype=float)
+    return np.zeros(3)
+
+
+def _fastest_point(evaluation: Evaluation) -> float:
+    """An upper bound on the speed of any point of a body, mover or robot link near the bodies."""
+    world = evaluation.world
+    reach = world.size + max((float(np.linalg.norm(b.body().com)) for b in world.bodies), default=0.0)
+    speeds = [0.0]
+    for body in world.bodies:
+        twist = evaluation.twist(body.name)
+        speeds.append(float(np.linalg.norm(twist[:3]) + np.linalg.norm(twist[3:]) * world.size))
+    for mover in world.movers:
+        twist = _mover_twist(mover.twist)
+        extent = mover.shape.extent if mover.shape is not None and math.isfinite(mover.shape.extent) else reach
+        speeds.append(float(np.linalg.norm(twist[:3]) + np.linalg.norm(twist[3:]) * extent))
+    for robot in world.robots:
+        rates = np.asarray(robot.joint_velocities, dtype=float)
+        if not rates.any():
+            continue
+        spin = float(np.abs(rates).sum())  # |w| of any link is at most the sum of its joints' rates
+        for collider in robot.colliders:
+            v = robot.point_jacobian(collider.link, collider.pose.position) @ rates
+            speeds.append(float(np.linalg.norm(v)) + spin * collider.shape.extent)
+    return max(speeds)
+
+
+def moving(evaluation: Evaluation) -> bool:
+    """The run can go on from this evaluation."""
+    return evaluation.motion is not None and evaluation.status in MOVING
