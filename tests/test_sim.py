@@ -262,3 +262,12 @@ def test_simulate_command_bad_input_is_one_error_line(args: list[str], words: st
 def test_simulate_command_refuses_listed_contacts() -> None:
     result = run_cli("simulate", str(Path(__file__).resolve().parents[1] / "examples" / "squeeze.yaml"), "--duration", "1")
     assert result.returncode == 2 and result.stderr.startswith("error:") and "shapes" in result.stderr
+
+
+def test_uncertified_steps_are_marked_in_the_trajectory_and_the_output(tmp_path: Path) -> None:
+    out = tmp_path / "push.npz"
+    result = run_cli("simulate", str(PUSH), "--duration", "0.5", "--dt", "0.25", "--first-solution", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    assert "NOT certified" in result.stdout
+    trajectory = Trajectory.load(out)
+    assert not trajectory.certified and not any(s.certified for s in trajectory.steps)

@@ -190,6 +190,13 @@ def simulate(
         str, typer.Option(help="At an ambiguous answer: stop, or min-power (go on with the least-power motion).")
     ] = "stop",
     method: Annotated[str, typer.Option(help=f"Solver at every step: {', '.join(METHODS)}.")] = "auto",
+    all_solutions: Annotated[
+        bool,
+        typer.Option(
+            "--all-solutions/--first-solution",
+            help="Certify every step (default), or follow the first audited motion found, marked unproven.",
+        ),
+    ] = True,
 ) -> None:
     """Follow a scene of shapes or URDF robots over time: contacts found again and a certified solve at every step (docs/simulation.md)."""
     from .sim import Trajectory
@@ -204,7 +211,7 @@ def simulate(
     console = make_console()
     with _progress_bar(console, duration) as advance:
         trajectory: Trajectory = _guarded(
-            lambda: run(world, duration, dt, ambiguous=policies[ambiguous], method=method, progress=advance)  # type: ignore[arg-type]
+            lambda: run(world, duration, dt, ambiguous=policies[ambiguous], method=method, certify=all_solutions, progress=advance)  # type: ignore[arg-type]
         )
     if out is not None:
         try:

@@ -37,6 +37,7 @@ from ...solvers import BACKENDS
 from .families import FAMILIES, Family, grasp_2d
 from .naive import naive_applicable, solve_naive, to_solution
 from .pipeline import PipelineRow, growth_exponent, run_pipeline
+from .simulation import run_simulation_rows
 
 __all__ = ["BenchConfig", "Row", "BatchRow", "BenchResult", "run_benchmarks", "machine_info", "growth_exponents"]
 
@@ -191,7 +192,7 @@ def run_benchmarks(config: BenchConfig, progress: Progress | None = None) -> Ben
             continue
         rows += _run_family(FAMILIES[name], config, say)
     batch = tuple(_run_batch(config, say)) if config.batch else ()
-    pipeline = tuple(run_pipeline(config.full, config.row_budget, say)) if config.robots else ()
+    pipeline = tuple(run_pipeline(config.full, config.row_budget, say) + run_simulation_rows(config.full, say)) if config.robots else ()
     machine = machine_info()
     if config.batch:
         machine["effective_cores_for_2_workers"] = effective_cores()

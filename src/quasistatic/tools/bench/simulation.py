@@ -1,0 +1,102 @@
+"""Motion over time in the benchmark: steps per second, and where a step's time goes.
+
+Two runs of :func:`quasistatic.sim.step` (each step: contacts found again, a certified solve, the move):
+
+- ``simulate push``: a box on a table pushed by two fingertips side by side (6 contacts; the answer is
+  ambiguous, so the least-power motion is followed, as ``--ambiguous min-power`` does);
+- ``simulate allegro``: the Allegro hand holding a cube on a table (the pipeline rows' grasp), the hand
+  still, so every step re-detects and re-certifies the rest.
+
+Each row gives the median step, steps per second in its note, and the split of one step into
+detection, assembly and solve, measured on the same states.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from importlib.util import find_spec
+
+import numpy as np
+
+from ...adapters import Box, ContactDetection, FrictionPair, Halfspace, Pose, ShapedMover, SolidBody, Sphere, World
+from ...errors import SceneError
+from ...laws import assemble
+from ...sim import Inputs, SimModel, State, StepOptions, advance, evaluate
+from ...solve import solve
+from .pipeline import PipelineRow, allegro_grasp
+
+__all__ = ["run_simulation_rows", "two_finger_push"]
+
+PUSH_STEP = 0.05  # [s]: the fingertips move 0.5 mm per step
+
+
+def two_finger_push() -> World:
+    """A 0.1 m, 1 kg cube on a table (friction 0.5), pushed in +x at 1 cm/s by two frictionless fingertips 6 cm apart."""
+    fingers = tuple(
+        ShapedMover(f"finger{i}", Sphere(0.005), Pose([-0.055, y, 0.05]), twist=[0.01, 0, 0, 0, 0, 0]) for i, y in enumerate((-0.03, 0.03))
+    )
+    table = ShapedMover("table", Halfspace([0, 0, 1], 0.0))
+    pairs = tuple(FrictionPair(("box", f.name), 0.0) for f in fingers)
+    return World(
+        bodies=(SolidBody("box", 1.0, Box([0.1, 0.1, 0.1]), Pose([0, 0, 0.05])),),
+        movers=(table, *fingers),
+        detection=ContactDetection(mu=0.5, pairs=pairs),
+        friction="pyramid:4",
+    )
+
+
+def run_simulation_rows(full: bool, say: Callable[[str], None]) -> list[PipelineRow]:
+    """The simulation rows (the robots extra needed; the Allegro row also example-robot-data)."""
+    if find_spec("coal") is None or find_spec("pinocchio") is None:
+        return [PipelineRow("simulate", skipped="coal/pinocchio not installed (pip install 'quasistatic[robots]')")]
+    steps = 20 if full else 6
+    rows = [_row("simulate push (2 fingertips, box, table)", two_finger_push(), steps, "min_power")]
+    try:
+        world, _ = allegro_grasp()
+    except SceneError:  # the URDF is not installed
+        rows.append(PipelineRow("simulate allegro", skipped="example-robot-data not installed (pip install 'quasistatic[models]')"))
+    else:
+        rows.append(_row("simulate allegro (cube, table, 3 tips)", world, steps, "stop"))
+    for row in rows:
+        say(f"{row.case}: {row.note or row.skipped}")
+    return rows
+
+
+def _row(case: str, world: World, steps: int, policy: str) -> PipelineRow:
+    model = SimModel(world, StepOptions(PUSH_STEP, ambiguous=policy))  # type: ignore[arg-type]
+    state, times, parts = State.of(world), [], []
+    evaluation = evaluate(model, state, Inputs())  # warm: imports, caches, first compilations
+    for _ in range(steps):
+        start = time.perf_counter()
+        evaluation = evaluate(model, state, Inputs())
+        if evaluation.motion is None:
+            break
+        state = advance(evaluation, PUSH_STEP)
+        times.append(time.perf_counter() - start)
+        parts.append(_split(evaluation.world))
+    if not times:
+        return PipelineRow(case, skipped=f"no step taken: {evaluation.solution.status}")
+    median = float(np.median(times))
+    detect, build, solving = (float(np.median(column)) for column in zip(*parts, strict=True))
+    note = (
+        f"{1.0 / median:.3g} steps/s; per step: detect {detect * 1e3:.2f} ms, assemble {build * 1e3:.2f} ms, "
+        f"solve {solving * 1e3:.1f} ms; status {evaluation.solution.status}"
+    )
+    return PipelineRow(
+        case, objects=len(world.bodies), contacts=len(evaluation.detection.contacts), samples=len(times), median=median,
+        p25=float(np.percentile(times, 25)), p75=float(np.percentile(times, 75)), status=evaluation.solution.status,
+        certified=evaluation.solution.certified, note=note,
+    )  # fmt: skip
+
+
+def _split(world: World) -> tuple[float, float, float]:
+    """One step's detection, assembly and solve, timed apart on the same state."""
+    start = time.perf_counter()
+    detection = world.detect()
+    detected = time.perf_counter()
+    scene = world.scene(detection)
+    assemble(scene)
+    assembled = time.perf_counter()
+    solve(scene)
+    return detected - start, assembled - detected, time.perf_counter() - assembled
