@@ -25,7 +25,7 @@ ALLOWED = {
     "check": {"model"},
     "solvers": {"model", "laws"},
     "adapters": {"model"},
-    "sim": {"model", "adapters", "laws", "solve"},
+    "sim": {"model", "adapters", "laws", "solve", "loading"},
     "viz": {"model", "sim", "adapters"},
 }
 # The ways into viz/ from outside it, besides the CLI: the package root re-exports ``plot`` (matplotlib is
