@@ -13,6 +13,7 @@ import json
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, NoReturn, TypeVar
@@ -213,6 +214,7 @@ def simulate(
         trajectory: Trajectory = _guarded(
             lambda: run(world, duration, dt, ambiguous=policies[ambiguous], method=method, certify=all_solutions, progress=advance)  # type: ignore[arg-type]
         )
+    trajectory = replace(trajectory, scene_file=str(scene_file.resolve()))  # for `animate`
     if out is not None:
         try:
             trajectory.save(out)
@@ -220,6 +222,36 @@ def simulate(
             _fail(f"cannot write {str(out)!r}: {exc.strerror or exc}")
     render_trajectory(trajectory, console, saved=str(out or ""))
     raise typer.Exit(1 if trajectory.status == "failed" else 0)
+
+
+@app.command()
+def animate(
+    trajectory_file: Annotated[Path, typer.Argument(metavar="TRAJECTORY", help="A trajectory saved by `simulate --out` (.npz or .jsonl).")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The animation: .gif, or .mp4 when ffmpeg is installed.")],
+    scene: Annotated[Path | None, typer.Option(help="The scene file it was run on (default: the one the trajectory names).")] = None,
+    view: Annotated[str, typer.Option(help="How the scene is seen: iso, xy, xz or yz.")] = "iso",
+    fps: Annotated[int, typer.Option(help="Frames per second.", min=1, max=120)] = 20,
+) -> None:
+    """Draw a simulated trajectory as an animation: shapes, robot links, contacts by mode, forces to scale."""
+    from .sim import Trajectory
+    from .viz import VIEWS, require_matplotlib
+    from .viz import animate as draw
+
+    if view not in VIEWS:
+        _fail(f"--view {view!r} is not one of {', '.join(VIEWS)}")
+    _guarded(require_matplotlib)
+    trajectory = _guarded(lambda: Trajectory.load(trajectory_file))
+    source = scene or (Path(trajectory.scene_file) if trajectory.scene_file else None)
+    if source is None:
+        _fail(f"{str(trajectory_file)!r} names no scene file (it was run on a World built in Python): give --scene")
+    world = _guarded(lambda: load_world(source))
+    if not isinstance(world, World):
+        _fail(f"--scene {str(source)!r} lists its contacts: a trajectory is run on a scene of shapes")
+    try:
+        _guarded(lambda: draw(trajectory, world, output, view=view, fps=fps))
+    except OSError as exc:
+        _fail(f"cannot write {str(output)!r}: {exc.strerror or exc}")
+    typer.echo(f"wrote {output}: {len(trajectory.states)} states, {trajectory.status}")
 
 
 @contextmanager

@@ -85,7 +85,8 @@ def simulate(
     states.append(current.state)
     steps.append(replace(StepResult.of(current, 0.0), events=pending))
     status, message = _ending(current, duration, len(steps) > max_steps)
-    return Trajectory(tuple(states), tuple(steps), status, message)
+    scene_file = str(Path(scene).resolve()) if isinstance(scene, str | Path) else ""
+    return Trajectory(tuple(states), tuple(steps), status, message, scene_file)
 
 
 def _world(scene: World | Scene | str | Path | dict[str, Any]) -> World:

@@ -30,12 +30,15 @@ class Trajectory:
 
     ``steps[i]`` belongs to ``states[i]``; the last step has ``dt`` 0. ``status`` says how the run
     ended: ``completed`` (the whole duration), or the status that stopped it, with ``message``.
+    ``scene_file``: the absolute path of the scene file it was run on ("" for a World built in Python),
+    so that ``quasistatic animate`` can draw it.
     """
 
     states: tuple[State, ...]
     steps: tuple[StepResult, ...]
     status: RunStatus
     message: str
+    scene_file: str = ""
 
     @property
     def times(self) -> FloatArray:
@@ -103,7 +106,10 @@ class Trajectory:
         raise SceneError("trajectory", str(path), "a trajectory file ends in .npz or .jsonl")
 
     def _header(self) -> dict[str, Any]:
-        return {"format": FORMAT, "version": VERSION, "status": self.status, "message": self.message, "certified": self.certified}
+        return {
+            "format": FORMAT, "version": VERSION, "status": self.status, "message": self.message,
+            "certified": self.certified, "scene_file": self.scene_file,
+        }  # fmt: skip
 
     def _arrays(self) -> dict[str, Any]:
         first = self.states[0]
@@ -140,7 +146,7 @@ class Trajectory:
                 for k, t in enumerate(times)
             )
         steps = tuple(_step_from(s) for s in document["steps"])
-        return cls(states, steps, document["status"], document["message"])
+        return cls(states, steps, document["status"], document["message"], str(document.get("scene_file", "")))
 
     @classmethod
     def _from_lines(cls, path: Path) -> Trajectory:
@@ -148,7 +154,7 @@ class Trajectory:
         header = _checked_header(lines[0])
         states = tuple(_state_from(line) for line in lines[1:])
         steps = tuple(_step_from(line["step"]) for line in lines[1:])
-        return cls(states, steps, header["status"], header["message"])
+        return cls(states, steps, header["status"], header["message"], str(header.get("scene_file", "")))
 
 
 def _pose(state: State, name: str) -> Pose:
