@@ -26,7 +26,7 @@ from .loading import load_scene, load_world
 from .model import Body, Contact, FrictionModel, Mover, Robot, Scene
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
-from .viz import plot
+from .viz import plot, view
 
 __version__ = "0.1.0"
 
@@ -71,4 +71,5 @@ __all__ = [
     "plot",
     "solve",
     "solve_many",
+    "view",
 ]
