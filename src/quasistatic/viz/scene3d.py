@@ -39,6 +39,9 @@ _PART_OPACITY = 0.55  # bodies and movers are see-through: contacts and forces i
 _FLOOR_SHARE = 0.75  # half the side of the square drawn for a halfspace per scene size
 
 
+_NO_SHADOW: dict[str, Any] = {"cast_shadow": False, "receive_shadow": False}  # software WebGL speckles shadowed faces
+
+
 def rgb(colour: str) -> tuple[int, int, int]:
     """``#RRGGBB`` as an (r, g, b) tuple of 0-255 integers."""
     return int(colour[1:3], 16), int(colour[3:5], 16), int(colour[5:7], 16)
@@ -167,7 +170,9 @@ def _draw_bodies(api: Any, scene: Scene, world: World | None, scales: ArrowScale
             _draw_shape(api, name, part.shape, part.pose, BODY_FILL, scales)
         else:
             vertices, faces = _outline_mesh(scene, body.name, scales)
-            api.add_mesh_simple(name, vertices, faces, color=rgb(BODY_FILL), opacity=_PART_OPACITY, side="double", flat_shading=True)
+            api.add_mesh_simple(
+                name, vertices, faces, color=rgb(BODY_FILL), opacity=_PART_OPACITY, side="double", **_NO_SHADOW, flat_shading=True
+            )
         api.add_label(f"{name}/label", body.name, position=tuple(lifted(body.com)))
         names.append(name)
     return tuple(names)
@@ -190,7 +195,9 @@ def _draw_robot_links(api: Any, world: World | None, root: str) -> tuple[str, ..
         for index, collider in enumerate(robot.colliders):
             name = f"{root}/robots/{robot.name}/{collider.link}_{index}"
             vertices, faces = _local_mesh(collider.shape)
-            api.add_mesh_simple(name, vertices, faces, color=rgb(ROBOT_FILL), opacity=0.6, side="double", **_placement(collider.pose))
+            api.add_mesh_simple(
+                name, vertices, faces, color=rgb(ROBOT_FILL), opacity=0.6, side="double", **_NO_SHADOW, **_placement(collider.pose)
+            )
             names.append(name)
     return tuple(names)
 
@@ -198,10 +205,10 @@ def _draw_robot_links(api: Any, world: World | None, root: str) -> tuple[str, ..
 def _draw_shape(api: Any, name: str, shape: Shape, pose: Pose, colour: str, scales: ArrowScales) -> None:
     if isinstance(shape, Halfspace):
         vertices, faces = _floor(shape, pose, scales)
-        api.add_mesh_simple(name, vertices, faces, color=rgb("#F4F4F4"), side="double")
+        api.add_mesh_simple(name, vertices, faces, color=rgb("#F4F4F4"), side="double", **_NO_SHADOW)
         return
     vertices, faces = _local_mesh(shape)
-    api.add_mesh_simple(name, vertices, faces, color=rgb(colour), opacity=_PART_OPACITY, side="double", **_placement(pose))
+    api.add_mesh_simple(name, vertices, faces, color=rgb(colour), opacity=_PART_OPACITY, side="double", **_NO_SHADOW, **_placement(pose))
 
 
 def _placement(pose: Pose) -> dict[str, Any]:
@@ -307,7 +314,7 @@ def _draw_contacts(api: Any, scene: Scene, motion: Motion | None, scales: ArrowS
     for index, (contact, mode) in enumerate(zip(scene.contacts, modes, strict=True)):
         name = f"{root}/contacts/{index}_{contact.body}-{contact.other}"
         colour = NO_MOTION_COLOUR if mode is None else MODE_COLOURS[mode]
-        api.add_icosphere(name, radius=_DOT_SHARE * scales.size, color=rgb(colour), position=tuple(lifted(contact.point)))
+        api.add_icosphere(name, radius=_DOT_SHARE * scales.size, color=rgb(colour), position=tuple(lifted(contact.point)), **_NO_SHADOW)
         names.append(name)
     return tuple(names)
 

@@ -127,7 +127,8 @@ class Viewer:
         self._status = server.gui.add_markdown("")
         self._motion_choice = server.gui.add_dropdown("motion", ("motion 1",))
         self._motion_choice.on_update(lambda _: self._redraw())
-        self._sliders = _add_sliders(server, self.velocities, self._on_slider)
+        joints = {r.name: r.joint_labels() for r in self.scene.robots}
+        self._sliders = _add_sliders(server, self.velocities, joints, self._on_slider)
         self._place_camera()
         self.drawn = self._show(solution)
 
@@ -236,11 +237,11 @@ class _Sliders:
     movers: dict[str, list[Any]]
 
 
-def _add_sliders(server: Any, velocities: Velocities, on_change: Any) -> _Sliders:
+def _add_sliders(server: Any, velocities: Velocities, joints: Mapping[str, tuple[str, ...]], on_change: Any) -> _Sliders:
     """One slider per joint velocity and twist entry, grouped by robot and mover; each re-solves when moved."""
     sliders = _Sliders({}, {})
     for group, values, labels in [
-        *((sliders.robots, (name, v), [f"joint {j}" for j in range(v.size)]) for name, v in velocities.robots.items()),
+        *((sliders.robots, (name, v), list(joints[name])) for name, v in velocities.robots.items()),
         *((sliders.movers, (name, v), _twist_labels(v.size)) for name, v in velocities.movers.items()),
     ]:
         name, vector = values
@@ -266,7 +267,7 @@ def _status_text(solution: Solution, scales: ArrowScales) -> str:
         "" if solution.certified or solution.status not in ("solved", "ambiguous") else " **(not proven: the motion may not be unique)**"
     )
     lines = [
-        f"**{solution.status}**{proven}: {headline(solution)}",
+        f"**{headline(solution)}**{proven}",
         f"forces: {scales.force:.3g} length per unit force; slips and com velocities: {scales.velocity:.3g} length per unit velocity",
         "colours: rolling green, sliding vermillion, separating sky blue; force blue, slip orange, com velocity purple",
     ]
