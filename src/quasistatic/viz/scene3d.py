@@ -170,9 +170,7 @@ def _draw_bodies(api: Any, scene: Scene, world: World | None, scales: ArrowScale
             _draw_shape(api, name, part.shape, part.pose, BODY_FILL, scales)
         else:
             vertices, faces = _outline_mesh(scene, body.name, scales)
-            api.add_mesh_simple(
-                name, vertices, faces, color=rgb(BODY_FILL), opacity=_PART_OPACITY, side="double", **_NO_SHADOW, flat_shading=True
-            )
+            api.add_mesh_simple(name, vertices, faces, color=rgb(BODY_FILL), opacity=_PART_OPACITY, **_NO_SHADOW, flat_shading=True)
         api.add_label(f"{name}/label", body.name, position=tuple(lifted(body.com)))
         names.append(name)
     return tuple(names)
@@ -195,9 +193,7 @@ def _draw_robot_links(api: Any, world: World | None, root: str) -> tuple[str, ..
         for index, collider in enumerate(robot.colliders):
             name = f"{root}/robots/{robot.name}/{collider.link}_{index}"
             vertices, faces = _local_mesh(collider.shape)
-            api.add_mesh_simple(
-                name, vertices, faces, color=rgb(ROBOT_FILL), opacity=0.6, side="double", **_NO_SHADOW, **_placement(collider.pose)
-            )
+            api.add_mesh_simple(name, vertices, faces, color=rgb(ROBOT_FILL), opacity=0.6, **_NO_SHADOW, **_placement(collider.pose))
             names.append(name)
     return tuple(names)
 
@@ -208,7 +204,7 @@ def _draw_shape(api: Any, name: str, shape: Shape, pose: Pose, colour: str, scal
         api.add_mesh_simple(name, vertices, faces, color=rgb("#F4F4F4"), side="double", **_NO_SHADOW)
         return
     vertices, faces = _local_mesh(shape)
-    api.add_mesh_simple(name, vertices, faces, color=rgb(colour), opacity=_PART_OPACITY, side="double", **_NO_SHADOW, **_placement(pose))
+    api.add_mesh_simple(name, vertices, faces, color=rgb(colour), opacity=_PART_OPACITY, **_NO_SHADOW, **_placement(pose))
 
 
 def _placement(pose: Pose) -> dict[str, Any]:
@@ -271,11 +267,15 @@ def _sphere_points(radius: float) -> FloatArray:
 
 
 def _hull_mesh(points: FloatArray) -> tuple[FloatArray, np.ndarray]:
-    """The convex hull's triangles; flat or tiny point sets are joggled (qhull's QJ) so that a hull exists."""
+    """The convex hull's triangles, counter-clockwise seen from outside (so only front faces need drawing); flat
+    or tiny point sets are joggled (qhull's QJ) so that a hull exists."""
     from scipy.spatial import ConvexHull
 
-    hull = ConvexHull(points, qhull_options="QJ")
-    return np.asarray(points, dtype=float), np.asarray(hull.simplices)
+    points = np.asarray(points, dtype=float)
+    faces = np.asarray(ConvexHull(points, qhull_options="QJ").simplices)
+    a, b, c = points[faces[:, 0]], points[faces[:, 1]], points[faces[:, 2]]
+    outward = np.einsum("ij,ij->i", np.cross(b - a, c - a), a - points.mean(axis=0)) >= 0.0
+    return points, np.where(outward[:, None], faces, faces[:, [0, 2, 1]])
 
 
 def _outline_mesh(scene: Scene, body: str, scales: ArrowScales) -> tuple[FloatArray, np.ndarray]:
