@@ -177,6 +177,7 @@ def test_the_export_opens_without_a_server(chromium: Chromium, tmp_path: Path) -
     [
         (("--export", "scene.png"), "--export 'scene.png': the file must end in .html"),
         (("--port", "70000"), "--port 70000"),
+        (("--export", "/nonexistent/folder/scene.html"), "cannot write '/nonexistent/folder/scene.html'"),
         (("--host", "no such host.invalid"), "host: cannot listen on 'no such host.invalid'"),
     ],
 )
