@@ -142,6 +142,26 @@ def test_a_slider_change_solves_again_with_the_new_velocities() -> None:
         viewer.stop()
 
 
+def test_moving_the_sliders_solves_again() -> None:
+    """The same stop through the sliders (as a browser sets them): one finger stopped, then the other."""
+    scene, solution = _answer("two_finger_lift.yaml")
+    viewer = qs.view(solution, scene, port=0)
+    try:
+        sliders = viewer.sliders
+        assert set(sliders) == {"left_finger", "right_finger", "left_wall", "right_wall"} and len(sliders["left_finger"]) == 3
+        assert [s.value for s in sliders["left_finger"]] == pytest.approx([0.0, 0.01, 0.0])
+        sliders["left_finger"][1].value = 0.0
+        half = viewer.solution
+        assert half is not solution and np.allclose(viewer.velocities.movers["left_finger"], 0.0)
+        assert np.allclose(viewer.velocities.movers["right_finger"], [0.0, 0.01, 0.0])
+        sliders["right_finger"][1].value = 0.0
+        rest = viewer.solution
+        assert rest is not half and rest.status == "solved" and rest.certified and rest.motion is not None
+        assert np.allclose(rest.motion.twists["box"], 0.0) and rest.motion.audit.passed
+    finally:
+        viewer.stop()
+
+
 # --------------------------------------------------------------------------- the console script
 
 

@@ -123,7 +123,7 @@ class Viewer:
         self.scene = scene if isinstance(scene, Scene) else scene.scene(self._detection)
         self.velocities = Velocities.of(scene)
         self.solution = solution
-        self._lock = threading.Lock()
+        self._lock = threading.RLock()  # a re-solve and the motion control both redraw, from viser's worker threads
         self._status = server.gui.add_markdown("")
         self._motion_choice = server.gui.add_dropdown("motion", ("motion 1",))
         self._motion_choice.on_update(lambda _: self._redraw())
@@ -142,6 +142,12 @@ class Viewer:
     def motions(self) -> list[Motion]:
         """The motions the control switches between: an ambiguous answer's list, or the one motion."""
         return list(self.solution.solutions) or ([self.solution.motion] if self.solution.motion is not None else [])
+
+    @property
+    def sliders(self) -> dict[str, tuple[Any, ...]]:
+        """The velocity sliders (viser handles) by robot or mover name, in joint or twist order: setting one's
+        ``value`` re-solves, as moving it in the browser does."""
+        return {name: tuple(row) for group in (self._sliders.robots, self._sliders.movers) for name, row in group.items()}
 
     def show_motion(self, index: int) -> DrawnFrame:
         """Draw motion ``index`` (0-based) of the answer, as the motion control does."""
@@ -201,11 +207,12 @@ class Viewer:
         return self._redraw()
 
     def _redraw(self) -> DrawnFrame:
-        options = list(self._motion_choice.options)
-        index = options.index(self._motion_choice.value) if self._motion_choice.value in options else 0
-        motion = self.motions[index] if index < len(self.motions) else None
-        self.drawn = draw_frame(self.server.scene, self.scene, motion, self._scales, self.world)
-        return self.drawn
+        with self._lock:
+            options = list(self._motion_choice.options)
+            index = options.index(self._motion_choice.value) if self._motion_choice.value in options else 0
+            motion = self.motions[index] if index < len(self.motions) else None
+            self.drawn = draw_frame(self.server.scene, self.scene, motion, self._scales, self.world)
+            return self.drawn
 
     def _place_camera(self) -> None:
         scales = ArrowScales.of(self.solution, self.scene, self.world)
