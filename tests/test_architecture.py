@@ -26,7 +26,7 @@ ALLOWED = {
     "solvers": {"model", "laws"},
     "adapters": {"model"},
     "sim": {"model", "adapters", "laws", "solve", "loading"},
-    "viz": {"model", "sim", "adapters"},
+    "viz": {"model", "sim", "adapters", "solve"},  # solve: the viewer's live re-solve, through the public solve()
 }
 # The ways into viz/ from outside it, besides the CLI: the package root re-exports ``plot`` (matplotlib is
 # loaded only when drawing), and ``Solution._repr_png_`` (a notebook's picture) calls ``viz.chart``, which

@@ -27,7 +27,7 @@ from .model import Body, Contact, FrictionModel, Mover, Robot, Scene
 from .sim import Inputs, InputTable, Trajectory, simulate
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
-from .viz import plot
+from .viz import plot, view
 
 __version__ = "0.1.0"
 
@@ -76,4 +76,5 @@ __all__ = [
     "simulate",
     "solve",
     "solve_many",
+    "view",
 ]

@@ -1,4 +1,6 @@
-"""Command line: ``quasistatic demo | solve | simulate | plot | check | contacts | validate | bench``. A thin layer, no physics.
+"""Command line: ``quasistatic demo | solve | simulate | animate | plot | view | check | contacts | validate | bench``.
+
+A thin layer, no physics.
 
 Exit codes: 0 when the library gave an answer (``solved``, ``ambiguous``,
 ``jammed`` or ``unstable``: a diagnosis is an answer), 1 when the solve
@@ -268,6 +270,42 @@ def _progress_bar(console: Console, duration: float) -> Iterator[Callable[[float
     ) as progress:
         task = progress.add_task("run", total=duration)
         yield lambda time, _: progress.update(task, completed=time)
+
+
+def view(
+    scene_file: SceneArgument,
+    method: Annotated[str, typer.Option(help=f"Solver: {', '.join(METHODS)} (also for the live re-solves).")] = "auto",
+    host: Annotated[str, typer.Option(help="Address the viewer's server listens on.")] = "127.0.0.1",
+    port: Annotated[int, typer.Option(help="Port of the viewer's server (the next free one when taken; 0: any free one).")] = 8080,
+    export: Annotated[Path | None, typer.Option(help="Write the view as one .html file that opens without a server, and exit.")] = None,
+) -> None:
+    """Show the answer in an interactive 3-D viewer in the browser (viser; docs/pictures.md), until Ctrl-C."""
+    from .viz import require_viser
+    from .viz import view as show
+
+    if export is not None and export.suffix.lower() != ".html":
+        _fail(f"--export {str(export)!r}: the file must end in .html")
+    if not 0 <= port <= 65535:
+        _fail(f"--port {port}: not a port number (0 to 65535)")
+    _guarded(require_viser)
+    scene, detection, world = _loaded_world(scene_file)
+    solution = _guarded(lambda: solve(scene, method=method))
+    if detection is not None:
+        solution = with_detection(solution, detection)
+    viewer = _guarded(lambda: show(solution, world or scene, host=host, port=0 if export is not None else port, method=method))
+    if export is not None:
+        try:
+            viewer.export_html(export)
+        except OSError as exc:
+            _fail(f"cannot write {str(export)!r}: {exc.strerror or exc}")
+        finally:
+            viewer.stop()
+        typer.echo(f"wrote {export}: {solution.status}")
+        raise typer.Exit(1 if solution.status == "failed" else 0)
+    typer.echo(
+        f"viewer at {viewer.url} ({solution.status}); press Ctrl-C to stop",
+    )
+    viewer.wait()
 
 
 @app.command()

@@ -584,6 +584,13 @@ class Solution:
 
         return summary_png(self)
 
+    def _repr_html_(self) -> str:
+        """Jupyter's view of this answer: the verdict, whether it is proven and audited, the contacts' modes, forces
+        and slips as a table, the twists, and the picture of :meth:`_repr_png_` when matplotlib is installed."""
+        from .viz.chart import summary_html
+
+        return summary_html(self)
+
     def to_dict(self) -> dict[str, Any]:
         """Exactly what ``quasistatic solve --json`` prints."""
         out: dict[str, Any] = {

@@ -1,7 +1,9 @@
-"""Pictures: figures of a Solution on its scene, animations of a Trajectory (matplotlib).
+"""Pictures: figures of a Solution on its scene and animations of a Trajectory (matplotlib), the interactive 3-D viewer (viser).
 
 - :func:`plot`: a Solution drawn on its Scene (or World of shapes), one panel per motion.
 - :func:`animate`: a Trajectory drawn on its World, frame by frame (GIF, or MP4 with ffmpeg).
+- :func:`view`: the viewer, a viser server with live re-solves (:mod:`.viewer`); one frame is drawn by
+  :func:`.scene3d.draw_frame`.
 - :data:`MODE_COLOURS` and the other colours: fixed, colour-blind safe (see ``style``).
 
 Rules:
@@ -19,20 +21,30 @@ from .animation import ANIMATION_FORMATS, animate
 from .chart import summary_png
 from .figures import MAX_PANELS, plot
 from .geometry import VIEWS
+from .scene3d import ArrowScales, DrawnFrame, draw_frame
 from .style import FORCE_COLOUR, MODE_COLOURS, NO_MOTION_COLOUR, SLIP_COLOUR, TWIST_COLOUR, require_matplotlib, save
+from .viewer import VIEWER_INSTALL_HINT, Velocities, Viewer, require_viser, view
 
 __all__ = [
     "ANIMATION_FORMATS",
+    "ArrowScales",
+    "DrawnFrame",
     "FORCE_COLOUR",
     "MAX_PANELS",
     "MODE_COLOURS",
     "NO_MOTION_COLOUR",
     "SLIP_COLOUR",
     "TWIST_COLOUR",
+    "VIEWER_INSTALL_HINT",
     "VIEWS",
     "animate",
+    "Velocities",
+    "Viewer",
+    "draw_frame",
     "plot",
     "require_matplotlib",
+    "require_viser",
     "save",
     "summary_png",
+    "view",
 ]

@@ -8,6 +8,8 @@ nothing of the package but the style, so that ``solution.py`` may call it.
 
 from __future__ import annotations
 
+import base64
+import html
 import io
 from typing import TYPE_CHECKING, Any
 
@@ -18,7 +20,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["draw_summary", "summary_figure", "summary_png"]
+__all__ = ["draw_summary", "summary_figure", "summary_html", "summary_png"]
 
 _SIZE = (6.4, 3.6)  # inches
 
@@ -34,6 +36,59 @@ def summary_png(solution: Any) -> bytes | None:
         buffer = io.BytesIO()
         figure.savefig(buffer, format="png")
     return buffer.getvalue()
+
+
+def summary_html(solution: Any) -> str:
+    """A notebook's view of a Solution: the verdict and whether it is proven, a table of the reported motion's
+    contacts (mode in its colour, normal force, slip), each body's twist, and the bar chart when matplotlib is there."""
+    parts = [f"<p><b>{html.escape(headline(solution))}</b></p>", f"<p>{html.escape(_proof_line(solution))}</p>"]
+    if solution.motion is not None:
+        parts += [_twists_table(solution), _contacts_table(solution)]
+    png = summary_png(solution)
+    if png is not None:
+        parts.append(f'<img alt="normal force per contact" src="data:image/png;base64,{base64.b64encode(png).decode()}"/>')
+    return '<div class="quasistatic-solution">' + "".join(parts) + "</div>"
+
+
+def _proof_line(solution: Any) -> str:
+    count = len(solution.solutions)
+    shown = f"motion 1 of {count} shown; " if count > 1 else ""
+    if solution.motion is None:
+        return f"{shown}no motion; {'proven' if solution.certified else 'not proven'}"
+    audit = "passed" if solution.motion.audit.passed else "FAILED"
+    proof = "proven" if solution.certified else "not proven (the motion may not be unique)"
+    return f"{shown}{proof}; audit of the laws: {audit}"
+
+
+def _twists_table(solution: Any) -> str:
+    rows = "".join(
+        f"<tr><td>{html.escape(name)}</td><td>{html.escape(_numbers(twist))}</td></tr>" for name, twist in solution.motion.twists.items()
+    )
+    return f"<table><tr><th>body</th><th>twist (v, w)</th></tr>{rows}</table>"
+
+
+def _contacts_table(solution: Any) -> str:
+    header = "<tr><th>#</th><th>body</th><th>other</th><th>mode</th><th>normal force</th><th>slip</th></tr>"
+    rows = "".join(
+        f"<tr><td>{index}</td><td>{html.escape(c.body)}</td><td>{html.escape(c.other)}</td>"
+        f'<td><span style="color:{MODE_COLOURS[c.mode]}">&#9679;</span> {c.mode}</td>'
+        f"<td>{_force_text(c)}</td><td>{html.escape(_numbers(c.slip)) if c.mode == 'sliding' else ''}</td></tr>"
+        for index, c in enumerate(solution.contacts)
+    )
+    return f"<table>{header}{rows}</table>"
+
+
+def _force_text(contact: Any) -> str:
+    """The normal force, and its range when the forces are indeterminate (an open range: no upper bound)."""
+    text = f"{contact.normal_force:.4g}"
+    if contact.normal_force_range is not None:
+        low, high = contact.normal_force_range
+        text += f" (range {low:.4g} to {'unbounded' if high is None else f'{high:.4g}'})"
+    return text
+
+
+def _numbers(values: Any) -> str:
+    return "[" + ", ".join(f"{float(v):.4g}" for v in values) + "]"
 
 
 def summary_figure(solution: Any, ax: Axes | None = None) -> Figure:
