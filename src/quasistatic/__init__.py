@@ -26,6 +26,7 @@ from .loading import load_scene, load_world
 from .model import Body, Contact, FrictionModel, Mover, Robot, Scene
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
+from .sweeps import SweepResult, sweep
 from .viz import plot
 
 __version__ = "0.1.0"
@@ -62,6 +63,7 @@ __all__ = [
     "SolidBody",
     "Solution",
     "SolverError",
+    "SweepResult",
     "Sphere",
     "UrdfRobot",
     "World",
@@ -71,4 +73,5 @@ __all__ = [
     "plot",
     "solve",
     "solve_many",
+    "sweep",
 ]

@@ -1,6 +1,7 @@
 """Pictures: figures of a Solution on its scene (matplotlib); animations and the viewer come later.
 
 - :func:`plot`: a Solution drawn on its Scene (or World of shapes), one panel per motion.
+- :func:`phase_diagram`: a sweep's phase regions over one or two parameters, boundaries refined.
 - :data:`MODE_COLOURS` and the other colours: fixed, colour-blind safe (see ``style``).
 
 Rules:
@@ -17,6 +18,7 @@ Rules:
 from .chart import summary_png
 from .figures import MAX_PANELS, plot
 from .geometry import VIEWS
+from .phase import STATUS_COLOURS, phase_diagram
 from .style import FORCE_COLOUR, MODE_COLOURS, NO_MOTION_COLOUR, SLIP_COLOUR, TWIST_COLOUR, require_matplotlib, save
 
 __all__ = [
@@ -25,8 +27,10 @@ __all__ = [
     "MODE_COLOURS",
     "NO_MOTION_COLOUR",
     "SLIP_COLOUR",
+    "STATUS_COLOURS",
     "TWIST_COLOUR",
     "VIEWS",
+    "phase_diagram",
     "plot",
     "require_matplotlib",
     "save",
