@@ -421,6 +421,7 @@ def bench(
     plot: Annotated[Path | None, typer.Option(help="Write the log-log time-vs-contacts plot here (needs matplotlib).")] = None,
     batch: Annotated[bool, typer.Option("--batch/--no-batch", help="Measure solve_many throughput.")] = True,
     robots: Annotated[bool, typer.Option("--robots/--no-robots", help="Measure robots and geometry (Allegro, detection).")] = True,
+    sweeps: Annotated[bool, typer.Option("--sweeps/--no-sweeps", help="Measure sweep throughput (serial, joblib, Dask).")] = True,
     check: Annotated[bool, typer.Option("--check", help="Exit 1 if a method contradicts the certified answer (CI).")] = False,
 ) -> None:
     """Benchmark every method on generated problem families against baselines measured in the same run."""
@@ -439,6 +440,7 @@ def bench(
             row_budget=budget if budget is not None else (5.0 if full else 2.0),
             batch=batch,
             robots=robots,
+            sweeps=sweeps,
         )
     )
     console = make_console()
