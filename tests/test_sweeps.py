@@ -156,6 +156,7 @@ def test_resume_after_an_interruption_recomputes_nothing_done(tmp_path: Path, mo
     solved.clear()
     resumed = _tip_or_slide(chunk_dir=tmp_path, chunk_size=3, resume=True)
     assert sorted(solved) == list(range(6, 12))  # only the chunks not finished before
+    assert resumed.reused == 6
     solved.clear()
     again = _tip_or_slide(chunk_dir=tmp_path, chunk_size=3, resume=True)
     assert solved == [] and again.points == resumed.points
@@ -214,7 +215,11 @@ def test_cli_writes_parquet_csv_and_the_diagram(tmp_path: Path) -> None:
     table = pq.read_table(tmp_path / "r.parquet")
     assert table.num_rows > 6 and any(table.column("refinement").to_pylist())
     assert (tmp_path / "d.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "0 unproven" in done.stdout
+    assert "0 unproven" in done.stdout and "read from finished chunks" not in done.stdout
+    resumed = _run("sweep", BOX, *grid, "--out", tmp_path / "r.parquet", "--refine", "1", "--resume")
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"; {table.num_rows} read from finished chunks" in resumed.stdout  # nothing solved again
+    assert pq.read_table(tmp_path / "r.parquet").equals(table)
     again = _run("sweep", BOX, *grid, "--out", tmp_path / "r.csv")
     assert again.returncode == 0, again.stderr
     assert pcsv.read_csv(tmp_path / "r.csv").column("status").to_pylist() == ["solved"] * 6
@@ -226,3 +231,18 @@ def test_cli_bad_param_is_one_error_line() -> None:
     assert done.stderr.strip().splitlines() == ["error: contacts[9].mu: contacts has 3 entries; the index must be below 3 (got 9)"]
     done = _run("sweep", BOX, "--param", "contacts[0].mu=0:1")
     assert done.returncode == 2 and done.stderr.startswith("error: --param contacts[0].mu:")
+
+
+def test_whitney_sweep_stays_above_the_jamming_line() -> None:
+    from quasistatic.tools.validation import whitney_line, whitney_parameters
+    from quasistatic.tools.validation.cases import read_yaml
+    from quasistatic.tools.validation.whitney import whitney_sweep
+
+    p = whitney_parameters(read_yaml(ROOT / "validation" / "scenes" / "whitney_peg.yaml"))
+    result = whitney_sweep(ROOT / "validation", n=6, refine=1)
+    assert result.refined and all(point.certified for point in result.points)
+    for point in result.points:
+        x, y = point.values[0] / p["F_z"], point.values[1] / (p["r"] * p["F_z"])
+        line = float(whitney_line(x, p["lambda"], p["mu"]))
+        if abs(y - line) > 0.02:
+            assert point.status == ("solved" if y > line else "unstable"), (x, y)

@@ -271,7 +271,8 @@ def _sweep_outputs(result: SweepResult, out: Path | None, plot: Path | None, pha
     counts = Counter(p.status for p in result.points)
     unproven = sum(not p.certified for p in result.points if p.status != "failed")
     summary = ", ".join(f"{n} {status}" for status, n in counts.most_common())
-    typer.echo(f"{len(result.points)} points ({len(result.refined)} refinement): {summary}; {unproven} unproven")
+    reused = f"; {result.reused} read from finished chunks" if result.reused else ""
+    typer.echo(f"{len(result.points)} points ({len(result.refined)} refinement): {summary}; {unproven} unproven{reused}")
     raise typer.Exit(1 if counts.get("failed") else 0)
 
 

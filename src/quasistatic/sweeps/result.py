@@ -126,10 +126,13 @@ class SweepResult:
         The grid's axes, in the order given.
     points : tuple of SweepPoint
         The grid points (the Cartesian product, last parameter fastest), then the refinement points.
+    reused : int
+        Points read back from finished chunks (``resume``) instead of solved in this run.
     """
 
     params: tuple[SweepParam, ...]
     points: tuple[SweepPoint, ...]
+    reused: int = field(default=0, compare=False)
 
     @property
     def shape(self) -> tuple[int, ...]:

@@ -117,7 +117,7 @@ def sweep(
             middles = run.solve(executor, f"refine-{round_}", tasks, size)
             points += middles
             intervals = narrowed(intervals, middles, phase)
-    return SweepResult(axes, tuple(points))
+    return SweepResult(axes, tuple(points), reused=run.reused)
 
 
 class _Run:
@@ -134,7 +134,7 @@ class _Run:
     ) -> None:
         self.data, self.folder, self.axes, self.options = data, folder, axes, options
         self.store, self.progress = store, progress
-        self.done = self.planned = 0
+        self.done = self.planned = self.reused = 0
 
     def solve(self, executor: Executor, stage: str, tasks: Sequence[tuple[int, tuple[float, ...], bool]], size: int) -> list[SweepPoint]:
         """The points of ``tasks``, in order: stored chunks read back, the others solved and stored."""
@@ -149,6 +149,7 @@ class _Run:
             stored = self.store.load(chunk.name) if self.store is not None else None
             if stored is not None and [p.index for p in stored] == [t[0] for t in chunk.points]:
                 found[chunk.name] = stored
+                self.reused += len(stored)
                 self._count(len(stored))
             else:
                 todo.append(chunk)

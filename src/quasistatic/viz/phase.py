@@ -28,13 +28,18 @@ _MORE_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#D55E00", "#56B4E9", "#CC79A7
 
 
 class PhaseMapLike(Protocol):
-    """What is drawn: ``quasistatic.sweeps.PhaseMap``."""
+    """What is drawn: ``quasistatic.sweeps.PhaseMap`` (names, grid values, labels, refinement points, kind)."""
 
-    names: tuple[str, ...]
-    axes: tuple[np.ndarray, ...]
-    labels: np.ndarray
-    refined: tuple[tuple[tuple[float, ...], str], ...]
-    kind: str
+    @property
+    def names(self) -> tuple[str, ...]: ...
+    @property
+    def axes(self) -> tuple[np.ndarray, ...]: ...
+    @property
+    def labels(self) -> np.ndarray: ...
+    @property
+    def refined(self) -> tuple[tuple[tuple[float, ...], str], ...]: ...
+    @property
+    def kind(self) -> str: ...
 
 
 def phase_diagram(phases: PhaseMapLike, ax: Axes | None = None, title: str | None = None) -> Figure:
@@ -45,7 +50,8 @@ def phase_diagram(phases: PhaseMapLike, ax: Axes | None = None, title: str | Non
     phases : PhaseMap
         ``SweepResult.phase_map()``: one or two parameters.
     ax : matplotlib Axes, optional
-        Draw here instead of on a new figure.
+        Draw here instead of on a new figure; artists already on it with a label (an analytic
+        boundary, say) join the legend.
     title : str, optional
         Default: the parameters and the number of points.
 
@@ -74,7 +80,8 @@ def phase_diagram(phases: PhaseMapLike, ax: Axes | None = None, title: str | Non
             ax.set_yticks([])
         count = phases.labels.size + len(phases.refined)
         ax.set_title(wrapped(title or f"{phases.kind} over {' and '.join(phases.names)}: {count} solves"))
-        handles = [Patch(facecolor=colour, label=label) for label, colour in colours.items()]
+        drawn, _ = ax.get_legend_handles_labels()
+        handles = [Patch(facecolor=colour, label=label) for label, colour in colours.items()] + drawn
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, frameon=False)
         figure.tight_layout()
     return figure
