@@ -26,6 +26,8 @@ from .result import SWEEPS_INSTALL_HINT, SweepPoint, point_from_solution
 
 __all__ = ["Chunk", "Executor", "executor_for", "scene_at", "solve_chunk"]
 
+_CONNECT_SECONDS = 10  # how long a scheduler address is tried before the sweep gives up
+
 
 @dataclass(frozen=True)
 class Chunk:
@@ -150,7 +152,10 @@ def _dask_client(spec: Any) -> Any:
         return nullcontext(spec)
     workers = _local_workers(spec)
     if workers is None:
-        return distributed.Client(spec, timeout=30)
+        try:
+            return distributed.Client(spec, timeout=_CONNECT_SECONDS)
+        except (OSError, TimeoutError) as exc:
+            raise QuasistaticError(f"--dask {spec!r}: cannot reach the Dask scheduler ({exc})") from None
     cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
     return _ClusterClient(cluster, distributed.Client(cluster))
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -209,9 +210,5 @@ def _check_values(data: Mapping[str, Any], folder: str, axes: tuple[SweepParam, 
 
 def _default_chunk(points: int, jobs: int) -> int:
     """About four chunks per worker (uneven solve times balance), at most 256 points (progress and resume stay fine)."""
-    workers = 1 if jobs == -1 else max(jobs, 1)
-    if jobs == -1:
-        import os
-
-        workers = os.cpu_count() or 1
+    workers = (os.cpu_count() or 1) if jobs == -1 else max(jobs, 1)
     return max(1, min(256, math.ceil(points / (4 * workers))))
