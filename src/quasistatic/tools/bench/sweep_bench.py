@@ -68,9 +68,9 @@ Say = Callable[[str], None]
 def run_sweep_bench(full: bool, say: Say, workers: int = 2, side: int | None = None) -> list[SweepRow]:
     """Sweep the tip-or-slide box serially, with joblib(``workers``) and Dask LocalCluster(``workers``).
 
-    The grid is ``side`` x ``side`` points (default 40 x 40 for a full run, 12 x 12 for the quick one).
+    The grid is ``side`` x ``side`` points (default 40 x 40 for a full run, 8 x 8 for the quick one in CI).
     """
-    side = side or (40 if full else 12)
+    side = side or (40 if full else 8)
     grid = {"contacts[2].point[1]": np.linspace(0.02, 0.38, side), "contacts[0].mu,contacts[1].mu": np.linspace(0.1, 1.0, side)}
     warm = {name: values[:2] for name, values in grid.items()}
     rows: list[SweepRow] = []
