@@ -203,7 +203,7 @@ def run_benchmarks(config: BenchConfig, progress: Progress | None = None) -> Ben
     if config.batch:
         machine["effective_cores_for_2_workers"] = effective_cores()
     machine["load_average_at_start"] = load_at_start
-    return BenchResult(config, machine, tuple(rows), batch, time.perf_counter() - start, tuple(left_out), pipeline, sweeps)
+    return BenchResult(config, machine, tuple(rows), batch, time.perf_counter() - start, tuple(left_out), pipeline, sweeps=sweeps)
 
 
 # --------------------------------------------------------------------------- one family
