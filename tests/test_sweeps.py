@@ -220,9 +220,11 @@ def test_cli_writes_parquet_csv_and_the_diagram(tmp_path: Path) -> None:
     assert resumed.returncode == 0, resumed.stderr
     assert f"; {table.num_rows} read from finished chunks" in resumed.stdout  # nothing solved again
     assert pq.read_table(tmp_path / "r.parquet").equals(table)
-    again = _run("sweep", BOX, *grid, "--out", tmp_path / "r.csv")
+    again = _run("sweep", BOX, *grid, "--out", tmp_path / "r.csv", "--no-certify")
     assert again.returncode == 0, again.stderr
-    assert pcsv.read_csv(tmp_path / "r.csv").column("status").to_pylist() == ["solved"] * 6
+    csv = pcsv.read_csv(tmp_path / "r.csv")
+    assert csv.column("status").to_pylist() == ["solved"] * 6
+    assert csv.column("certified").to_pylist() == [False] * 6 and "6 unproven" in again.stdout  # said, not hidden
 
 
 def test_cli_bad_param_is_one_error_line() -> None:

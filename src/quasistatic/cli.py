@@ -192,6 +192,9 @@ def sweep_command(
     refine: Annotated[int | None, typer.Option(help="Bisections of each phase boundary (default 3 with --plot, else 0).")] = None,
     phase: Annotated[str, typer.Option(help="Phases: status, or modes (status and every contact's mode).")] = "status",
     method: Annotated[str, typer.Option(help=f"Solver: {', '.join(METHODS)}.")] = "auto",
+    certify: Annotated[
+        bool, typer.Option("--certify/--no-certify", help="Prove every answer (default), or take the first audited one: unproven.")
+    ] = True,
     chunk_size: Annotated[int | None, typer.Option(min=1, help="Points per chunk (default: 4 chunks per worker, at most 256).")] = None,
     time_limit: Annotated[float, typer.Option(help="Seconds each point's certified search may take.")] = 60.0,
 ) -> None:
@@ -218,6 +221,7 @@ def sweep_command(
                 scene_file,
                 grid,
                 method=method,
+                certify=certify,
                 time_limit=time_limit,
                 jobs=jobs,
                 dask=dask,
