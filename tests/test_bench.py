@@ -22,6 +22,7 @@ from quasistatic.tools.bench import (
     pipeline,
     render_result,
     run_benchmarks,
+    run_sweep_bench,
     runner,
     write_results,
     write_scaling_plot,
@@ -30,7 +31,9 @@ from quasistatic.tools.bench import (
 
 @pytest.fixture(scope="module")
 def result() -> runner.BenchResult:
-    config = BenchConfig(families=("grasp-3d-nf",), methods=("lp", "scipy-dense"), repeat=2, instances=2, batch=False, robots=False)
+    config = BenchConfig(
+        families=("grasp-3d-nf",), methods=("lp", "scipy-dense"), repeat=2, instances=2, batch=False, robots=False, sweeps=False
+    )
     return run_benchmarks(config)
 
 
@@ -156,3 +159,19 @@ def test_robot_scenes_touch_where_they_should() -> None:
     tips = {c.other for c in detection.contacts if c.other.endswith("_tip")}
     assert tips == {f"hand/{link}" for link in pipeline.GRASP_TIPS}
     assert sum(c.other == "table" for c in detection.contacts) == 4 and max(abs(g) for g in detection.gaps) < 1e-9
+
+
+def test_sweep_rows_compare_backends_on_certified_solves() -> None:
+    lines: list[str] = []
+    rows = run_sweep_bench(False, lines.append, side=2)
+    assert [(r.backend, r.workers) for r in rows] == [("serial", 1), ("joblib", 2), ("dask", 2)]
+    for row in rows:
+        assert row.points == 4 and row.certified == 4 and row.statuses == {"solved": 4}
+        assert row.per_second == pytest.approx(4 / row.seconds) and row.solve_seconds > 0
+    assert rows[0].ratio_to_serial is None and all(r.matches_serial for r in rows[1:])
+    assert rows[2].startup_seconds is not None and len(lines) == 3
+    result = runner.BenchResult(BenchConfig(batch=False, robots=False), runner.machine_info(), (), (), 1.0, sweeps=tuple(rows))
+    console = Console(file=io.StringIO(), width=200)
+    render_result(result, console)
+    assert "sweep throughput" in console.file.getvalue()  # type: ignore[attr-defined]
+    assert "| dask | 2 | 4 |" in markdown_tables(result.to_dict())

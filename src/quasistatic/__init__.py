@@ -27,6 +27,7 @@ from .model import Body, Contact, FrictionModel, Mover, Robot, Scene
 from .sim import Inputs, InputTable, Trajectory, simulate
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
+from .sweeps import SweepResult, sweep
 from .viz import plot, view
 
 __version__ = "0.1.0"
@@ -65,6 +66,7 @@ __all__ = [
     "SolidBody",
     "Solution",
     "SolverError",
+    "SweepResult",
     "Sphere",
     "Trajectory",
     "UrdfRobot",
@@ -76,5 +78,6 @@ __all__ = [
     "simulate",
     "solve",
     "solve_many",
+    "sweep",
     "view",
 ]

@@ -1,4 +1,4 @@
-"""Command line: ``quasistatic demo | solve | simulate | animate | plot | view | check | contacts | validate | bench``.
+"""Command line: ``quasistatic demo | solve | simulate | animate | plot | view | sweep | check | contacts | validate | bench``.
 
 A thin layer, no physics.
 
@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections import Counter
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import replace
@@ -34,6 +35,7 @@ from .report import make_console, render_contacts, render_solution, render_traje
 from .solution import Mode, Solution
 from .solve import METHODS, solve, with_detection
 from .solvers import SearchProgress
+from .sweeps import SweepResult
 
 __all__ = ["app", "main"]
 
@@ -181,6 +183,106 @@ def plot(
         _fail(f"cannot write {str(output)!r}: {exc.strerror or exc}")
     typer.echo(f"wrote {output}: {solution.status}")
     raise typer.Exit(1 if solution.status == "failed" else 0)
+
+
+@app.command("sweep")
+def sweep_command(
+    scene_file: SceneArgument,
+    param: Annotated[list[str], typer.Option(help="PATH=START:STOP:COUNT or PATH=V1,V2,... (repeatable; the grid is their product).")],
+    out: Annotated[Path | None, typer.Option(help="Table of every point: .parquet or .csv (chunks kept in OUT.chunks/).")] = None,
+    plot: Annotated[Path | None, typer.Option(help="Phase diagram over the (one or two) parameters: .png, .svg or .pdf.")] = None,
+    jobs: Annotated[int, typer.Option(help="Local worker processes (joblib); -1: every core.")] = 1,
+    dask: Annotated[str | None, typer.Option(help="Dask scheduler address (tcp://host:8786) or local:N workers.")] = None,
+    resume: Annotated[bool, typer.Option("--resume", help="Skip the chunks already finished in OUT.chunks/.")] = False,
+    refine: Annotated[int | None, typer.Option(help="Bisections of each phase boundary (default 3 with --plot, else 0).")] = None,
+    phase: Annotated[str, typer.Option(help="Phases: status, or modes (status and every contact's mode).")] = "status",
+    method: Annotated[str, typer.Option(help=f"Solver: {', '.join(METHODS)}.")] = "auto",
+    certify: Annotated[
+        bool, typer.Option("--certify/--no-certify", help="Prove every answer (default), or take the first audited one: unproven.")
+    ] = True,
+    chunk_size: Annotated[int | None, typer.Option(min=1, help="Points per chunk (default: 4 chunks per worker, at most 256).")] = None,
+    time_limit: Annotated[float, typer.Option(help="Seconds each point's certified search may take.")] = 60.0,
+) -> None:
+    """Solve a scene over a grid of parameter values (docs/planning.md#sweeps): a table, a phase diagram."""
+    from .sweeps import parse_param_spec, sweep
+
+    if out is not None and out.suffix.lower() not in (".parquet", ".csv"):
+        _fail(f"--out {str(out)!r}: the extension must be .parquet or .csv")
+    if plot is not None and plot.suffix.lower() not in _PICTURE_FORMATS:
+        _fail(f"--plot {str(plot)!r}: the extension must be one of {', '.join(_PICTURE_FORMATS)}")
+    if resume and out is None:
+        _fail("--resume needs --out: the finished chunks are kept next to it")
+    if plot is not None and len(param) > 2:
+        _fail(f"--plot draws one or two parameters; {len(param)} --param options were given")
+    if plot is not None:
+        from .viz import require_matplotlib
+
+        _guarded(require_matplotlib)
+    grid = dict(_guarded(lambda: [parse_param_spec(text) for text in param]))
+    bar = _SweepBar()
+    try:
+        result = _guarded(
+            lambda: sweep(
+                scene_file,
+                grid,
+                method=method,
+                certify=certify,
+                time_limit=time_limit,
+                jobs=jobs,
+                dask=dask,
+                chunk_size=chunk_size,
+                chunk_dir=None if out is None else out.with_name(out.name + ".chunks"),
+                resume=resume,
+                refine=(3 if plot is not None else 0) if refine is None else refine,
+                phase=phase,  # type: ignore[arg-type]  # checked by sweep()
+                progress=bar.update,
+            )
+        )
+    finally:
+        bar.stop()
+    _sweep_outputs(result, out, plot, phase)
+
+
+class _SweepBar:
+    """A progress bar on stderr, shown from the first finished chunk (so an input error stays one line)."""
+
+    def __init__(self) -> None:
+        from rich.progress import Progress
+
+        self.progress = Progress(console=Console(stderr=True), transient=True)
+        self.task = self.progress.add_task("sweep", total=None)
+        self.started = False
+
+    def update(self, done: int, planned: int) -> None:
+        if not self.started:
+            self.progress.start()
+            self.started = True
+        self.progress.update(self.task, completed=done, total=planned)
+
+    def stop(self) -> None:
+        if self.started:
+            self.progress.stop()
+
+
+def _sweep_outputs(result: SweepResult, out: Path | None, plot: Path | None, phase: str) -> None:
+    """Write the table and the diagram, print the count of each status; exit 1 when a point failed."""
+    try:
+        if out is not None:
+            _guarded(lambda: result.to_csv(out) if out.suffix.lower() == ".csv" else result.to_parquet(out))
+            typer.echo(f"wrote {out}")
+        if plot is not None:
+            from .viz import phase_diagram, save
+
+            save(phase_diagram(result.phase_map(phase)), plot)  # type: ignore[arg-type]
+            typer.echo(f"wrote {plot}")
+    except OSError as exc:
+        _fail(f"cannot write {exc.filename!r}: {exc.strerror or exc}")
+    counts = Counter(p.status for p in result.points)
+    unproven = sum(not p.certified for p in result.points if p.status != "failed")
+    summary = ", ".join(f"{n} {status}" for status, n in counts.most_common())
+    reused = f"; {result.reused} read from finished chunks" if result.reused else ""
+    typer.echo(f"{len(result.points)} points ({len(result.refined)} refinement): {summary}; {unproven} unproven{reused}")
+    raise typer.Exit(1 if counts.get("failed") else 0)
 
 
 @app.command()
@@ -454,6 +556,7 @@ def bench(
     plot: Annotated[Path | None, typer.Option(help="Write the log-log time-vs-contacts plot here (needs matplotlib).")] = None,
     batch: Annotated[bool, typer.Option("--batch/--no-batch", help="Measure solve_many throughput.")] = True,
     robots: Annotated[bool, typer.Option("--robots/--no-robots", help="Measure robots and geometry (Allegro, detection).")] = True,
+    sweeps: Annotated[bool, typer.Option("--sweeps/--no-sweeps", help="Measure sweep throughput (serial, joblib, Dask).")] = True,
     check: Annotated[bool, typer.Option("--check", help="Exit 1 if a method contradicts the certified answer (CI).")] = False,
 ) -> None:
     """Benchmark every method on generated problem families against baselines measured in the same run."""
@@ -472,6 +575,7 @@ def bench(
             row_budget=budget if budget is not None else (5.0 if full else 2.0),
             batch=batch,
             robots=robots,
+            sweeps=sweeps,
         )
     )
     console = make_console()

@@ -29,7 +29,16 @@ from ..errors import MISSING, SceneError
 from ..tolerances import MAX_DEPTH, MAX_FILE_BYTES, MAX_VALUES
 from .scene import Body, Contact, Mover, Robot, Scene
 
-__all__ = ["read_scene_file", "read_text", "scene_from_file", "scene_to_dict", "plain_robot", "SceneFile", "FORMAT_VERSION"]
+__all__ = [
+    "read_scene_data",
+    "read_scene_file",
+    "read_text",
+    "scene_from_file",
+    "scene_to_dict",
+    "plain_robot",
+    "SceneFile",
+    "FORMAT_VERSION",
+]
 
 FORMAT_VERSION = 1
 
@@ -200,6 +209,19 @@ def read_scene_file(source: str | Path | Mapping[str, Any]) -> tuple[SceneFile, 
         return SceneFile.model_validate(dict(data)), folder
     except pydantic.ValidationError as exc:
         raise _scene_error(exc) from None
+
+
+def read_scene_data(path: str | Path) -> dict[str, Any]:
+    """The keys of a scene file as written (aliases expanded, nothing filled in), checked against the schema.
+
+    Raises
+    ------
+    SceneError
+        As :func:`read_scene_file` does.
+    """
+    data = _read(path)
+    read_scene_file(data)
+    return dict(data)
 
 
 def scene_from_file(parsed: SceneFile) -> Scene:

@@ -4,6 +4,7 @@
 - :func:`animate`: a Trajectory drawn on its World, frame by frame (GIF, or MP4 with ffmpeg).
 - :func:`view`: the viewer, a viser server with live re-solves (:mod:`.viewer`); one frame is drawn by
   :func:`.scene3d.draw_frame`.
+- :func:`phase_diagram`: a sweep's phase regions over one or two parameters, boundaries refined.
 - :data:`MODE_COLOURS` and the other colours: fixed, colour-blind safe (see ``style``).
 
 Rules:
@@ -21,6 +22,7 @@ from .animation import ANIMATION_FORMATS, animate
 from .chart import summary_png
 from .figures import MAX_PANELS, plot
 from .geometry import VIEWS
+from .phase import STATUS_COLOURS, phase_diagram
 from .scene3d import ArrowScales, DrawnFrame, draw_frame
 from .style import FORCE_COLOUR, MODE_COLOURS, NO_MOTION_COLOUR, SLIP_COLOUR, TWIST_COLOUR, require_matplotlib, save
 from .viewer import VIEWER_INSTALL_HINT, Velocities, Viewer, require_viser, view
@@ -34,6 +36,7 @@ __all__ = [
     "MODE_COLOURS",
     "NO_MOTION_COLOUR",
     "SLIP_COLOUR",
+    "STATUS_COLOURS",
     "TWIST_COLOUR",
     "VIEWER_INSTALL_HINT",
     "VIEWS",
@@ -41,6 +44,7 @@ __all__ = [
     "Velocities",
     "Viewer",
     "draw_frame",
+    "phase_diagram",
     "plot",
     "require_matplotlib",
     "require_viser",

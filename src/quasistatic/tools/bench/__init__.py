@@ -10,6 +10,7 @@ from .families import FAMILIES, Family
 from .output import markdown_tables, render_result, write_results, write_scaling_plot
 from .pipeline import PipelineRow
 from .runner import BatchRow, BenchConfig, BenchResult, Row, growth_exponents, machine_info, run_benchmarks
+from .sweep_bench import SweepRow, run_sweep_bench
 
 __all__ = [
     "FAMILIES",
@@ -19,11 +20,13 @@ __all__ = [
     "Family",
     "PipelineRow",
     "Row",
+    "SweepRow",
     "growth_exponents",
     "machine_info",
     "markdown_tables",
     "render_result",
     "run_benchmarks",
+    "run_sweep_bench",
     "write_results",
     "write_scaling_plot",
 ]

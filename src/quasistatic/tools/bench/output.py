@@ -98,6 +98,8 @@ def render_result(result: BenchResult, console: Console) -> None:
             same = "-" if b.matches_serial is None else ("yes" if b.matches_serial else "NO")
             batch.add_row(b.scenes, b.method, str(b.n_jobs), str(b.problems), f"{b.per_second:,.0f}", _counts(b.statuses), same)
         console.print(batch)
+    if result.sweeps:
+        console.print(_sweep_table(result))
     if result.pipeline:
         console.print(_pipeline_table(result))
         console.print(_detect_growth(growth_exponent(list(result.pipeline))))
@@ -209,6 +211,10 @@ def markdown_tables(data: dict[str, Any]) -> str:
                 f"| {b['scenes']} | {b['method']} | {b['n_jobs']} | {b['problems']} | {b['per_second']:,.0f} "
                 f"| {_counts(b['statuses'])} | {same} |"
             )
+    if data.get("sweeps"):
+        lines += ["", "| " + " | ".join(_SWEEP_COLUMNS) + " |", "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |"]
+        lines += ["| " + " | ".join(_sweep_cells(row)) + " |" for row in data["sweeps"]]
+        lines += ["", _SWEEP_CAPTION]
     if data.get("pipeline"):
         lines += ["", "| " + " | ".join(_PIPELINE_COLUMNS) + " |", "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |"]
         lines += ["| " + " | ".join(_pipeline_cells(row)) + " |" for row in data["pipeline"]]
@@ -279,3 +285,53 @@ def write_scaling_plot(result: BenchResult, path: Path) -> Path | None:
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+# --------------------------------------------------------------------------- sweep throughput
+
+_SWEEP_COLUMNS = (
+    "sweep backend",
+    "workers",
+    "points",
+    "wall",
+    "certified solves/s",
+    "ratio to serial",
+    "one solve",
+    "startup",
+    "statuses",
+    "same as serial",
+)
+_SWEEP_CAPTION = (
+    "Sweep of the tip-or-slide box (push height x floor friction), every point certified and audited; warm workers. "
+    "one solve = median solver time of a point: workers / one solve is what the solves alone allow, the rest is "
+    "per-point overhead (scene read at each point, chunks shipped and collected); startup = the LocalCluster's start, not in wall"
+)
+
+
+def _sweep_cells(row: dict[str, Any]) -> list[str]:
+    if row["skipped"]:
+        return [row["backend"], str(row["workers"]), "", "", f"skipped ({row['skipped']})", "", "", "", "", ""]
+    ratio = "-" if row["ratio_to_serial"] is None else f"{row['ratio_to_serial']:.2f}"
+    same = "-" if row["matches_serial"] is None else ("yes" if row["matches_serial"] else "NO")
+    startup = "-" if row["startup_seconds"] is None else format_seconds(row["startup_seconds"])
+    return [
+        row["backend"],
+        str(row["workers"]),
+        str(row["points"]),
+        format_seconds(row["seconds"]),
+        f"{row['per_second']:,.0f}",
+        ratio,
+        format_seconds(row["solve_seconds"]),
+        startup,
+        _counts(row["statuses"] or {}),
+        same,
+    ]
+
+
+def _sweep_table(result: BenchResult) -> Table:
+    table = Table(title="sweep throughput (certified 2-D solves, qs.sweep)", caption=_SWEEP_CAPTION)
+    for name in _SWEEP_COLUMNS:
+        table.add_column(name)
+    for row in result.sweeps:
+        table.add_row(*_sweep_cells(row.to_dict()))
+    return table

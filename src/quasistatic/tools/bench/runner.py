@@ -38,6 +38,7 @@ from .families import FAMILIES, Family, grasp_2d
 from .naive import naive_applicable, solve_naive, to_solution
 from .pipeline import PipelineRow, growth_exponent, run_pipeline
 from .simulation import run_simulation_rows
+from .sweep_bench import SweepRow, run_sweep_bench
 
 __all__ = ["BenchConfig", "Row", "BatchRow", "BenchResult", "run_benchmarks", "machine_info", "growth_exponents"]
 
@@ -71,6 +72,8 @@ class BenchConfig:
         are made for slow methods [s].
     batch : bool
         Also measure ``solve_many`` throughput on small 2-D scenes.
+    sweeps : bool
+        Also measure sweep throughput: certified 2-D solves per second, serial, joblib(2) and Dask LocalCluster(2).
     robots : bool
         Also measure robots and geometry: the Allegro hand's detection, Jacobians and
         whole pipeline, and detection's growth with the pairs (needs the robots extra).
@@ -85,6 +88,7 @@ class BenchConfig:
     row_budget: float = 3.0
     batch: bool = True
     robots: bool = True
+    sweeps: bool = True
 
     def __post_init__(self) -> None:
         if self.repeat < 1:
@@ -159,6 +163,7 @@ class BenchResult:
     wall_seconds: float
     left_out: tuple[str, ...] = ()
     pipeline: tuple[PipelineRow, ...] = ()
+    sweeps: tuple[SweepRow, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -171,6 +176,7 @@ class BenchResult:
             "growth": growth_exponents(self.rows),
             "pipeline": [p.to_dict() for p in self.pipeline],
             "detect_growth": growth_exponent(list(self.pipeline)),
+            "sweeps": [s.to_dict() for s in self.sweeps],
         }
 
 
@@ -193,11 +199,12 @@ def run_benchmarks(config: BenchConfig, progress: Progress | None = None) -> Ben
         rows += _run_family(FAMILIES[name], config, say)
     batch = tuple(_run_batch(config, say)) if config.batch else ()
     pipeline = tuple(run_pipeline(config.full, config.row_budget, say) + run_simulation_rows(config.full, say)) if config.robots else ()
+    sweeps = tuple(run_sweep_bench(config.full, say)) if config.sweeps else ()
     machine = machine_info()
     if config.batch:
         machine["effective_cores_for_2_workers"] = effective_cores()
     machine["load_average_at_start"] = load_at_start
-    return BenchResult(config, machine, tuple(rows), batch, time.perf_counter() - start, tuple(left_out), pipeline)
+    return BenchResult(config, machine, tuple(rows), batch, time.perf_counter() - start, tuple(left_out), pipeline, sweeps=sweeps)
 
 
 # --------------------------------------------------------------------------- one family

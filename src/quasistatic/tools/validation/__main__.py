@@ -29,10 +29,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m quasistatic.tools.validation", description=(validation.__doc__ or "").splitlines()[0])
     parser.add_argument("--folder", type=Path, default=DEFAULT_FOLDER, help="validation folder (default: ./validation)")
     parser.add_argument("--quick", action="store_true", help="leave out the slow cases (3-D runs, sweeps)")
-    parser.add_argument("--whitney", type=Path, metavar="PNG", help="draw Whitney's jamming diagram to PNG and exit")
+    parser.add_argument("--whitney", type=Path, metavar="PNG", help="draw Whitney's jamming diagram (a qs.sweep) to PNG and exit")
+    parser.add_argument("--jobs", type=int, default=1, help="worker processes for the --whitney sweep (default 1)")
     args = parser.parse_args(argv)
     if args.whitney is not None:
-        print(f"wrote {plot_whitney(args.whitney, args.folder)}")
+        print(f"wrote {plot_whitney(args.whitney, args.folder, jobs=args.jobs)}")
         return 0
     results = run_validation(args.folder, include_slow=not args.quick)
     render_results(results)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import dataclasses
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -139,69 +140,73 @@ def run_whitney_grid(case: Case) -> tuple[str, list[str]]:
     return f"{checked - len(failures)} of {checked} points agree", failures
 
 
-def plot_whitney(path: str | Path, folder: str | Path = DEFAULT_FOLDER, n: int = 41) -> Path:
-    """Draw Whitney's jamming diagram from an ``n`` x ``n`` sweep of the library, with the analytic line.
+def whitney_sweep(folder: str | Path = DEFAULT_FOLDER, n: int = 41, refine: int = 3, jobs: int = 1) -> qs.SweepResult:
+    """Sweep the peg's load over Whitney's plane with :func:`quasistatic.sweep`: ``n`` x ``n`` points, boundary refined.
+
+    The scene is ``scenes/whitney_peg.yaml`` with its (massless) peg's reference point moved to the
+    tip, so that the wrench's entries are Whitney's load itself: ``bodies.peg.wrench[0]`` = F_x over
+    ``[-F_z/mu, F_z/mu]`` and ``bodies.peg.wrench[2]`` = M about the tip over ``[-r F_z, 6 r F_z]``.
+    Every point is certified, with every motion listed (``all_solutions=True``).
+    """
+    base = read_yaml(Path(folder) / "scenes" / "whitney_peg.yaml")
+    p = whitney_parameters(base)
+    data = copy.deepcopy(base)
+    data["bodies"]["peg"]["com"] = [0.0, 0.0]
+    data["bodies"]["peg"]["wrench"] = [0.0, -p["F_z"], 0.0]
+    grid = {
+        "bodies.peg.wrench[0]": np.linspace(-1 / p["mu"], 1 / p["mu"], n) * p["F_z"],
+        "bodies.peg.wrench[2]": np.linspace(-1.0, 6.0, n) * p["r"] * p["F_z"],
+    }
+    return qs.sweep(data, grid, all_solutions=True, refine=refine, jobs=jobs)
+
+
+def plot_whitney(path: str | Path, folder: str | Path = DEFAULT_FOLDER, n: int = 41, refine: int = 3, jobs: int = 1) -> Path:
+    """Draw Whitney's jamming diagram from :func:`whitney_sweep`, with the analytic line and the validation cases.
 
     Needs matplotlib (``pip install matplotlib``); uses the Agg backend.
 
     Parameters
     ----------
     path : path
-        PNG file to write.
+        Picture file to write (.png, .svg, .pdf).
     folder : path
         Validation folder holding ``scenes/whitney_peg.yaml`` and the cases drawn as crosses.
     n : int
         Grid points along each axis.
+    refine : int
+        Bisections of each boundary between grid neighbours.
+    jobs : int
+        Local worker processes for the sweep.
 
     Returns
     -------
     Path
         ``path``.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     base = read_yaml(Path(folder) / "scenes" / "whitney_peg.yaml")
     p = whitney_parameters(base)
-    xs = np.linspace(-1 / p["mu"], 1 / p["mu"], n)
-    ys = np.linspace(-1.0, 6.0, n)
-    stays, moves = _sweep(base, xs, ys)
-    fig, ax = plt.subplots(figsize=(7, 6), dpi=120)
-    _draw_sweep(ax, stays, moves)
+    phases = whitney_sweep(folder, n, refine, jobs).phase_map()
+    scale = (p["F_z"], p["r"] * p["F_z"])  # F_x -> x = F_x / F_z, M -> y = M / (r F_z)
+    phases = dataclasses.replace(
+        phases,
+        names=(r"$x = F_x / F_z$", r"$y = M / (r F_z)$"),
+        axes=tuple(values / s for values, s in zip(phases.axes, scale, strict=True)),
+        refined=tuple((tuple(v / s for v, s in zip(values, scale, strict=True)), label) for values, label in phases.refined),
+    )
+    title = f"Peg in a hole, two-point contact: r = {p['r']:g} m, l = {p['l']:g} m, F_z = {p['F_z']:g} N ({n} x {n} sweep)"
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(7.0, 6.0))
+    ax = figure.add_subplot()
     _draw_line(ax, p)
     points = _case_points(base, folder)
     if points:
         c = np.array(points)
-        ax.scatter(c[:, 0], c[:, 1], s=60, marker="x", color="k", label="validation cases")
-    _decorate(ax, p, xs, ys)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path)
-    plt.close(fig)
-    return path
-
-
-def _sweep(base: Mapping[str, Any], xs: np.ndarray, ys: np.ndarray) -> tuple[list[Point], list[Point]]:
-    """The grid points where the peg stays and those where it moves."""
-    stays: list[Point] = []
-    moves: list[Point] = []
-    for x in xs:
-        for y in ys:
-            status = _whitney_status(base, float(x), float(y))
-            (stays if status == "solved" else moves).append((float(x), float(y)))
-    return stays, moves
-
-
-def _draw_sweep(ax: Axes, stays: list[Point], moves: list[Point]) -> None:
-    """Scatter the sweep: hollow red where the peg moves, blue where it stays."""
-    if moves:
-        m = np.array(moves)
-        ax.scatter(m[:, 0], m[:, 1], s=14, marker="o", facecolors="none", edgecolors="tab:red", label="moves (unstable)")
-    if stays:
-        k = np.array(stays)
-        ax.scatter(k[:, 0], k[:, 1], s=14, marker="o", color="tab:blue", label="stays (at rest)")
+        ax.scatter(c[:, 0], c[:, 1], s=60, marker="x", color="k", label="validation cases", zorder=4)
+    qs.viz.phase_diagram(phases, ax=ax, title=title)  # the public picture API, as a user calls it
+    figure.tight_layout()
+    qs.viz.save(figure, path)
+    return Path(path)
 
 
 def _draw_line(ax: Axes, p: Mapping[str, float]) -> None:
@@ -227,14 +232,3 @@ def _case_points(base: Mapping[str, Any], folder: str | Path) -> list[Point]:
         moment = m_com - whitney_load(base, f_x, 0.0)[2]
         points.append((f_x / p["F_z"], moment / (p["r"] * p["F_z"])))
     return points
-
-
-def _decorate(ax: Axes, p: Mapping[str, float], xs: np.ndarray, ys: np.ndarray) -> None:
-    """Axis labels, title, limits, grid and the legend below the plot."""
-    ax.set_xlabel(r"$x = F_x / F_z$")
-    ax.set_ylabel(r"$y = M / (r F_z)$")
-    ax.set_title(f"Peg in a hole, two-point contact: r = {p['r']:g} m, l = {p['l']:g} m, F_z = {p['F_z']:g} N")
-    ax.set_xlim(xs[0] - 0.2, xs[-1] + 0.2)
-    ax.set_ylim(ys[0] - 0.3, ys[-1] + 0.3)
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8, frameon=False)
