@@ -78,6 +78,8 @@ def render_solution(solution: Solution, console: Console) -> None:
     console.print(Text(solution.message))
     console.print(Text(f"method: {solution.method}   friction model: {solution.friction}   {_proof(solution)}"))
     console.print(Text("units: those of the scene file (forces, lengths and times as given there)"))
+    if solution.compliant_forces:
+        console.print(Text("forces: compliant (of the forces the rigid motion allows, the least elastic energy; unique and audited)"))
     if solution.certificate is not None:
         console.print(Text(f"certificate: {solution.certificate.text}"))
         explanation = _explain(solution.certificate)

@@ -479,6 +479,11 @@ class Solution:
         The reported motion is determined but its contact forces are not; each
         contact then carries ``normal_force_range``. (For ``ambiguous``, each
         listed motion says the same of itself.)
+    compliant_forces : bool
+        The reported forces are the compliant ones: of the forces the rigid motion allows,
+        those of least elastic energy of the scene's contact springs and joint stiffness
+        (:mod:`quasistatic.solvers.compliance`), unique and audited; ``forces_indeterminate``
+        is then False.
     certified : bool
         The verdict is proven: ``solved`` means the only motion, ``ambiguous``
         lists motions that all satisfy the laws, ``jammed``/``unstable`` carry a
@@ -507,6 +512,7 @@ class Solution:
     motion: Motion | None = None
     solutions: tuple[Motion, ...] = ()
     forces_indeterminate: bool = False
+    compliant_forces: bool = False
     certified: bool = False
     diagnosis: Diagnosis | None = None
     certificate: Certificate | None = None
@@ -593,6 +599,7 @@ class Solution:
             "friction": self.friction,
             "certified": self.certified,
             "forces_indeterminate": self.forces_indeterminate,
+            "compliant_forces": self.compliant_forces,
         }
         if self.motion is not None:
             motion = self.motion.to_dict()

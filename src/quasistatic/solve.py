@@ -18,9 +18,9 @@ from .adapters import Detection, World
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
 from .errors import QuasistaticError, SolverError
 from .laws import Problem, RawMotion, WorldForceSet, assemble, free_directions, physical_twists, to_world
-from .model import Scene
+from .model import FloatArray, Scene
 from .solution import Attempt, Mode, Motion, Solution
-from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, get_backend, too_large
+from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, compliant_forces, get_backend, too_large
 
 Range = tuple[float, float | None]
 
@@ -111,6 +111,8 @@ def solve(
             )
         result = _run(backend, problem, options)
         solution = _audited(problem, result, name, tolerance, options, tuple(tried), started)
+        if problem.scene.compliant and solution.status == "solved" and result.motions:
+            solution = _with_compliance(problem, solution, result.motions[0].q, tolerance, options.time_limit)
         # A certifying method's verdict stands unless the audit turned its motion down; the fast path's only when solved.
         rejected = solution.status == "failed" and result.status != "failed"
         if name == names[-1] or (not rejected if backend.certifies else solution.ok):
@@ -207,6 +209,37 @@ def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFA
         force_set=None if raw.force_set is None else WorldForceSet(problem, raw.force_set),
         tolerance=tolerance,
     )
+
+
+def _with_compliance(problem: Problem, solution: Solution, q: FloatArray, tolerance: float, time_limit: float) -> Solution:
+    """The solved motion with its compliant forces (least elastic energy), audited; the rigid answer when they fail.
+
+    Why compliance did not fix the forces (a rigid contact, a failed program, an audit) goes in the notes.
+    """
+    found = compliant_forces(problem, q, time_limit)
+    if found.c is None:
+        return _compliance_note(solution, f"not applied: {found.reason}")
+    if not found.unique:
+        rigid = ", ".join(f"#{i}" for i in found.rigid) or "none"
+        return _compliance_note(solution, f"leaves the forces indeterminate: rigid loaded contacts {rigid} share the load freely")
+    motion = audited_raw_motion(problem, RawMotion(q, found.c), tolerance)
+    if not motion.audit.passed:
+        laws = ", ".join(motion.audit.failures())
+        return _compliance_note(solution, f"not applied: its forces failed the audit ({laws}); the rigid forces are reported")
+    energy = found.energy * problem.scales.force * problem.scales.length
+    message = solution.message.replace("; the contact forces are indeterminate", "")
+    return dataclasses.replace(
+        solution,
+        message=f"{message}; compliance determines the contact forces (least elastic energy)",
+        motion=motion,
+        forces_indeterminate=False,
+        compliant_forces=True,
+        notes=(*solution.notes, ("compliance", f"elastic energy {energy:.6g} (force x length)")),
+    )
+
+
+def _compliance_note(solution: Solution, text: str) -> Solution:
+    return dataclasses.replace(solution, notes=(*solution.notes, ("compliance", text)))
 
 
 def _physical_ranges(ranges: Sequence[Range], force: float) -> list[Range]:

@@ -8,8 +8,21 @@ units. Their numerics (``numerics/``) and certification helpers
 never ``check`` (the judge stays independent) nor anything above.
 """
 
+from .compliance import CompliantForces, compliant_forces
 from .oversize import too_large
 from .registry import BACKENDS, Backend, Solver, get_backend
 from .result import BackendResult, Options, Range, SearchProgress
 
-__all__ = ["BACKENDS", "Backend", "BackendResult", "Options", "Range", "SearchProgress", "Solver", "get_backend", "too_large"]
+__all__ = [
+    "BACKENDS",
+    "Backend",
+    "BackendResult",
+    "CompliantForces",
+    "Options",
+    "Range",
+    "SearchProgress",
+    "Solver",
+    "compliant_forces",
+    "get_backend",
+    "too_large",
+]

@@ -1,0 +1,199 @@
+"""Compliant contact forces: of the forces a rigid motion allows, those of least elastic energy.
+
+A statically indeterminate grasp leaves the rigid laws with a whole set of
+force distributions consistent with one motion (the seed paper's section 5
+names compliance as the remedy). Give the contacts springs (normal stiffness
+k_n, tangential k_t) and the robot joints servo stiffness K, and the forces
+that actually arise are those that minimise the complementary energy
+
+    1/2 c^T C c,   C = blockdiag(1/k_t, ..., 1/k_n)  +  sum_robots (R J) K^-1 (R J)^T
+
+(contact springs in series with the joints, whose compliance the contact
+Jacobians ``J`` map to the contact frames ``R``) over that set: equilibrium,
+open contacts unloaded, sliding contacts on their maximum-dissipation friction,
+rolling ones in their cones (Menabrea / Castigliano: compatibility of the
+deflections is the optimality condition of this program). With polyhedral cones
+it is a convex QP (HiGHS); with exact 3-D cones a convex quadratically
+constrained program (SCIP).
+
+The least-energy forces are unique when ``C`` is positive definite on every
+direction in which the consistent forces can vary (:func:`_resolves`): always
+when every loaded contact has a stiffness, and otherwise only if the rigid
+contacts' share is already fixed by the springs'. The result is checked by the
+caller's audit like every other motion.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..laws import ModeMasks, Problem, contact_modes, slips
+from ..laws.polyhedral import aligned_edges
+from ..tolerances import COMPLIANCE_RANK, FORCE_RANK
+from .numerics.forces import measured_forces_at_twist
+from .numerics.highs import solve_qp
+from .numerics.ranges import null_space
+from .numerics.scip_model import linear, new_model, optimize
+
+__all__ = ["CompliantForces", "compliance_matrix", "compliant_forces"]
+
+_PLANAR_EDGES = 2  # a 2-D cone's two edges; a frictionless 3-D contact's edges carry nothing
+_FRICTIONLESS_EDGES = 4
+
+
+@dataclass(frozen=True)
+class CompliantForces:
+    """The least-energy forces of one motion, scene-relative, or why there are none.
+
+    Attributes
+    ----------
+    c : (m, d) or None
+        Contact-frame forces (tangent(s), normal) on each ``body``; None when the program failed.
+    unique : bool
+        The compliance fixes them: no other consistent distribution has the same energy.
+    energy : float
+        Their complementary energy 1/2 c.C c [scene-relative force x length].
+    rigid : tuple of int
+        Loaded contacts without a stiffness (they make the forces non-unique when ``unique`` is False).
+    reason : str
+        Why ``c`` is None (the program's status), else empty.
+    """
+
+    c: np.ndarray | None
+    unique: bool
+    energy: float
+    rigid: tuple[int, ...]
+    reason: str = ""
+
+
+def compliance_matrix(problem: Problem) -> np.ndarray:
+    """C (m d, m d) in scene-relative units (length scale per force scale), contact frames, contact-major.
+
+    Rigid contacts and joints contribute nothing; joint compliance couples the
+    contacts of one robot (a yielding joint moves every contact beyond it).
+    """
+    scene, scales = problem.scene, problem.scales
+    m, d = problem.n_contacts, problem.dimension
+    units = scales.force / scales.length  # compliance [length/force] -> scene-relative
+    C = np.zeros((m * d, m * d))
+    for i, contact in enumerate(scene.contacts):
+        if contact.stiffness is not None:
+            block = np.full(d, 1.0 / contact.stiffness.tangential)
+            block[-1] = 1.0 / contact.stiffness.normal
+            C[i * d : (i + 1) * d, i * d : (i + 1) * d] = np.diag(block * units)
+    driver = {mover.name: mover.robot for mover in scene.movers}
+    for robot in scene.robots:
+        if robot.joint_stiffness is None:
+            continue
+        B = np.zeros((m * d, robot.joint_velocities.size))  # contact-frame deflection per unit joint rotation
+        for i, contact in enumerate(scene.contacts):
+            if driver.get(contact.other) == robot.name and contact.jacobian is not None:
+                B[i * d : (i + 1) * d] = problem.frames[i] @ contact.jacobian
+        C += (B / robot.joint_stiffness) @ B.T * units
+    return C
+
+
+def compliant_forces(problem: Problem, q: np.ndarray, time_limit: float) -> CompliantForces:
+    """The consistent forces of least elastic energy at the scene-relative twist ``q``."""
+    C = compliance_matrix(problem)
+    if problem.friction.is_polyhedral(problem.dimension):
+        return _polyhedral(problem, q, C)
+    return _exact(problem, q, C, time_limit)
+
+
+def _polyhedral(problem: Problem, q: np.ndarray, C: np.ndarray) -> CompliantForces:
+    """HiGHS's QP over the force polytope's columns ``x >= 0``, ``A x = rhs``, forces ``c = M x``."""
+    count = problem.friction.edges if problem.friction.kind == "pyramid" else _PLANAR_EDGES
+    if problem.dimension == 3 and problem.friction.kind == "none":
+        count = _FRICTIONLESS_EDGES
+    consistent = measured_forces_at_twist(problem, aligned_edges(problem, count), q)
+    forces = consistent.consistent()
+    M = forces.M.tocsr()
+    hessian = sp.csr_matrix(M.T @ C @ M)
+    n = M.shape[1]
+    result = solve_qp(hessian, forces.A, forces.rhs, forces.rhs, np.zeros(n), np.full(n, np.inf))
+    rigid = _rigid_loaded(problem, ~consistent.fixed[consistent.polytope.normal])
+    if result.status != "optimal":
+        return CompliantForces(None, False, float("nan"), rigid, f"the QP is {result.status}")
+    free = ~consistent.fixed
+    directions = np.asarray(M[:, free] @ null_space(forces.A.toarray()[:, free]))
+    c = np.asarray(M @ result.x).reshape(problem.n_contacts, problem.dimension)
+    return CompliantForces(c, _resolves(C, directions), result.objective, rigid)
+
+
+def _exact(problem: Problem, q: np.ndarray, C: np.ndarray, time_limit: float) -> CompliantForces:
+    """SCIP over the contact-frame forces: rolling contacts in their exact cones (a convex quadratic constraint each)."""
+    m, d = problem.n_contacts, problem.dimension
+    masks = ModeMasks.of(problem, contact_modes(problem, q))
+    E = _equalities(problem, q, masks)
+    rigid = _rigid_loaded(problem, masks.closed)
+    scip = new_model(time_limit)
+    c = [scip.addVar(lb=None, ub=None, name=f"c{j}") for j in range(m * d)]
+    for i in range(m):
+        scip.chgVarLb(c[i * d + d - 1], 0.0)
+        if masks.rolling[i]:
+            t1, t2, n = c[i * d : (i + 1) * d]
+            scip.addCons(t1 * t1 + t2 * t2 <= float(problem.mu[i]) ** 2 * n * n)
+    rhs = np.r_[-problem.g, np.zeros(E.shape[0] - problem.n_dof)]
+    for row, value in zip(E, rhs, strict=True):
+        scip.addCons(linear(row, c) == float(value))
+    energy = scip.addVar(lb=0.0, ub=None, name="energy")
+    scip.addCons(_quadratic(C, c) <= energy)
+    scip.setObjective(energy, "minimize")
+    status = optimize(scip, "compliance")
+    if status != "optimal":
+        return CompliantForces(None, False, float("nan"), rigid, f"SCIP's status is {status}")
+    values = np.array([scip.getVal(v) for v in c])
+    return CompliantForces(values.reshape(m, d), _resolves(C, null_space(E)), 0.5 * float(values @ C @ values), rigid)
+
+
+def _equalities(problem: Problem, q: np.ndarray, masks: ModeMasks) -> np.ndarray:
+    """The linear equalities on the flattened forces (m d,): equilibrium first (``= -g``), then each ``= 0``.
+
+    Open contacts carry nothing, frictionless ones no friction, and a sliding
+    contact's friction is ``-mu cn slip/|slip|`` (Coulomb's maximum dissipation).
+    """
+    m, d = problem.n_contacts, problem.dimension
+    rows = [problem.J.reshape(m * d, -1).T]
+    slip = slips(problem, q)
+    for i in range(m):
+        fixed = np.zeros((0, m * d))
+        if not masks.closed[i]:
+            fixed = np.eye(m * d)[i * d : (i + 1) * d]
+        elif masks.sliding[i]:
+            direction = slip[i] / np.linalg.norm(slip[i])
+            fixed = np.eye(m * d)[i * d : i * d + d - 1]
+            fixed[:, i * d + d - 1] = problem.mu[i] * direction
+        elif not masks.rolling[i]:  # closed and frictionless
+            fixed = np.eye(m * d)[i * d : i * d + d - 1]
+        rows.append(fixed)
+    return np.vstack(rows)
+
+
+def _quadratic(C: np.ndarray, c: list[Any]) -> Any:
+    """The SCIP expression 1/2 c.C c over C's nonzero entries."""
+    import pyscipopt
+
+    rows, cols = np.nonzero(np.triu(C))
+    return pyscipopt.quicksum((0.5 if r == k else 1.0) * float(C[r, k]) * c[r] * c[k] for r, k in zip(rows, cols, strict=True)) + 0.0
+
+
+def _resolves(C: np.ndarray, directions: np.ndarray) -> bool:
+    """Whether C is positive definite on the span of ``directions`` (the ways the consistent forces may vary)."""
+    if directions.size == 0:
+        return True
+    u, sigma, _ = np.linalg.svd(directions, full_matrices=False)
+    basis = u[:, sigma > FORCE_RANK]
+    if basis.shape[1] == 0:
+        return True
+    largest = float(np.abs(C).max(initial=0.0))
+    return largest > 0.0 and float(np.linalg.eigvalsh(basis.T @ C @ basis).min()) > COMPLIANCE_RANK * largest
+
+
+def _rigid_loaded(problem: Problem, closed: np.ndarray) -> tuple[int, ...]:
+    """Closed contacts with no spring of their own (a joint's stiffness alone leaves a contact's friction rigid)."""
+    return tuple(i for i, contact in enumerate(problem.scene.contacts) if closed[i] and contact.stiffness is None)
