@@ -1,0 +1,238 @@
+"""Compliance: the forces of least elastic energy, checked against classical statically indeterminate results.
+
+Each expected force is a hand-derived formula (compatibility of the spring
+deflections of a rigid body), not a solver output.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import quasistatic as qs
+
+G = 9.81
+QUASISTATIC = str(Path(sys.executable).with_name("quasistatic"))
+
+
+def _plane_of_springs(points: np.ndarray, stiffness: np.ndarray, load: float, at: np.ndarray) -> np.ndarray:
+    """Vertical spring forces under a rigid body loaded by ``load`` at ``at`` (x or (x, y) per support).
+
+    The body's deflection is a plane w(x) = w0 + theta . (x - centroid); each force k_i w(x_i).
+    With the stiffness-weighted centroid and second moments the equations decouple:
+    f_i = k_i [P / K + (P (e - c))^T I^-1 (x_i - c)], K = sum k, c = sum k x / K, I = sum k (x - c)(x - c)^T.
+    """
+    points = points.reshape(len(stiffness), -1)
+    total = stiffness.sum()
+    centre = stiffness @ points / total
+    arms = points - centre
+    inertia = np.einsum("i,ij,ik->jk", stiffness, arms, arms)
+    tilt = np.linalg.solve(inertia, load * (np.atleast_1d(at) - centre))
+    return stiffness * (load / total + arms @ tilt)
+
+
+def _beam(stiffness: list[float], load_at: float, scale_length: float = 1.0, scale_mass: float = 1.0) -> qs.Scene:
+    """A rigid beam on supports at x = -0.4, 0.1, 0.5 (a table, with friction), loaded by its weight at ``load_at``."""
+    L, M = scale_length, scale_mass
+    force = M * L  # unit of force in the scaled units (mass x length / s^2)
+    contacts = [
+        qs.Contact("beam", "ground", [x * L, 0.0], [0.0, 1.0], mu=0.5, stiffness=qs.Stiffness(k * force / L, 2.0 * k * force / L))
+        for x, k in zip((-0.4, 0.1, 0.5), stiffness, strict=True)
+    ]
+    return qs.Scene([qs.Body("beam", 2.0 * M, [load_at * L, 0.02 * L])], contacts, [qs.Mover("ground")], dimension=2, gravity=[0, -G * L])
+
+
+def test_rigid_beam_on_three_springs_by_compatibility() -> None:
+    stiffness = np.array([1.0e4, 3.0e4, 2.0e4])
+    rigid = qs.solve(
+        qs.Scene(
+            _beam(list(stiffness), 0.05).bodies,
+            [_rigid(c) for c in _beam(list(stiffness), 0.05).contacts],
+            [qs.Mover("ground")],
+            dimension=2,
+        )
+    )
+    assert rigid.status == "solved" and rigid.forces_indeterminate and not rigid.compliant_forces
+    solution = qs.solve(_beam(list(stiffness), 0.05))
+    assert solution.status == "solved" and solution.compliant_forces and not solution.forces_indeterminate
+    assert solution.audit is not None and solution.audit.passed
+    expected = _plane_of_springs(np.array([-0.4, 0.1, 0.5]), stiffness, 2.0 * G, np.array([0.05]))
+    np.testing.assert_allclose([c.normal_force for c in solution.contacts], expected, rtol=1e-7)
+    np.testing.assert_allclose([c.force[0] for c in solution.contacts], 0.0, atol=1e-7)
+    assert all(c.normal_force_range is None for c in solution.contacts)
+    assert "compliance determines the contact forces" in solution.message
+
+
+def _rigid(contact: qs.Contact) -> qs.Contact:
+    return qs.Contact(contact.body, contact.other, contact.point, contact.normal, contact.mu)
+
+
+def test_stiffer_support_carries_more() -> None:
+    """Moving stiffness to the middle support moves load to it: the forces follow the springs, not a vertex."""
+    soft = qs.solve(_beam([1.0e4, 1.0e4, 1.0e4], 0.0))
+    stiff = qs.solve(_beam([1.0e4, 1.0e6, 1.0e4], 0.0))
+    assert stiff.contacts[1].normal_force > soft.contacts[1].normal_force + 1.0
+    np.testing.assert_allclose(sum(c.normal_force for c in stiff.contacts), 2.0 * G, rtol=1e-9)
+
+
+def test_scale_invariance_mm_g() -> None:
+    """The same beam in millimetres and grams: forces x 1e6 (g mm / s^2 per N), the same split."""
+    metres = qs.solve(_beam([1.0e4, 3.0e4, 2.0e4], 0.05))
+    millimetres = qs.solve(_beam([1.0e4, 3.0e4, 2.0e4], 0.05, scale_length=1e3, scale_mass=1e3))
+    assert millimetres.compliant_forces
+    np.testing.assert_allclose([c.normal_force / 1e6 for c in millimetres.contacts], [c.normal_force for c in metres.contacts], rtol=1e-7)
+
+
+def _table(friction: str, load_at: tuple[float, float], stiffness: qs.Stiffness | None = None, legs: list[bool] | None = None) -> qs.Scene:
+    """A 3-D table top on four legs at (+-0.3, +-0.2), its 10 kg load at ``load_at``; ``legs`` marks the springy ones."""
+    corners = [(-0.3, -0.2), (0.3, -0.2), (0.3, 0.2), (-0.3, 0.2)]
+    springy = legs or [True] * 4
+    spring = stiffness or qs.Stiffness(5.0e4)
+    contacts = [
+        qs.Contact("top", "floor", [x, y, 0.0], [0, 0, 1], mu=0.6, stiffness=spring if s else None)
+        for (x, y), s in zip(corners, springy, strict=True)
+    ]
+    body = qs.Body("top", 10.0, [load_at[0], load_at[1], 0.3])
+    return qs.Scene([body], contacts, [qs.Mover("floor")], friction=friction)
+
+
+@pytest.mark.parametrize("friction", ["exact", "pyramid:8"])
+def test_table_on_four_compliant_legs(friction: str) -> None:
+    solution = qs.solve(_table(friction, (0.08, -0.05)))
+    assert solution.status == "solved" and solution.compliant_forces and not solution.forces_indeterminate
+    assert solution.audit is not None and solution.audit.passed
+    # Equal legs at (+-a, +-b): f_i = P/4 (1 + e_x x_i / a^2 + e_y y_i / b^2).
+    a, b, P = 0.3, 0.2, 10.0 * G
+    signs = np.array([(-1, -1), (1, -1), (1, 1), (-1, 1)])
+    by_hand = P / 4 * (1 + 0.08 * signs[:, 0] * a / a**2 + -0.05 * signs[:, 1] * b / b**2)
+    np.testing.assert_allclose([c.normal_force for c in solution.contacts], by_hand, rtol=1e-6)
+    corners = signs * np.array([a, b])
+    np.testing.assert_allclose(by_hand, _plane_of_springs(corners, np.full(4, 5.0e4), P, np.array([0.08, -0.05])), rtol=1e-12)
+    np.testing.assert_allclose([np.linalg.norm(c.force[:2]) for c in solution.contacts], 0.0, atol=1e-6)
+
+
+def test_rigid_legs_leave_the_forces_indeterminate() -> None:
+    """Two rigid legs can push against each other along the line between them: compliance cannot fix that."""
+    solution = qs.solve(_table("pyramid:8", (0.0, 0.0), legs=[True, False, True, False]))
+    assert solution.status == "solved" and solution.forces_indeterminate and not solution.compliant_forces
+    assert "rigid loaded contacts #1, #3" in solution.details["compliance"]
+
+
+def test_joint_stiffness_in_series_with_the_contact() -> None:
+    """The middle support is a robot's prismatic finger: its joint spring and the contact's act in series."""
+    beam = _beam([1.0e4, 3.0e4, 2.0e4], 0.05)
+    finger = qs.Contact("beam", "finger", [0.1, 0.0], [0.0, 1.0], mu=0.5, stiffness=qs.Stiffness(3.0e4, 6.0e4), jacobian=[[0.0], [1.0]])
+    robot = qs.Robot("arm", [0.0], joint_stiffness=[1.5e4])
+    scene = qs.Scene(
+        beam.bodies,
+        [beam.contacts[0], finger, beam.contacts[2]],
+        [qs.Mover("ground"), qs.Mover("finger", robot="arm")],
+        [robot],
+        dimension=2,
+    )
+    solution = qs.solve(scene)
+    assert solution.compliant_forces
+    series = 1.0 / (1.0 / 3.0e4 + 1.0 / 1.5e4)  # 1e4
+    expected = _plane_of_springs(np.array([-0.4, 0.1, 0.5]), np.array([1.0e4, series, 2.0e4]), 2.0 * G, np.array([0.05]))
+    np.testing.assert_allclose([c.normal_force for c in solution.contacts], expected, rtol=1e-7)
+    np.testing.assert_allclose(solution.robot_loads[0].torques, [expected[1]], rtol=1e-7)
+
+
+def test_scene_file_keys_and_round_trip(tmp_path: Path) -> None:
+    text = """
+quasistatic: 1
+dimension: 2
+stiffness: {normal: 10000.0, tangential: 20000.0}
+bodies:
+  beam: {mass: 2.0, com: [0.05, 0.02]}
+movers:
+  ground:
+contacts:
+  - {body: beam, other: ground, point: [-0.4, 0.0], normal: [0, 1], mu: 0.5}
+  - {body: beam, other: ground, point: [0.1, 0.0], normal: [0, 1], mu: 0.5, stiffness: {normal: 30000.0, tangential: 60000.0}}
+  - {body: beam, other: ground, point: [0.5, 0.0], normal: [0, 1], mu: 0.5, stiffness: {normal: 20000.0, tangential: 40000.0}}
+"""
+    path = tmp_path / "beam.yaml"
+    path.write_text(text)
+    scene = qs.load_scene(path)
+    assert scene.contacts[0].stiffness == qs.Stiffness(1.0e4, 2.0e4) and scene.contacts[1].stiffness == qs.Stiffness(3.0e4, 6.0e4)
+    again = qs.load_scene(qs.model.io.scene_to_dict(scene))
+    assert [c.stiffness for c in again.contacts] == [c.stiffness for c in scene.contacts]
+    out = json.loads(subprocess.run([QUASISTATIC, "solve", str(path), "--json"], capture_output=True, text=True, check=True).stdout)
+    assert out["status"] == "solved" and out["compliant_forces"] is True and out["forces_indeterminate"] is False
+    expected = _plane_of_springs(np.array([-0.4, 0.1, 0.5]), np.array([1.0e4, 3.0e4, 2.0e4]), 2.0 * G, np.array([0.05]))
+    np.testing.assert_allclose([c["normal_force"] for c in out["contacts"]], expected, rtol=1e-7)
+    assert all("normal_force_range" not in c for c in out["contacts"])
+    table = subprocess.run([QUASISTATIC, "solve", str(path)], capture_output=True, text=True, check=True).stdout
+    assert "forces: compliant" in table and "f_n range" not in table
+
+
+@pytest.mark.parametrize(
+    ("entry", "field"),
+    [
+        ("stiffness: {normal: -1.0}", "contacts[0].stiffness.normal"),
+        ("stiffness: {normal: 1.0, tangential: 0}", "contacts[0].stiffness.tangential"),
+        ("stiffness: {normal: .nan}", "contacts[0].stiffness.normal"),
+        ("stiffness: {tangential: 1.0}", "contacts[0].stiffness.normal"),
+    ],
+)
+def test_bad_stiffness_is_one_error_line(tmp_path: Path, entry: str, field: str) -> None:
+    path = tmp_path / "bad.yaml"
+    path.write_text(
+        "quasistatic: 1\ndimension: 2\nbodies: {box: {mass: 1, com: [0, 0.1]}}\nmovers: {ground: }\n"
+        f"contacts:\n  - {{body: box, other: ground, point: [0, 0], normal: [0, 1], {entry}}}\n"
+    )
+    result = subprocess.run([QUASISTATIC, "solve", str(path)], capture_output=True, text=True)
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error:") and field in lines[0] and "Traceback" not in result.stderr
+
+
+def test_joint_stiffness_must_match_the_joints() -> None:
+    with pytest.raises(qs.SceneError, match="expected 2 numbers") as error:
+        qs.Robot("arm", [0.0, 0.0], joint_stiffness=[1.0])
+    assert error.value.field == "robots.arm.joint_stiffness"
+    with pytest.raises(qs.SceneError, match="> 0"):
+        qs.Robot("arm", [0.0], joint_stiffness=[0.0])
+
+
+def _energy(solution: qs.Solution, scene: qs.Scene) -> float:
+    """1/2 sum f_n^2 / k_n + |f_t|^2 / k_t over the contacts, by hand."""
+    total = 0.0
+    for result, contact in zip(solution.contacts, scene.contacts, strict=True):
+        assert contact.stiffness is not None
+        tangential = np.linalg.norm(result.force) ** 2 - result.normal_force**2
+        total += 0.5 * (result.normal_force**2 / contact.stiffness.normal + tangential / contact.stiffness.tangential)
+    return total
+
+
+def test_exact_cone_active_at_the_optimum() -> None:
+    """A push on the table top: the slippery, stiff leg's share reaches its cone, where SCIP holds it.
+
+    The exact cones contain the inscribed 64-edge pyramid, so their optimum has no more energy, and at most
+    1 - cos(pi/64) = 0.12 % of the friction less.
+    """
+
+    def scene(friction: str) -> qs.Scene:
+        table = _table(friction, (0.0, 0.0))
+        legs = [
+            qs.Contact(
+                c.body, c.other, c.point, c.normal, mu=0.05 if i == 0 else 0.6, stiffness=qs.Stiffness(5.0e4, 5.0e5 if i == 0 else 5.0e4)
+            )
+            for i, c in enumerate(table.contacts)
+        ]
+        body = qs.Body("top", 10.0, [0.0, 0.0, 0.3], wrench=[20.0, 10.0, 0.0, 0.0, 0.0, 0.0])
+        return qs.Scene([body], legs, table.movers, friction=friction)
+
+    exact, pyramid = qs.solve(scene("exact")), qs.solve(scene("pyramid:64"), certify=False)  # the rest is not in question
+    assert exact.status == "solved" and exact.compliant_forces and exact.audit is not None and exact.audit.passed
+    leg = exact.contacts[0]
+    np.testing.assert_allclose(np.linalg.norm(leg.force[:2]), 0.05 * leg.normal_force, rtol=1e-5)  # on its cone
+    assert pyramid.compliant_forces
+    energy, bound = _energy(exact, scene("exact")), _energy(pyramid, scene("pyramid:64"))
+    assert energy <= bound * (1 + 1e-6) and energy >= bound * (1 - 5e-3)
