@@ -236,3 +236,121 @@ def test_exact_cone_active_at_the_optimum() -> None:
     assert pyramid.compliant_forces
     energy, bound = _energy(exact, scene("exact")), _energy(pyramid, scene("pyramid:64"))
     assert energy <= bound * (1 + 1e-6) and energy >= bound * (1 - 5e-3)
+
+
+# --------------------------------------------------------------------------- the compliant step (a squeeze)
+
+
+def _grasp(
+    closing_time: float,
+    *,
+    gravity: float = G,
+    k: tuple[float, float] = (2000.0, 2000.0),
+    kt: tuple[float, float] = (1000.0, 1000.0),
+    mu: float = 0.8,
+    length: float = 1.0,
+    mass: float = 1.0,
+) -> qs.Scene:
+    """A 0.5 kg box (0.1 wide) between two fingers at its com's height, closing at 0.01 each; springs k (normal), kt."""
+    L, M = length, mass
+    contacts = [
+        qs.Contact("box", "left", [-0.05 * L, 0.05 * L], [1.0, 0.0], mu=mu, stiffness=qs.Stiffness(k[0] * M, kt[0] * M)),
+        qs.Contact("box", "right", [0.05 * L, 0.05 * L], [-1.0, 0.0], mu=mu, stiffness=qs.Stiffness(k[1] * M, kt[1] * M)),
+    ]
+    movers = [qs.Mover("left", [0.01 * L, 0.0, 0.0]), qs.Mover("right", [-0.01 * L, 0.0, 0.0])]
+    body = qs.Body("box", 0.5 * M, [0.0, 0.05 * L])
+    return qs.Scene([body], contacts, movers, dimension=2, gravity=[0.0, -gravity * L], closing_time=closing_time)
+
+
+@pytest.mark.parametrize("closing_time", [0.1, 0.2, 0.4])
+def test_rigid_squeeze_is_jammed_compliant_squeeze_grows_with_closing(closing_time: float) -> None:
+    """Frictionless, no gravity, springs 1000 and 3000 in series: N = 2 v h / (1/k1 + 1/k2) = 1500 v h."""
+    solution = qs.solve(_grasp(closing_time, gravity=0.0, k=(1000.0, 3000.0), mu=0.0))
+    assert solution.status == "jammed"
+    step = solution.compliant_step
+    assert step is not None and step.valid and step.audit.passed
+    squeeze = 1500.0 * 0.01 * closing_time
+    np.testing.assert_allclose(step.normal_forces, [squeeze, squeeze], rtol=1e-9)
+    # The softer left spring takes up more of the closing: the box moves toward it, by v h - N / k1.
+    np.testing.assert_allclose(step.displacements["box"][0], 0.01 * closing_time - squeeze / 1000.0, rtol=1e-9)
+    assert "leave the displacement free" in step.message  # nothing holds the box along y, nor its turn
+
+
+def test_level_grasp_held_by_the_squeeze() -> None:
+    """Held when 2 mu k v h >= m g: N = k v h; the moment balance gives each finger m g / 2; the box sags and turns.
+
+    Tangential springs kt1, kt2: the contact points drop dy -+ 0.05 dtheta = -m g / (2 kt_i).
+    """
+    h, m, kt = 0.5, 0.5, (1000.0, 3000.0)
+    solution = qs.solve(_grasp(h, kt=kt))
+    step = solution.compliant_step
+    assert solution.status == "jammed" and step is not None and step.valid, solution.message
+    np.testing.assert_allclose(step.normal_forces, [2000.0 * 0.01 * h] * 2, rtol=1e-9)
+    np.testing.assert_allclose(step.forces[:, 1], [m * G / 2] * 2, rtol=1e-9)
+    drop = [-m * G / (2 * k) for k in kt]
+    dy, turn = (drop[0] + drop[1]) / 2, (drop[1] - drop[0]) / 0.1
+    np.testing.assert_allclose(step.displacements["box"], [0.0, dy, turn], rtol=1e-9, atol=1e-15)
+    assert step.states == ("stuck", "stuck") and "hold the bodies" in solution.message
+
+
+def test_level_grasp_slips_without_enough_closing() -> None:
+    """2 mu k v h = 2 x 0.8 x 2000 x 0.01 x 0.1 = 3.2 N < m g = 4.905 N: the fingers reach their friction limit."""
+    solution = qs.solve(_grasp(0.1))
+    step = solution.compliant_step
+    assert step is not None and not step.valid and set(step.states) == {"at friction limit"}
+    assert "reach their friction limit" in solution.message and "no answer" in solution.message
+
+
+def test_step_units_mm_g() -> None:
+    metres = qs.solve(_grasp(0.5, kt=(1000.0, 3000.0))).compliant_step
+    millimetres = qs.solve(_grasp(0.5, kt=(1000.0, 3000.0), length=1e3, mass=1e3)).compliant_step
+    assert metres is not None and millimetres is not None and millimetres.valid
+    np.testing.assert_allclose(np.array(millimetres.normal_forces) / 1e6, metres.normal_forces, rtol=1e-9)
+    np.testing.assert_allclose(millimetres.displacements["box"] * [1e-3, 1e-3, 1.0], metres.displacements["box"], rtol=1e-8, atol=1e-15)
+
+
+def test_rigid_fingers_stay_jammed() -> None:
+    """Only the table has springs: nothing takes up the fingers' closing, and the step says so."""
+    scene = _grasp(0.5)
+    rigid = [qs.Contact(c.body, c.other, c.point, c.normal, c.mu) for c in scene.contacts]
+    table = qs.Contact("box", "table", [0.0, 0.0], [0.0, 1.0], mu=0.5, stiffness=qs.Stiffness(1000.0))
+    solution = qs.solve(qs.Scene(scene.bodies, [*rigid, table], [*scene.movers, qs.Mover("table")], dimension=2, closing_time=0.5))
+    assert solution.status == "jammed" and solution.compliant_step is None
+    assert "a rigid contact is closed" in solution.details["compliance"]
+
+
+def test_exact_cone_squeeze_in_3d() -> None:
+    """The level grasp in 3-D on exact cones (SCIP): N = k v h, each finger m g / 2 upward."""
+    contacts = [
+        qs.Contact("box", "left", [-0.05, 0.0, 0.05], [1, 0, 0], mu=0.8, stiffness=qs.Stiffness(2000.0, 1000.0)),
+        qs.Contact("box", "right", [0.05, 0.0, 0.05], [-1, 0, 0], mu=0.8, stiffness=qs.Stiffness(2000.0, 1000.0)),
+    ]
+    movers = [qs.Mover("left", [0.01, 0, 0, 0, 0, 0]), qs.Mover("right", [-0.01, 0, 0, 0, 0, 0])]
+    scene = qs.Scene([qs.Body("box", 0.5, [0.0, 0.0, 0.05])], contacts, movers, closing_time=0.5)
+    solution = qs.solve(scene)
+    step = solution.compliant_step
+    assert solution.status == "jammed" and step is not None and step.valid, solution.message
+    np.testing.assert_allclose(step.normal_forces, [10.0, 10.0], rtol=1e-6)
+    np.testing.assert_allclose(step.forces[:, 2], [0.25 * G] * 2, rtol=1e-6)
+    np.testing.assert_allclose(step.displacements["box"][2], -0.5 * G / 2000.0, rtol=1e-5)
+
+
+def test_step_in_json_and_table(tmp_path: Path) -> None:
+    path = tmp_path / "grasp.yaml"
+    path.write_text(
+        "quasistatic: 1\ndimension: 2\nclosing_time: 0.5\nstiffness: {normal: 2000.0, tangential: 1000.0}\n"
+        "bodies: {box: {mass: 0.5, com: [0.0, 0.05]}}\n"
+        "movers: {left: {twist: [0.01, 0.0, 0.0]}, right: {twist: [-0.01, 0.0, 0.0]}}\n"
+        "contacts:\n"
+        "  - {body: box, other: left, point: [-0.05, 0.05], normal: [1.0, 0.0], mu: 0.8}\n"
+        "  - {body: box, other: right, point: [0.05, 0.05], normal: [-1.0, 0.0], mu: 0.8}\n"
+    )
+    out = json.loads(subprocess.run([QUASISTATIC, "solve", str(path), "--json"], capture_output=True, text=True, check=True).stdout)
+    assert out["status"] == "jammed" and out["compliant_step"]["valid"] is True
+    np.testing.assert_allclose([c["normal_force"] for c in out["compliant_step"]["contacts"]], [10.0, 10.0], rtol=1e-9)
+    assert out["compliant_step"]["audit"]["passed"] is True
+    table = subprocess.run([QUASISTATIC, "solve", str(path)], capture_output=True, text=True, check=True).stdout
+    assert "compliant step (0.5): valid" in table and "box displacement" in table
+    path.write_text(path.read_text().replace("closing_time: 0.5", "closing_time: -1"))
+    bad = subprocess.run([QUASISTATIC, "solve", str(path)], capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.startswith("error:") and "closing_time" in bad.stderr and len(bad.stderr.splitlines()) == 1

@@ -128,6 +128,7 @@ class World:
     gravity: npt.ArrayLike | None = None
     friction: FrictionModel | str = "exact"
     stiffness: Stiffness | None = None  # the Scene's default: every contact without a stiffness of its own
+    closing_time: float | None = None  # the Scene's: how long the movers advance against the springs
 
     def __post_init__(self) -> None:
         parts: list[SolidBody | ShapedMover] = [*self.bodies, *self.movers]
@@ -175,6 +176,7 @@ class World:
             gravity=self.gravity,
             friction=self.friction,
             stiffness=self.stiffness,
+            closing_time=self.closing_time,
         )
 
     # ----------------------------------------------------------------- parts

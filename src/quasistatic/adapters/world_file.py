@@ -56,6 +56,7 @@ def world_from_file(parsed: SceneFile, folder: Path) -> World:
         gravity=parsed.gravity,
         friction=parsed.friction,
         stiffness=stiffness_of(parsed.stiffness, "stiffness"),
+        closing_time=parsed.closing_time,
     )
 
 

@@ -198,6 +198,7 @@ class SceneFile(_FileModel):
     contacts: list[ContactFile] = []
     contact_detection: DetectionFile | None = None
     stiffness: StiffnessFile | None = None
+    closing_time: _Number | None = None
 
     @property
     def is_geometric(self) -> bool:
@@ -247,6 +248,7 @@ def scene_from_file(parsed: SceneFile) -> Scene:
         robots=tuple(plain_robot(name, r) for name, r in parsed.robots.items()),
         contacts=tuple(_contact(c, index) for index, c in enumerate(parsed.contacts)),
         stiffness=stiffness_of(parsed.stiffness, "stiffness"),
+        closing_time=parsed.closing_time,
     )
 
 
@@ -286,6 +288,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "robots": {r.name: _robot_entry(r) for r in scene.robots},
         "contacts": [_contact_entry(c) for c in scene.contacts],
         **({} if scene.stiffness is None else {"stiffness": _stiffness_entry(scene.stiffness)}),
+        **({} if scene.closing_time is None else {"closing_time": scene.closing_time}),
     }
 
 

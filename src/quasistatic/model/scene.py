@@ -119,10 +119,10 @@ class Stiffness:
         _assign(self, normal=k_n, tangential=k_n if tangential is None else _positive(tangential, "stiffness.tangential"))
 
 
-def _positive(value: Any, path: str) -> float:
+def _positive(value: Any, path: str, what: str = "a stiffness") -> float:
     number = checked_number(value, path, minimum=0.0)
     if number <= 0.0:
-        raise SceneError(path, value, "a stiffness must be > 0 (leave it out for a rigid contact)")
+        raise SceneError(path, value, f"{what} must be > 0 (leave the key out for none)")
     return number
 
 
@@ -346,6 +346,11 @@ class Scene:
     stiffness : Stiffness or None
         The default stiffness of every contact that gives none of its own (filled into those
         contacts once in a Scene); None leaves them rigid.
+    closing_time : float or None
+        How long the commanded motion acts against the contact springs [time], > 0: each mover
+        advances its velocity times this, and the compliant step (:mod:`quasistatic.solvers.compliance`)
+        finds the squeeze forces and the bodies' small displacement when the rigid answer is
+        ``jammed`` or ``ambiguous``. None: no step.
     """
 
     bodies: tuple[Body, ...]
@@ -356,6 +361,7 @@ class Scene:
     gravity: FloatArray
     friction: FrictionModel
     stiffness: Stiffness | None
+    closing_time: float | None
     _derived: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __init__(
@@ -368,9 +374,12 @@ class Scene:
         gravity: npt.ArrayLike | None = None,
         friction: FrictionModel | str = "exact",
         stiffness: Stiffness | None = None,
+        closing_time: float | None = None,
     ) -> None:
         if stiffness is not None and not isinstance(stiffness, Stiffness):
             raise SceneError("stiffness", stiffness, "expected a Stiffness(normal, tangential)")
+        if closing_time is not None:
+            closing_time = _positive(closing_time, "closing_time", "a time over which the movers advance")
         if isinstance(dimension, bool) or not isinstance(dimension, (int, np.integer)) or dimension not in (2, 3):
             raise SceneError("dimension", dimension, "must be 2 or 3")
         dimension = int(dimension)
@@ -388,6 +397,7 @@ class Scene:
             gravity=gravity_vector,
             friction=model,
             stiffness=stiffness,
+            closing_time=closing_time,
             _derived={},
         )
 

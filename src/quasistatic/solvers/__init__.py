@@ -8,7 +8,7 @@ units. Their numerics (``numerics/``) and certification helpers
 never ``check`` (the judge stays independent) nor anything above.
 """
 
-from .compliance import CompliantForces, compliant_forces
+from .compliance import CompliantForces, StepForces, compliant_forces, compliant_step
 from .oversize import too_large
 from .registry import BACKENDS, Backend, Solver, get_backend
 from .result import BackendResult, Options, Range, SearchProgress
@@ -21,8 +21,10 @@ __all__ = [
     "Options",
     "Range",
     "SearchProgress",
+    "StepForces",
     "Solver",
     "compliant_forces",
+    "compliant_step",
     "get_backend",
     "too_large",
 ]

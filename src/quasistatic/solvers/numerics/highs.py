@@ -117,8 +117,9 @@ def solve_qp(
     row_upper: np.ndarray,
     col_lower: np.ndarray | None = None,
     col_upper: np.ndarray | None = None,
+    cost: np.ndarray | None = None,
 ) -> LPResult:
-    """Solve the convex QP ``min 1/2 x.H x  s.t.  row_lower <= A x <= row_upper, col_lower <= x <= col_upper``.
+    """Solve the convex QP ``min 1/2 x.H x + cost.x  s.t.  row_lower <= A x <= row_upper, col_lower <= x <= col_upper``.
 
     ``hessian`` (n, n) must be symmetric positive semi-definite; a fresh HiGHS instance
     solves it (a Hessian would otherwise stay on this thread's LP instance).
@@ -126,7 +127,7 @@ def solve_qp(
     n = hessian.shape[0]
     if n == 0:
         return _without_columns(row_lower, row_upper)
-    cost = np.zeros(n)
+    cost = np.zeros(n) if cost is None else cost
     solver = _load(_new_highs(), cost, A, row_lower, row_upper, col_lower, col_upper, False)
     lower = sp.tril(sp.csc_matrix(hessian)).tocsc()  # HiGHS reads the lower triangle, column by column
     lower.eliminate_zeros()
@@ -141,7 +142,7 @@ def solve_qp(
     except Exception as exc:  # a crash inside HiGHS, not a status
         raise SolverError("highs", f"HiGHS failed: {exc}") from exc
     result = _run(solver, cost, False)
-    objective = 0.5 * float(result.x @ (hessian @ result.x)) if result.status == "optimal" else float("nan")
+    objective = 0.5 * float(result.x @ (hessian @ result.x)) + float(cost @ result.x) if result.status == "optimal" else float("nan")
     return LPResult(result.status, result.x, result.row_dual, objective)
 
 
