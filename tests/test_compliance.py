@@ -354,3 +354,62 @@ def test_step_in_json_and_table(tmp_path: Path) -> None:
     path.write_text(path.read_text().replace("closing_time: 0.5", "closing_time: -1"))
     bad = subprocess.run([QUASISTATIC, "solve", str(path)], capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.startswith("error:") and "closing_time" in bad.stderr and len(bad.stderr.splitlines()) == 1
+
+
+def test_level_grasp_without_closing_cannot_hold() -> None:
+    """Still fingers: the rigid model lists four motions (held with any squeeze, or sliding down); with springs
+    and no closing the squeeze is zero, so friction cannot carry the weight: the box slips."""
+    grasp = _grasp(0.5)
+    still = qs.Scene(grasp.bodies, grasp.contacts, [qs.Mover("left"), qs.Mover("right")], dimension=2, closing_time=0.5)
+    solution = qs.solve(still)
+    assert solution.status == "ambiguous"
+    step = solution.compliant_step
+    assert step is not None and not step.valid and set(step.states) == {"at friction limit"}
+
+
+def test_detected_contacts_take_the_pair_stiffness(tmp_path: Path) -> None:
+    """A box on a table found from shapes, its com off-centre: the four corners share the load as a plane of springs."""
+    pytest.importorskip("coal")
+    text = """
+quasistatic: 1
+stiffness: {normal: 1.0}
+bodies:
+  box:
+    mass: 2.0
+    com: [0.02, -0.01, 0.0]
+    shape: {box: [0.1, 0.1, 0.1]}
+    pose: {position: [0.0, 0.0, 0.05]}
+movers:
+  table:
+    shape: {halfspace: {normal: [0.0, 0.0, 1.0], offset: 0.0}}
+contact_detection:
+  friction: {default: 0.5}
+  stiffness:
+    default: {normal: 2.0}
+    pairs:
+      - {between: [box, table], normal: 40000.0, tangential: 20000.0}
+"""
+    path = tmp_path / "box.yaml"
+    path.write_text(text)
+    world = qs.load_world(path)
+    scene = world.scene()
+    assert {c.stiffness for c in scene.contacts} == {qs.Stiffness(4.0e4, 2.0e4)} and len(scene.contacts) == 4
+    solution = qs.solve(world)
+    assert solution.status == "solved" and solution.compliant_forces
+    corners = np.array([c.point[:2] for c in scene.contacts])
+    expected = _plane_of_springs(corners, np.full(4, 4.0e4), 2.0 * G, np.array([0.02, -0.01]))
+    np.testing.assert_allclose([c.normal_force for c in solution.contacts], expected, rtol=1e-6)
+    bad = text.replace("between: [box, table]", "between: [box, tabel]")
+    path.write_text(bad)
+    with pytest.raises(qs.SceneError) as error:
+        qs.load_world(path)
+    assert error.value.field == "contact_detection.stiffness.pairs[0].between"
+
+
+def test_compliant_grasp_example_gives_the_answer_its_comment_derives() -> None:
+    example = Path(__file__).resolve().parents[1] / "examples" / "compliant_grasp.yaml"
+    solution = qs.solve(qs.load_scene(example))
+    step = solution.compliant_step
+    assert solution.status == "jammed" and step is not None and step.valid
+    np.testing.assert_allclose(step.forces, [[10.0, 2.4525], [-10.0, 2.4525]], rtol=1e-9)
+    np.testing.assert_allclose(step.displacements["box"], [0.0, -0.0024525, 0.0], atol=1e-12)

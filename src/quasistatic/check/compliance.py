@@ -13,7 +13,7 @@ import numpy as np
 from ..model import Scales, Scene
 from ..model.kinematics import contact_frames
 from ..solution import CompliantStep, StepAudit
-from ..tolerances import AUDIT, SMALLEST_LENGTH
+from ..tolerances import AUDIT, ROUNDOFF, SMALLEST_LENGTH
 from .audit import relative_velocities
 
 __all__ = ["audited_step"]
@@ -44,8 +44,13 @@ def audited_step(
         tolerance,
     )
     valid = audit.passed and LIMIT not in states
-    normal_forces = tuple(float(f) + 0.0 for f in local[:, -1])
-    return CompliantStep(h, dict(displacements), forces, normal_forces, states, audit, valid, message)
+    # Round-off of the scene's own scales is reported as 0 (as a motion's): a 1e-18 m shift next to 2 mm is not data.
+    d = scene.dimension
+    units = np.r_[np.full(d, span), np.full(scene.twist_size - d, span / scales.length)] * ROUNDOFF
+    shown = {name: np.where(np.abs(value) <= units, 0.0, value) + 0.0 for name, value in displacements.items()}
+    forces = np.where(np.abs(forces) <= ROUNDOFF * scales.force, 0.0, forces) + 0.0
+    normal_forces = tuple(0.0 if abs(f) <= ROUNDOFF * scales.force else float(f) + 0.0 for f in local[:, -1])
+    return CompliantStep(h, shown, forces, normal_forces, states, audit, valid, message)
 
 
 def _deflections(scene: Scene, frames: np.ndarray, forces: np.ndarray, local: np.ndarray) -> np.ndarray:
