@@ -413,3 +413,11 @@ def test_compliant_grasp_example_gives_the_answer_its_comment_derives() -> None:
     assert solution.status == "jammed" and step is not None and step.valid
     np.testing.assert_allclose(step.forces, [[10.0, 2.4525], [-10.0, 2.4525]], rtol=1e-9)
     np.testing.assert_allclose(step.displacements["box"], [0.0, -0.0024525, 0.0], atol=1e-12)
+
+
+def test_closing_time_without_springs_says_so() -> None:
+    grasp = _grasp(0.5)
+    rigid = [qs.Contact(c.body, c.other, c.point, c.normal, c.mu) for c in grasp.contacts]
+    solution = qs.solve(qs.Scene(grasp.bodies, rigid, grasp.movers, dimension=2, closing_time=0.5))
+    assert solution.status == "jammed" and solution.compliant_step is None
+    assert "nothing has a stiffness" in solution.details["compliance"]

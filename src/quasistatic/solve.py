@@ -216,6 +216,8 @@ def _compliant(problem: Problem, solution: Solution, result: BackendResult, tole
     """With springs in the scene: a solved motion's compliant forces; with a closing time, the step the rigid model lacks."""
     scene = problem.scene
     if not scene.compliant:
+        if scene.closing_time is not None:
+            return _compliance_note(solution, "closing_time is given but nothing has a stiffness to take up the closing")
         return solution
     if solution.status == "solved" and result.motions:
         return _with_compliance(problem, solution, result.motions[0].q, tolerance, time_limit)
@@ -276,10 +278,15 @@ def _with_compliance(problem: Problem, solution: Solution, q: FloatArray, tolera
         laws = ", ".join(motion.audit.failures())
         return _compliance_note(solution, f"not applied: its forces failed the audit ({laws}); the rigid forces are reported")
     energy = found.energy * problem.scales.force * problem.scales.length
-    message = solution.message.replace("; the contact forces are indeterminate", "")
+    message = solution.message
+    if solution.forces_indeterminate:
+        message = (
+            message.replace("; the contact forces are indeterminate", "")
+            + "; compliance determines the contact forces (least elastic energy)"
+        )
     return dataclasses.replace(
         solution,
-        message=f"{message}; compliance determines the contact forces (least elastic energy)",
+        message=message,
         motion=motion,
         forces_indeterminate=False,
         compliant_forces=True,
