@@ -23,7 +23,7 @@ from .batch import solve_many
 from .errors import BackendUnavailableError, QuasistaticError, SceneError, SolverError
 from .laws import Problem, assemble
 from .loading import load_scene, load_world
-from .model import Body, Contact, FrictionModel, Mover, Robot, Scene
+from .model import Body, Contact, FrictionModel, Mover, Robot, Scene, Stiffness
 from .sim import Inputs, InputTable, Trajectory, simulate
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
@@ -61,6 +61,7 @@ __all__ = [
     "QuasistaticError",
     "Robot",
     "Scene",
+    "Stiffness",
     "SceneError",
     "ShapedMover",
     "SolidBody",

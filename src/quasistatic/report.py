@@ -17,7 +17,7 @@ from rich.table import Table
 from rich.text import Text
 
 from .model import Contact
-from .solution import Bounds, Certificate, CertificateKind, ContactResult, Motion, MoverWrench, RobotLoad, Solution
+from .solution import Bounds, Certificate, CertificateKind, CompliantStep, ContactResult, Motion, MoverWrench, RobotLoad, Solution
 from .tolerances import DISPLAY_ZERO
 
 if TYPE_CHECKING:
@@ -82,11 +82,15 @@ def render_solution(solution: Solution, console: Console) -> None:
     console.print(Text(solution.message))
     console.print(Text(f"method: {solution.method}   friction model: {solution.friction}   {_proof(solution)}"))
     console.print(Text("units: those of the scene file (forces, lengths and times as given there)"))
+    if solution.compliant_forces:
+        console.print(Text("forces: compliant (of the forces the rigid motion allows, the least elastic energy; unique and audited)"))
     if solution.certificate is not None:
         console.print(Text(f"certificate: {solution.certificate.text}"))
         explanation = _explain(solution.certificate)
         if explanation:
             console.print(Text(explanation))
+    if solution.compliant_step is not None:
+        _render_step(solution.compliant_step, console)
     motion = solution.motion
     if motion is None:
         return
@@ -267,6 +271,27 @@ def _format_bounds(bounds: Bounds | None) -> str:
         return "-"
     lo, hi = bounds
     return f"{'(-inf' if lo is None else '[' + format_float(lo)}, {'inf)' if hi is None else format_float(hi) + ']'}"
+
+
+def _render_step(step: CompliantStep, console: Console) -> None:
+    """The compliant step: its verdict, each contact's force and state, each body's displacement, its audit."""
+    verdict = Text("valid", style="green") if step.valid else Text("NOT AN ANSWER", style="bold red")
+    table = _table(Text.assemble(f"compliant step ({step.closing_time:g}): ", verdict))
+    for name in ("#", "state", "f_n", "force"):
+        table.add_column(name, justify="left" if name == "state" else "right")
+    scale = float(np.max(np.abs(step.forces), initial=0.0))
+    for index, (force, normal, state) in enumerate(zip(step.forces, step.normal_forces, step.states, strict=True)):
+        table.add_row(str(index), state, format_float(normal, scale), format_vector(force, scale))
+    audit = step.audit
+    residuals = (
+        f"equilibrium {format_float(audit.equilibrium)}, cone {format_float(audit.cone)}, compatibility {format_float(audit.compatibility)}"
+    )
+    console.print()
+    console.print(table)
+    console.print(Text(f"step audit (scene-relative, tolerance {format_float(audit.tolerance)}): {'passed' if audit.passed else 'FAILED'}"))
+    console.print(Text(f"  residuals: {residuals}"))
+    for name, displacement in step.displacements.items():
+        console.print(Text(f"{name} displacement (com, then rotation): {format_vector(displacement)}"))
 
 
 def _power_table(motion: Motion) -> Table:

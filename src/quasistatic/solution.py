@@ -28,6 +28,8 @@ __all__ = [
     "Bounds",
     "PowerBalance",
     "Audit",
+    "StepAudit",
+    "CompliantStep",
     "Motion",
     "Solution",
 ]
@@ -338,6 +340,88 @@ class Audit:
         return {**{k: float(v) for k, v in self.residuals().items()}, "tolerance": self.tolerance, "passed": self.passed}
 
 
+@dataclass(frozen=True)
+class StepAudit:
+    """Residuals of the compliant step's laws on the scene data, each relative to the scene's scales.
+
+    Attributes
+    ----------
+    equilibrium : float
+        Largest unbalanced force (per force scale) or moment (per force x length scale).
+    cone : float
+        Largest excursion of a force outside its friction cone or below zero normal force (per force scale).
+    compatibility : float
+        Largest mismatch, per displacement scale (the largest commanded advance or spring deflection), between
+        what the springs of a stuck contact deflect and how far the bodies and movers moved there; at an open
+        contact, the penetration of its gap; at a contact at its friction limit, the part of the slip not
+        opposite to its friction.
+    tolerance : float
+    """
+
+    equilibrium: float
+    cone: float
+    compatibility: float
+    tolerance: float
+
+    @property
+    def passed(self) -> bool:
+        t = self.tolerance
+        return self.equilibrium <= t and self.cone <= t and self.compatibility <= t
+
+    def to_dict(self) -> dict[str, Any]:
+        residuals = {"equilibrium": self.equilibrium, "cone": self.cone, "compatibility": self.compatibility}
+        return {**{k: float(v) for k, v in residuals.items()}, "tolerance": self.tolerance, "passed": self.passed}
+
+
+@dataclass(frozen=True)
+class CompliantStep:
+    """What the contact springs do when the movers advance for ``closing_time`` (``Scene.closing_time``).
+
+    The answer when the rigid model has none (``jammed``: a squeeze) or many (``ambiguous``): the bodies'
+    small displacement and the forces of least complementary energy, 1/2 f.C f minus the work of the
+    movers' advance. Exact while every loaded contact sticks; a contact at its friction limit would slip,
+    which this static step does not model: ``valid`` is then False and the numbers are not an answer.
+
+    Attributes
+    ----------
+    closing_time : float
+        [time]
+    displacements : dict name -> array (3,) in 2-D or (6,) in 3-D
+        Each body's displacement over the step: its com's, then its (small) rotation [length, rad].
+    forces : array (m, d)
+        Contact forces on each ``body``, world frame [force].
+    normal_forces : tuple of float
+        Their components along the contact normals [force], >= 0.
+    states : tuple of {"stuck", "at friction limit", "open"}
+    audit : StepAudit
+    valid : bool
+        The audit passed and no loaded contact is at its friction limit.
+    message : str
+    """
+
+    closing_time: float
+    displacements: dict[str, np.ndarray]
+    forces: np.ndarray
+    normal_forces: tuple[float, ...]
+    states: tuple[str, ...]
+    audit: StepAudit
+    valid: bool
+    message: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "closing_time": float(self.closing_time),
+            "valid": self.valid,
+            "message": self.message,
+            "displacements": {name: _floats(d) for name, d in self.displacements.items()},
+            "contacts": [
+                {"force": _floats(f), "normal_force": float(n), "state": state}
+                for f, n, state in zip(self.forces, self.normal_forces, self.states, strict=True)
+            ],
+            "audit": self.audit.to_dict(),
+        }
+
+
 class ContactSource(Protocol):
     """Where a Motion's per-contact results come from: built when first read (solves that only need
     twists, statuses and audits, as batches do, never pay for one object per contact)."""
@@ -479,6 +563,14 @@ class Solution:
         The reported motion is determined but its contact forces are not; each
         contact then carries ``normal_force_range``. (For ``ambiguous``, each
         listed motion says the same of itself.)
+    compliant_forces : bool
+        The reported forces are the compliant ones: of the forces the rigid motion allows,
+        those of least elastic energy of the scene's contact springs and joint stiffness
+        (:mod:`quasistatic.solvers.compliance`), unique and audited; ``forces_indeterminate``
+        is then False.
+    compliant_step : CompliantStep or None
+        With ``Scene.closing_time``, when the rigid answer is ``jammed`` or ``ambiguous``: what the
+        contact springs do as the movers advance for that time (a squeeze force, a held or slipping grasp).
     certified : bool
         The verdict is proven: ``solved`` means the only motion, ``ambiguous``
         lists motions that all satisfy the laws, ``jammed``/``unstable`` carry a
@@ -507,6 +599,8 @@ class Solution:
     motion: Motion | None = None
     solutions: tuple[Motion, ...] = ()
     forces_indeterminate: bool = False
+    compliant_forces: bool = False
+    compliant_step: CompliantStep | None = None
     certified: bool = False
     diagnosis: Diagnosis | None = None
     certificate: Certificate | None = None
@@ -600,6 +694,7 @@ class Solution:
             "friction": self.friction,
             "certified": self.certified,
             "forces_indeterminate": self.forces_indeterminate,
+            "compliant_forces": self.compliant_forces,
         }
         if self.motion is not None:
             motion = self.motion.to_dict()
@@ -617,6 +712,7 @@ class Solution:
         out["certificate"] = None if self.certificate is None else self.certificate.to_dict()
         out["search_complete"] = self.search_complete
         out["fallback"] = [{"method": a.method, "message": a.message} for a in self.fallback]
+        out["compliant_step"] = None if self.compliant_step is None else self.compliant_step.to_dict()
         out["seconds"] = float(self.seconds)
         details = self.details
         if details:

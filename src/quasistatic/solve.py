@@ -14,13 +14,15 @@ import time
 from collections.abc import Callable, Sequence
 from functools import partial
 
+import numpy as np
+
 from .adapters import Detection, World
-from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
+from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion, audited_step
 from .errors import QuasistaticError, SolverError
 from .laws import Problem, RawMotion, WorldForceSet, assemble, free_directions, physical_twists, to_world
-from .model import Scene
-from .solution import Attempt, Mode, Motion, Solution
-from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, get_backend, too_large
+from .model import FloatArray, Scene
+from .solution import Attempt, CompliantStep, Mode, Motion, Solution
+from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, compliant_forces, compliant_step, get_backend, too_large
 
 Range = tuple[float, float | None]
 
@@ -111,6 +113,7 @@ def solve(
             )
         result = _run(backend, problem, options)
         solution = _audited(problem, result, name, tolerance, options, tuple(tried), started)
+        solution = _compliant(problem, solution, result, tolerance, options.time_limit)
         # A certifying method's verdict stands unless the audit turned its motion down; the fast path's only when solved.
         rejected = solution.status == "failed" and result.status != "failed"
         if name == names[-1] or (not rejected if backend.certifies else solution.ok):
@@ -207,6 +210,92 @@ def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFA
         force_set=None if raw.force_set is None else WorldForceSet(problem, raw.force_set),
         tolerance=tolerance,
     )
+
+
+def _compliant(problem: Problem, solution: Solution, result: BackendResult, tolerance: float, time_limit: float) -> Solution:
+    """With springs in the scene: a solved motion's compliant forces; with a closing time, the step the rigid model lacks."""
+    scene = problem.scene
+    if not scene.compliant:
+        if scene.closing_time is not None:
+            return _compliance_note(solution, "closing_time is given but nothing has a stiffness to take up the closing")
+        return solution
+    if solution.status == "solved" and result.motions:
+        return _with_compliance(problem, solution, result.motions[0].q, tolerance, time_limit)
+    if solution.status in ("jammed", "ambiguous") and scene.closing_time is not None:
+        return _with_step(problem, solution, tolerance, time_limit)
+    return solution
+
+
+def _with_step(problem: Problem, solution: Solution, tolerance: float, time_limit: float) -> Solution:
+    """The rigid verdict with the compliant step beside it: what the springs do as the movers advance (audited)."""
+    scene, scales = problem.scene, problem.scales
+    assert scene.closing_time is not None
+    found = compliant_step(problem, scene.closing_time, time_limit)
+    if found.c is None or found.displacement is None:
+        return _compliance_note(solution, f"step: {found.reason}")
+    _, forces = to_world(problem, np.zeros(problem.n_dof), found.c)
+    k, d = scene.twist_size, scene.dimension
+    units = np.r_[np.full(d, scales.length), np.ones(k - d)]  # the displacement's length entries, then its rotations [rad]
+    displacements = {body.name: found.displacement[i * k : (i + 1) * k] * units for i, body in enumerate(scene.bodies)}
+    step = audited_step(scene, scales, displacements, forces, "", tolerance)
+    text = _step_text(step, found.determined)
+    step = dataclasses.replace(step, message=text)
+    return dataclasses.replace(solution, message=f"{solution.message}; {text}", compliant_step=step)
+
+
+def _step_text(step: CompliantStep, determined: bool) -> str:
+    h = f"with compliance, as the movers advance for {step.closing_time:g}"
+    limit = [f"#{i}" for i, state in enumerate(step.states) if state == "at friction limit"]
+    if limit:
+        slip = "they would slip, which the static step does not model (no answer)"
+        return f"{h}, contacts {', '.join(limit)} reach their friction limit: {slip}"
+    if not step.audit.passed:
+        return f"{h}: the step failed its audit ({', '.join(_step_failures(step))}); it is not an answer"
+    loaded = ", ".join(f"#{i} {f:.6g}" for i, f in enumerate(step.normal_forces) if step.states[i] != "open")
+    free = "" if determined else " (the loaded contacts leave the displacement free along some direction: the smallest is shown)"
+    return f"{h} the springs hold the bodies with normal forces {loaded or 'none'}{free}"
+
+
+def _step_failures(step: CompliantStep) -> list[str]:
+    audit = step.audit
+    residuals = {"equilibrium": audit.equilibrium, "cone": audit.cone, "compatibility": audit.compatibility}
+    return [name for name, value in residuals.items() if not value <= audit.tolerance]
+
+
+def _with_compliance(problem: Problem, solution: Solution, q: FloatArray, tolerance: float, time_limit: float) -> Solution:
+    """The solved motion with its compliant forces (least elastic energy), audited; the rigid answer when they fail.
+
+    Why compliance did not fix the forces (a rigid contact, a failed program, an audit) goes in the notes.
+    """
+    found = compliant_forces(problem, q, time_limit)
+    if found.c is None:
+        return _compliance_note(solution, f"not applied: {found.reason}")
+    if not found.unique:
+        rigid = ", ".join(f"#{i}" for i in found.rigid) or "none"
+        return _compliance_note(solution, f"leaves the forces indeterminate: rigid loaded contacts {rigid} share the load freely")
+    motion = audited_raw_motion(problem, RawMotion(q, found.c), tolerance)
+    if not motion.audit.passed:
+        laws = ", ".join(motion.audit.failures())
+        return _compliance_note(solution, f"not applied: its forces failed the audit ({laws}); the rigid forces are reported")
+    energy = found.energy * problem.scales.force * problem.scales.length
+    message = solution.message
+    if solution.forces_indeterminate:
+        message = (
+            message.replace("; the contact forces are indeterminate", "")
+            + "; compliance determines the contact forces (least elastic energy)"
+        )
+    return dataclasses.replace(
+        solution,
+        message=message,
+        motion=motion,
+        forces_indeterminate=False,
+        compliant_forces=True,
+        notes=(*solution.notes, ("compliance", f"elastic energy {energy:.6g} (force x length)")),
+    )
+
+
+def _compliance_note(solution: Solution, text: str) -> Solution:
+    return dataclasses.replace(solution, notes=(*solution.notes, ("compliance", text)))
 
 
 def _physical_ranges(ranges: Sequence[Range], force: float) -> list[Range]:

@@ -26,6 +26,7 @@ __all__ = [
     "SAME_TWIST",
     "DISTINCT_TWIST",
     "FORCE_RANK",
+    "COMPLIANCE_RANK",
     "MOTION_RANK",
     "LP_FEASIBILITY",
     "HIGHS_SMALLEST_ENTRY",
@@ -108,6 +109,11 @@ DISTINCT_TWIST = 1e-5
 
 FORCE_RANK = 1e-10
 """Singular values of the closed contacts' normals above this are independent: then the forces are unique [-]."""
+
+COMPLIANCE_RANK = 1e-9
+"""Eigenvalues of the compliance on the directions the consistent forces may vary in, above this fraction of its
+largest entry, make the least-energy forces unique (a rigid contact's direction has 0; the stiffest spring
+a scene may pair with the softest is 1e9 times stiffer) [-]."""
 
 MOTION_RANK = 1e-9
 """Singular values of the loaded contacts' normals above this fix the twist: then the motion is unique [-]."""

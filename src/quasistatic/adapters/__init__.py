@@ -22,7 +22,7 @@ Rules:
 from .detect import Collider, ContactPoint, candidate_pairs, detect
 from .robot import ROBOTS_INSTALL_HINT, UrdfRobot
 from .shapes import Box, Capsule, Convex, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere, shape_from_coal
-from .world import ContactDetection, Detection, FrictionPair, ShapedMover, SolidBody, World
+from .world import ContactDetection, Detection, FrictionPair, ShapedMover, SolidBody, StiffnessPair, World
 from .world_file import world_from_file
 
 __all__ = [
@@ -36,6 +36,7 @@ __all__ = [
     "Cylinder",
     "Detection",
     "FrictionPair",
+    "StiffnessPair",
     "Halfspace",
     "Mesh",
     "Pose",

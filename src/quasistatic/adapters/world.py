@@ -16,12 +16,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
 
 from ..errors import SceneError
-from ..model import Body, Contact, FrictionModel, Mover, Robot, Scene
+from ..model import Body, Contact, FrictionModel, Mover, Robot, Scene, Stiffness
 from ..tolerances import DETECTION_MARGIN
 from .detect import Collider, ContactPoint, detect, nearest_gaps
 from .robot import UrdfRobot, link_owner
@@ -70,17 +71,29 @@ class FrictionPair:
 
 
 @dataclass(frozen=True)
+class StiffnessPair:
+    """The contact stiffness between two names (as :class:`FrictionPair`): every detected contact between them."""
+
+    between: tuple[str, str]
+    stiffness: Stiffness
+
+
+@dataclass(frozen=True)
 class ContactDetection:
     """What counts as a contact and its friction.
 
     ``margin``: gaps up to this count as contacts [length]; None means :data:`DETECTION_MARGIN` times the
     largest free body's size, so a scene in millimetres finds the same contacts as one in metres.
     ``mu``: the default friction coefficient; ``pairs`` override it.
+    ``stiffness``: the default stiffness of a detected contact (None: the scene's, else rigid);
+    ``stiffness_pairs`` override it.
     """
 
     margin: float | None = None
     mu: float = 0.0
     pairs: tuple[FrictionPair, ...] = ()
+    stiffness: Stiffness | None = None
+    stiffness_pairs: tuple[StiffnessPair, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -114,14 +127,20 @@ class World:
     detection: ContactDetection = field(default_factory=ContactDetection)
     gravity: npt.ArrayLike | None = None
     friction: FrictionModel | str = "exact"
+    stiffness: Stiffness | None = None  # the Scene's default: every contact without a stiffness of its own
+    closing_time: float | None = None  # the Scene's: how long the movers advance against the springs
 
     def __post_init__(self) -> None:
         parts: list[SolidBody | ShapedMover] = [*self.bodies, *self.movers]
         known = {p.name for p in parts} | {r.name for r in self.robots} | set(self._robot_links())
-        for index, pair in enumerate(self.detection.pairs):
-            for name in pair.between:
+        named = [("friction.pairs", p.between) for p in self.detection.pairs]
+        named += [("stiffness.pairs", p.between) for p in self.detection.stiffness_pairs]
+        counts: dict[str, int] = {}
+        for key, between in named:
+            index = counts[key] = counts.get(key, -1) + 1
+            for name in between:
                 if name not in known:
-                    field = f"contact_detection.friction.pairs[{index}].between"
+                    field = f"contact_detection.{key}[{index}].between"
                     raise SceneError(field, name, "names no body, mover, robot or robot link (robot/link) of the scene")
 
     def detect(self) -> Detection:
@@ -156,6 +175,8 @@ class World:
             dimension=3,
             gravity=self.gravity,
             friction=self.friction,
+            stiffness=self.stiffness,
+            closing_time=self.closing_time,
         )
 
     @property
@@ -193,15 +214,29 @@ class World:
         jacobian = None if robot_link is None else robot_link[0].point_jacobian(robot_link[1], point.point)
         # A friction pair may name a robot link's whole robot.
         others = {other} if robot_link is None else {other, robot_link[0].name}
-        return Contact(body, other, point.point, normal, mu=self._mu(body, others), jacobian=jacobian)
+        stiffness = self._stiffness(body, others)
+        return Contact(body, other, point.point, normal, mu=self._mu(body, others), jacobian=jacobian, stiffness=stiffness)
 
     def _mu(self, body: str, others: set[str]) -> float:
         """The first friction pair naming ``body`` and one of ``others``, else the default."""
-        for pair in self.detection.pairs:
-            a, b = pair.between
-            if (a == body and b in others) or (b == body and a in others):
-                return pair.mu
-        return self.detection.mu
+        pair = _first_pair(self.detection.pairs, body, others)
+        return self.detection.mu if pair is None else pair.mu
+
+    def _stiffness(self, body: str, others: set[str]) -> Stiffness | None:
+        """The first stiffness pair naming ``body`` and one of ``others``, else the detection's default."""
+        pair = _first_pair(self.detection.stiffness_pairs, body, others)
+        return self.detection.stiffness if pair is None else pair.stiffness
+
+
+_Pair = TypeVar("_Pair", FrictionPair, StiffnessPair)
+
+
+def _first_pair(pairs: tuple[_Pair, ...], body: str, others: set[str]) -> _Pair | None:
+    for pair in pairs:
+        a, b = pair.between
+        if (a == body and b in others) or (b == body and a in others):
+            return pair
+    return None
 
 
 def _robot(robot: UrdfRobot) -> Robot:

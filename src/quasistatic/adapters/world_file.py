@@ -16,11 +16,24 @@ import numpy as np
 
 from ..errors import MISSING, SceneError
 from ..model import Contact, Robot
-from ..model.io import BodyFile, ContactFile, DetectionFile, MoverFile, PoseFile, RobotFile, SceneFile, ShapeFile, plain_robot
+from ..model.io import (
+    BodyFile,
+    ContactFile,
+    DetectionFile,
+    MoverFile,
+    PoseFile,
+    RobotFile,
+    SceneFile,
+    ShapeFile,
+    StiffnessFile,
+    StiffnessPairFile,
+    plain_robot,
+    stiffness_of,
+)
 from ..tolerances import MAX_FRICTION
 from .robot import UrdfRobot
 from .shapes import Box, Capsule, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere
-from .world import ContactDetection, FrictionPair, ShapedMover, SolidBody, World
+from .world import ContactDetection, FrictionPair, ShapedMover, SolidBody, StiffnessPair, World
 
 __all__ = ["world_from_file"]
 
@@ -42,6 +55,8 @@ def world_from_file(parsed: SceneFile, folder: Path) -> World:
         detection=_detection(parsed.contact_detection),
         gravity=parsed.gravity,
         friction=parsed.friction,
+        stiffness=stiffness_of(parsed.stiffness, "stiffness"),
+        closing_time=parsed.closing_time,
     )
 
 
@@ -84,6 +99,9 @@ def _robot(name: str, entry: RobotFile, folder: Path) -> UrdfRobot:
     assert entry.urdf is not None
     if entry.joint_names is not None:
         raise SceneError(f"{field}.joint_names", entry.joint_names, "a robot with a urdf has its own joint names")
+    if entry.joint_stiffness is not None:
+        reason = "joint stiffness is read for robots given by their contacts' Jacobians; a urdf robot's is not supported yet"
+        raise SceneError(f"{field}.joint_stiffness", entry.joint_stiffness, reason)
     with _within(field):
         return UrdfRobot(
             name,
@@ -187,7 +205,21 @@ def _detection(entry: DetectionFile | None) -> ContactDetection:
         if len(pair.between) != 2:
             raise SceneError(f"{field}.between", pair.between, "expected two names")
         pairs.append(FrictionPair((pair.between[0], pair.between[1]), _mu(pair.mu, f"{field}.mu")))
-    return ContactDetection(entry.margin, _mu(entry.friction.default, "contact_detection.friction.default"), tuple(pairs))
+    default = stiffness_of(entry.stiffness.default, "contact_detection.stiffness.default")
+    mu = _mu(entry.friction.default, "contact_detection.friction.default")
+    return ContactDetection(entry.margin, mu, tuple(pairs), default, _stiffness_pairs(entry.stiffness.pairs))
+
+
+def _stiffness_pairs(entries: list[StiffnessPairFile]) -> tuple[StiffnessPair, ...]:
+    pairs = []
+    for index, pair in enumerate(entries):
+        field = f"contact_detection.stiffness.pairs[{index}]"
+        if len(pair.between) != 2:
+            raise SceneError(f"{field}.between", pair.between, "expected two names")
+        stiffness = stiffness_of(StiffnessFile(normal=pair.normal, tangential=pair.tangential), field)
+        assert stiffness is not None  # an entry was given
+        pairs.append(StiffnessPair((pair.between[0], pair.between[1]), stiffness))
+    return tuple(pairs)
 
 
 def _mu(value: float, field: str) -> float:
@@ -200,6 +232,7 @@ def _mu(value: float, field: str) -> float:
 def _contact(entry: ContactFile, index: int) -> Contact:
     with _within(f"contacts[{index}]"):
         try:
-            return Contact(entry.body, entry.other, entry.point, entry.normal, entry.mu, entry.jacobian)
+            stiffness = stiffness_of(entry.stiffness, "stiffness")
+            return Contact(entry.body, entry.other, entry.point, entry.normal, entry.mu, entry.jacobian, stiffness)
         except SceneError as exc:
             raise SceneError(exc.field.removeprefix("contact."), exc.value, exc.reason) from None

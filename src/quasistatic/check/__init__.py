@@ -5,6 +5,7 @@ only: no assembly and no solver code, so a bug there cannot hide here.
 """
 
 from .audit import DEFAULT_TOLERANCE, AuditGeometry, audit_motion, audit_motion_velocities, power_balance, relative_velocities
+from .compliance import audited_step
 from .loads import ForceFunctionals, LoadMap, LoadTable
 from .motion import ContactTable, MotionGeometry, audited_motion
 
@@ -19,6 +20,7 @@ __all__ = [
     "audit_motion",
     "audit_motion_velocities",
     "audited_motion",
+    "audited_step",
     "power_balance",
     "relative_velocities",
 ]

@@ -7,7 +7,7 @@ every other stage reads a :class:`Scene`, which is validated here once.
 from .friction import FrictionModel, parse_friction
 from .io import FORMAT_VERSION
 from .scales import Scales, scene_scales
-from .scene import Body, Contact, FloatArray, Mover, Robot, Scene, checked_array, checked_number
+from .scene import Body, Contact, FloatArray, Mover, Robot, Scene, Stiffness, checked_array, checked_number
 
 __all__ = [
     "FORMAT_VERSION",
@@ -19,6 +19,7 @@ __all__ = [
     "Robot",
     "Scales",
     "Scene",
+    "Stiffness",
     "parse_friction",
     "checked_array",
     "checked_number",

@@ -27,7 +27,7 @@ import yaml
 
 from ..errors import MISSING, SceneError
 from ..tolerances import MAX_DEPTH, MAX_FILE_BYTES, MAX_VALUES
-from .scene import Body, Contact, Mover, Robot, Scene
+from .scene import Body, Contact, Mover, Robot, Scene, Stiffness
 
 __all__ = [
     "read_scene_data",
@@ -36,7 +36,9 @@ __all__ = [
     "scene_from_file",
     "scene_to_dict",
     "plain_robot",
+    "stiffness_of",
     "SceneFile",
+    "StiffnessFile",
     "FORMAT_VERSION",
 ]
 
@@ -130,11 +132,19 @@ class RobotFile(_FileModel):
 
     joint_velocities: list[_Number] | dict[str, _Number] | None = None
     torque_limits: list[_Number] | dict[str, _Number] | None = None
+    joint_stiffness: list[_Number] | None = None
     joint_names: list[str] | None = None
     urdf: str | None = None
     package_dirs: list[str] = []
     base: PoseFile | None = None
     q: list[_Number] | dict[str, _Number] | None = None
+
+
+class StiffnessFile(_FileModel):
+    """A contact's springs [force/length]; ``tangential`` defaults to ``normal``."""
+
+    normal: _Number
+    tangential: _Number | None = None
 
 
 class ContactFile(_FileModel):
@@ -144,6 +154,7 @@ class ContactFile(_FileModel):
     normal: list[_Number]
     mu: _Number = 0.0
     jacobian: list[list[_Number]] | None = None
+    stiffness: StiffnessFile | None = None
 
 
 class FrictionPairFile(_FileModel):
@@ -156,11 +167,23 @@ class DetectionFrictionFile(_FileModel):
     pairs: list[FrictionPairFile] = []
 
 
+class StiffnessPairFile(_FileModel):
+    between: list[str]
+    normal: _Number
+    tangential: _Number | None = None
+
+
+class DetectionStiffnessFile(_FileModel):
+    default: StiffnessFile | None = None
+    pairs: list[StiffnessPairFile] = []
+
+
 class DetectionFile(_FileModel):
-    """Gaps up to ``margin`` count as contacts (default: relative to the bodies' size); friction by pair of names."""
+    """Gaps up to ``margin`` count as contacts (default: relative to the bodies' size); friction and stiffness by pair of names."""
 
     margin: _Number | None = None
     friction: DetectionFrictionFile = DetectionFrictionFile()
+    stiffness: DetectionStiffnessFile = DetectionStiffnessFile()
 
 
 class SceneFile(_FileModel):
@@ -175,6 +198,8 @@ class SceneFile(_FileModel):
     robots: dict[str, RobotFile] = {}
     contacts: list[ContactFile] = []
     contact_detection: DetectionFile | None = None
+    stiffness: StiffnessFile | None = None
+    closing_time: _Number | None = None
 
     @property
     def is_geometric(self) -> bool:
@@ -236,6 +261,8 @@ def scene_from_file(parsed: SceneFile) -> Scene:
         movers=tuple(Mover(name, m.twist, m.origin, m.robot) if m is not None else Mover(name) for name, m in parsed.movers.items()),
         robots=tuple(plain_robot(name, r) for name, r in parsed.robots.items()),
         contacts=tuple(_contact(c, index) for index, c in enumerate(parsed.contacts)),
+        stiffness=stiffness_of(parsed.stiffness, "stiffness"),
+        closing_time=parsed.closing_time,
     )
 
 
@@ -244,7 +271,23 @@ def plain_robot(name: str, robot: RobotFile) -> Robot:
     if isinstance(robot.torque_limits, dict):
         reason = "joints can be named only for a robot with a urdf; give a list, one per Jacobian column"
         raise SceneError(f"robots.{name}.torque_limits", robot.torque_limits, reason)
-    return Robot(name, _velocity_list(name, robot), joint_names=robot.joint_names, torque_limits=robot.torque_limits)
+    return Robot(
+        name,
+        _velocity_list(name, robot),
+        joint_names=robot.joint_names,
+        torque_limits=robot.torque_limits,
+        joint_stiffness=robot.joint_stiffness,
+    )
+
+
+def stiffness_of(entry: StiffnessFile | None, field: str) -> Stiffness | None:
+    """The Stiffness of a file entry at ``field`` (None when absent); an error names that field."""
+    if entry is None:
+        return None
+    try:
+        return Stiffness(entry.normal, entry.tangential)
+    except SceneError as exc:
+        raise SceneError(exc.field.replace("stiffness", field, 1), exc.value, exc.reason) from None
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
@@ -258,7 +301,13 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "movers": {m.name: _mover_entry(m) for m in scene.movers},
         "robots": {r.name: _robot_entry(r) for r in scene.robots},
         "contacts": [_contact_entry(c) for c in scene.contacts],
+        **({} if scene.stiffness is None else {"stiffness": _stiffness_entry(scene.stiffness)}),
+        **({} if scene.closing_time is None else {"closing_time": scene.closing_time}),
     }
+
+
+def _stiffness_entry(stiffness: Stiffness) -> dict[str, float]:
+    return {"normal": stiffness.normal, "tangential": stiffness.tangential}
 
 
 def _robot_entry(robot: Robot) -> dict[str, Any]:
@@ -267,6 +316,8 @@ def _robot_entry(robot: Robot) -> dict[str, Any]:
         entry["joint_names"] = list(robot.joint_names)
     if robot.torque_limits is not None:
         entry["torque_limits"] = robot.torque_limits.tolist()
+    if robot.joint_stiffness is not None:
+        entry["joint_stiffness"] = robot.joint_stiffness.tolist()
     return entry
 
 
@@ -281,6 +332,8 @@ def _contact_entry(contact: Contact) -> dict[str, Any]:
     entry["mu"] = contact.mu
     if contact.jacobian is not None:
         entry["jacobian"] = contact.jacobian.tolist()
+    if contact.stiffness is not None:
+        entry["stiffness"] = _stiffness_entry(contact.stiffness)
     return entry
 
 
@@ -318,8 +371,9 @@ def _check_version(data: Mapping[str, Any]) -> None:
 
 def _contact(entry: ContactFile, index: int) -> Contact:
     """A contact of the file; an error in it names the contact by its index."""
+    stiffness = stiffness_of(entry.stiffness, f"contacts[{index}].stiffness")
     try:
-        return Contact(entry.body, entry.other, entry.point, entry.normal, entry.mu, entry.jacobian)
+        return Contact(entry.body, entry.other, entry.point, entry.normal, entry.mu, entry.jacobian, stiffness)
     except SceneError as exc:
         raise SceneError(exc.field.replace("contact", f"contacts[{index}]", 1), exc.value, exc.reason) from None
 

@@ -22,7 +22,7 @@ from ..errors import SceneError
 from ..tolerances import MAX_FRICTION, MAX_MAGNITUDE, MAX_NAME_LENGTH, MAX_PYRAMID_EDGES, NORMAL_LENGTH
 from .friction import FrictionModel, parse_friction
 
-__all__ = ["Body", "Mover", "Robot", "Contact", "Scene", "FloatArray", "checked_array", "checked_number"]
+__all__ = ["Body", "Mover", "Robot", "Contact", "Scene", "Stiffness", "FloatArray", "checked_array", "checked_number"]
 
 FloatArray = npt.NDArray[np.float64]
 T = TypeVar("T")
@@ -95,6 +95,35 @@ def _checked_copy(part: T, **changes: Any) -> T:
     copy = object.__new__(type(part))
     copy.__dict__.update(part.__dict__, **changes)
     return cast(T, copy)
+
+
+@dataclass(frozen=True, init=False)
+class Stiffness:
+    """A contact's stiffness: the force per unit deflection of its normal and tangential springs.
+
+    Attributes
+    ----------
+    normal : float
+        Normal stiffness k_n [force/length], > 0.
+    tangential : float
+        Tangential stiffness k_t [force/length], > 0, the same in every tangent direction;
+        ``normal`` when not given (a Hertzian contact of like materials has k_t = 2(1 - nu)/(2 - nu)
+        k_n, within 20 % of k_n for 0 <= nu <= 0.5).
+    """
+
+    normal: float
+    tangential: float
+
+    def __init__(self, normal: float, tangential: float | None = None) -> None:
+        k_n = _positive(normal, "stiffness.normal")
+        _assign(self, normal=k_n, tangential=k_n if tangential is None else _positive(tangential, "stiffness.tangential"))
+
+
+def _positive(value: Any, path: str, what: str = "a stiffness") -> float:
+    number = checked_number(value, path, minimum=0.0)
+    if number <= 0.0:
+        raise SceneError(path, value, f"{what} must be > 0 (leave the key out for none)")
+    return number
 
 
 @dataclass(frozen=True, init=False)
@@ -177,12 +206,17 @@ class Robot:
     torque_limits : array (n_joints,) or None
         Largest joint torque magnitude each joint can supply [force x length, or force for a
         prismatic joint], >= 0; a motion that needs more is reported as infeasible for this robot.
+    joint_stiffness : array (n_joints,) or None
+        Stiffness of each joint's servo or transmission [torque/rad for a revolute joint, force/length
+        for a prismatic one], > 0: its links then yield, in series with the contact springs, when the
+        compliant forces are worked out (:mod:`quasistatic.solvers.compliance`). None: rigid joints.
     """
 
     name: str
     joint_velocities: FloatArray
     joint_names: tuple[str, ...] | None
     torque_limits: FloatArray | None
+    joint_stiffness: FloatArray | None
 
     def __init__(
         self,
@@ -191,6 +225,7 @@ class Robot:
         *,
         joint_names: Iterable[str] | None = None,
         torque_limits: npt.ArrayLike | None = None,
+        joint_stiffness: npt.ArrayLike | None = None,
     ) -> None:
         path = f"robots.{_name(name, 'robots')}"
         velocities = checked_array(joint_velocities, f"{path}.joint_velocities")
@@ -200,6 +235,9 @@ class Robot:
             joint_velocities=velocities,
             joint_names=None if joint_names is None else _joint_names(joint_names, velocities.size, f"{path}.joint_names"),
             torque_limits=None if torque_limits is None else _torque_limits(torque_limits, velocities.size, f"{path}.torque_limits"),
+            joint_stiffness=None
+            if joint_stiffness is None
+            else _joint_stiffness(joint_stiffness, velocities.size, f"{path}.joint_stiffness"),
         )
 
     def joint_labels(self) -> tuple[str, ...]:
@@ -227,6 +265,15 @@ def _torque_limits(limits: npt.ArrayLike, count: int, path: str) -> FloatArray:
     return array
 
 
+def _joint_stiffness(values: npt.ArrayLike, count: int, path: str) -> FloatArray:
+    array = checked_array(values, path)
+    if array.shape != (count,):
+        raise SceneError(path, array.tolist(), f"expected {count} numbers, one per joint (as joint_velocities)")
+    if not np.all(array > 0.0):
+        raise SceneError(path, array.tolist(), "every joint stiffness must be > 0 (leave the key out for rigid joints)")
+    return array
+
+
 @dataclass(frozen=True, init=False)
 class Contact:
     """A point contact between a free body and another body.
@@ -246,6 +293,8 @@ class Contact:
     jacobian : array (d, n_joints), optional
         For a robot-driven ``other``: world velocity of its material point at
         ``point`` per unit joint velocity.
+    stiffness : Stiffness, optional
+        The contact's springs; None (default) is rigid, or the Scene's default stiffness once in a Scene.
     """
 
     body: str
@@ -254,6 +303,7 @@ class Contact:
     normal: FloatArray
     mu: float
     jacobian: FloatArray | None
+    stiffness: Stiffness | None
 
     def __init__(
         self,
@@ -263,7 +313,10 @@ class Contact:
         normal: npt.ArrayLike,
         mu: float = 0.0,
         jacobian: npt.ArrayLike | None = None,
+        stiffness: Stiffness | None = None,
     ) -> None:
+        if stiffness is not None and not isinstance(stiffness, Stiffness):
+            raise SceneError("contact.stiffness", stiffness, "expected a Stiffness(normal, tangential)")
         _assign(
             self,
             body=_name(body, "contact.body"),
@@ -272,6 +325,7 @@ class Contact:
             normal=checked_array(normal, "contact.normal"),
             mu=checked_number(mu, "contact.mu", minimum=0.0, maximum=MAX_FRICTION, why=_MU_TOO_LARGE),
             jacobian=None if jacobian is None else checked_array(jacobian, "contact.jacobian", ndim=2),
+            stiffness=stiffness,
         )
 
 
@@ -289,6 +343,14 @@ class Scene:
         Gravitational acceleration; [0, 0, -9.81] (3-D) or [0, -9.81] (2-D) when given as None.
     friction : FrictionModel
         ``exact`` (default), ``pyramid:K`` or ``none`` (a string is parsed).
+    stiffness : Stiffness or None
+        The default stiffness of every contact that gives none of its own (filled into those
+        contacts once in a Scene); None leaves them rigid.
+    closing_time : float or None
+        How long the commanded motion acts against the contact springs [time], > 0: each mover
+        advances its velocity times this, and the compliant step (:mod:`quasistatic.solvers.compliance`)
+        finds the squeeze forces and the bodies' small displacement when the rigid answer is
+        ``jammed`` or ``ambiguous``. None: no step.
     """
 
     bodies: tuple[Body, ...]
@@ -298,6 +360,8 @@ class Scene:
     dimension: int
     gravity: FloatArray
     friction: FrictionModel
+    stiffness: Stiffness | None
+    closing_time: float | None
     _derived: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __init__(
@@ -309,14 +373,20 @@ class Scene:
         dimension: int = 3,
         gravity: npt.ArrayLike | None = None,
         friction: FrictionModel | str = "exact",
+        stiffness: Stiffness | None = None,
+        closing_time: float | None = None,
     ) -> None:
+        if stiffness is not None and not isinstance(stiffness, Stiffness):
+            raise SceneError("stiffness", stiffness, "expected a Stiffness(normal, tangential)")
+        if closing_time is not None:
+            closing_time = _positive(closing_time, "closing_time", "a time over which the movers advance")
         if isinstance(dimension, bool) or not isinstance(dimension, (int, np.integer)) or dimension not in (2, 3):
             raise SceneError("dimension", dimension, "must be 2 or 3")
         dimension = int(dimension)
         model = _friction(friction, dimension)
         default_gravity = [0.0, -9.81] if dimension == 2 else [0.0, 0.0, -9.81]
         gravity_vector = _sized(checked_array(default_gravity if gravity is None else gravity, "gravity"), dimension, "gravity")
-        parts = _Parts(dimension, tuple(bodies), tuple(movers), tuple(robots))
+        parts = _Parts(dimension, tuple(bodies), tuple(movers), tuple(robots), stiffness)
         _assign(
             self,
             bodies=parts.bodies,
@@ -326,6 +396,8 @@ class Scene:
             dimension=dimension,
             gravity=gravity_vector,
             friction=model,
+            stiffness=stiffness,
+            closing_time=closing_time,
             _derived={},
         )
 
@@ -364,6 +436,11 @@ class Scene:
         wrench = np.zeros(self.twist_size) if body.wrench is None else np.array(body.wrench, dtype=float)
         wrench[: self.dimension] += body.mass * self.gravity
         return wrench
+
+    @property
+    def compliant(self) -> bool:
+        """Whether some contact or robot joint has a stiffness: compliance then picks the forces of a motion."""
+        return any(c.stiffness is not None for c in self.contacts) or any(r.joint_stiffness is not None for r in self.robots)
 
     @property
     def twist_size(self) -> int:
@@ -406,8 +483,11 @@ def _sized(vector: FloatArray, length: int, path: str) -> FloatArray:
 class _Parts:
     """The scene's bodies, movers and robots checked together, with their defaults filled in (new objects)."""
 
-    def __init__(self, dimension: int, bodies: tuple[Body, ...], movers: tuple[Mover, ...], robots: tuple[Robot, ...]) -> None:
+    def __init__(
+        self, dimension: int, bodies: tuple[Body, ...], movers: tuple[Mover, ...], robots: tuple[Robot, ...], stiffness: Stiffness | None
+    ) -> None:
         self.dimension = dimension
+        self.stiffness = stiffness
         self.twist_size = 3 if dimension == 2 else 6
         if not bodies:
             raise SceneError("bodies", [], "at least one free body is required")
@@ -459,7 +539,8 @@ class _Parts:
             raise SceneError(f"{path}.normal", normal.tolist(), f"must be a unit vector (its length is {length:.6g})")
         unit = normal / length
         unit.setflags(write=False)
-        return _checked_copy(contact, point=point, normal=unit, jacobian=self._jacobian(contact, path))
+        stiffness = self.stiffness if contact.stiffness is None else contact.stiffness
+        return _checked_copy(contact, point=point, normal=unit, jacobian=self._jacobian(contact, path), stiffness=stiffness)
 
     def _check_pair(self, contact: Contact, path: str) -> None:
         if contact.body not in self.body_names:

@@ -8,8 +8,23 @@ units. Their numerics (``numerics/``) and certification helpers
 never ``check`` (the judge stays independent) nor anything above.
 """
 
+from .compliance import CompliantForces, StepForces, compliant_forces, compliant_step
 from .oversize import too_large
 from .registry import BACKENDS, Backend, Solver, get_backend
 from .result import BackendResult, Options, Range, SearchProgress
 
-__all__ = ["BACKENDS", "Backend", "BackendResult", "Options", "Range", "SearchProgress", "Solver", "get_backend", "too_large"]
+__all__ = [
+    "BACKENDS",
+    "Backend",
+    "BackendResult",
+    "CompliantForces",
+    "Options",
+    "Range",
+    "SearchProgress",
+    "StepForces",
+    "Solver",
+    "compliant_forces",
+    "compliant_step",
+    "get_backend",
+    "too_large",
+]

@@ -29,7 +29,15 @@ from .highs import solve_lp
 from .ranges import Bounds, linear_ranges, ranges_are_wide, rows_feasible, value_ranges
 from .rank import full_column_rank
 
-__all__ = ["ForcesAtTwist", "ConsistentForces", "FrictionlessForces", "forces_at_twist", "force_ranges", "least_normal_forces"]
+__all__ = [
+    "ForcesAtTwist",
+    "ConsistentForces",
+    "FrictionlessForces",
+    "forces_at_twist",
+    "measured_forces_at_twist",
+    "force_ranges",
+    "least_normal_forces",
+]
 
 _MOVING = ZERO * 10  # scene-relative speed or dissipation rate above which a contact opens or slides
 
@@ -151,9 +159,14 @@ def _measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeM
     return ModeMasks(closed, closed & ~sliding & (problem.mu > 0), sliding)
 
 
+def measured_forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ForcesAtTwist:
+    """:func:`forces_at_twist` with the modes the velocities at ``q`` show."""
+    return forces_at_twist(problem, edges, q, _measured_masks(problem, edges, q))
+
+
 def force_ranges(problem: Problem, edges: np.ndarray, q: np.ndarray) -> tuple[list[Range], ConsistentForces] | None:
     """Normal-force ranges (scene-relative) over all forces consistent with twist ``q``, and that set; None when the forces are unique."""
-    forces = forces_at_twist(problem, edges, q, _measured_masks(problem, edges, q))
+    forces = measured_forces_at_twist(problem, edges, q)
     free = ~forces.fixed
     if full_column_rank(forces.A.tocsc()[:, free], FORCE_RANK):
         return None

@@ -21,7 +21,7 @@ import scipy.sparse as sp
 from ...errors import SolverError
 from ...tolerances import HIGHS_SMALLEST_ENTRY
 
-__all__ = ["LPResult", "solve_lp", "optimise_each", "WarmLP", "INF"]
+__all__ = ["LPResult", "solve_lp", "solve_qp", "optimise_each", "WarmLP", "INF"]
 
 INF = float("inf")
 LPStatus = Literal["optimal", "infeasible", "unbounded", "unbounded_or_infeasible", "error"]
@@ -108,6 +108,42 @@ def solve_lp(
         return _without_columns(row_lower, row_upper)
     solver = _load(_thread_highs(), cost, A, row_lower, row_upper, col_lower, col_upper, maximize)
     return _run(solver, cost, maximize)
+
+
+def solve_qp(
+    hessian: sp.spmatrix,
+    A: np.ndarray | sp.spmatrix,
+    row_lower: np.ndarray,
+    row_upper: np.ndarray,
+    col_lower: np.ndarray | None = None,
+    col_upper: np.ndarray | None = None,
+    cost: np.ndarray | None = None,
+) -> LPResult:
+    """Solve the convex QP ``min 1/2 x.H x + cost.x  s.t.  row_lower <= A x <= row_upper, col_lower <= x <= col_upper``.
+
+    ``hessian`` (n, n) must be symmetric positive semi-definite; a fresh HiGHS instance
+    solves it (a Hessian would otherwise stay on this thread's LP instance).
+    """
+    n = hessian.shape[0]
+    if n == 0:
+        return _without_columns(row_lower, row_upper)
+    cost = np.zeros(n) if cost is None else cost
+    solver = _load(_new_highs(), cost, A, row_lower, row_upper, col_lower, col_upper, False)
+    lower = sp.tril(sp.csc_matrix(hessian)).tocsc()  # HiGHS reads the lower triangle, column by column
+    lower.eliminate_zeros()
+    matrix = highspy.HighsHessian()
+    matrix.dim_ = n
+    matrix.format_ = highspy.HessianFormat.kTriangular
+    matrix.start_ = lower.indptr
+    matrix.index_ = lower.indices
+    matrix.value_ = lower.data
+    try:
+        solver.passHessian(matrix)
+    except Exception as exc:  # a crash inside HiGHS, not a status
+        raise SolverError("highs", f"HiGHS failed: {exc}") from exc
+    result = _run(solver, cost, False)
+    objective = 0.5 * float(result.x @ (hessian @ result.x)) + float(cost @ result.x) if result.status == "optimal" else float("nan")
+    return LPResult(result.status, result.x, result.row_dual, objective)
 
 
 def _without_columns(row_lower: np.ndarray, row_upper: np.ndarray) -> LPResult:
