@@ -6,7 +6,9 @@ an open contact carries nothing, a sliding one pushes on the
 maximum-dissipation face of its friction polygon, a rolling one anywhere in
 its polygon, and together they balance the load. The set is a polytope; the
 certified search reports each normal force's range over it
-(:func:`force_ranges`), the exact-cone refinement picks its point of least
+(:func:`indeterminate_forces`: whether some range is wide is usually proven
+by one LP, and the ranges' two LPs per contact run when they are first
+read), the exact-cone refinement picks its point of least
 total normal force (:func:`least_normal_forces`). A :class:`ConsistentForces`
 keeps the set with the motion, for the ranges of what else the forces
 determine (a robot's joint torques, a mover's wrench) and whether limits on
@@ -15,21 +17,31 @@ them can be met, worked out only when they are read.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 
 import numpy as np
 import scipy.sparse as sp
 
 from ...laws import ModeMasks, Problem, slips
 from ...laws.polyhedral import ForcePolytope, aligned_edges, force_polytope
-from ...tolerances import FORCE_RANK, ZERO
+from ...tolerances import FORCE_RANK, LP_FEASIBILITY, ZERO
 from ..result import Range
 from .highs import solve_lp
-from .ranges import Bounds, linear_ranges, ranges_are_wide, rows_feasible, value_ranges
-from .rank import full_column_rank
+from .ranges import Bounds, in_row_space, linear_ranges, null_space, ranges_are_wide, rows_feasible, value_ranges
+from .rank import DENSE_MAX, full_column_rank
 
-__all__ = ["ForcesAtTwist", "ConsistentForces", "FrictionlessForces", "forces_at_twist", "force_ranges", "least_normal_forces"]
+__all__ = [
+    "ForcesAtTwist",
+    "ConsistentForces",
+    "FrictionlessForces",
+    "IndeterminateForces",
+    "forces_at_twist",
+    "indeterminate_forces",
+    "least_normal_forces",
+    "measured_masks",
+]
 
 _MOVING = ZERO * 10  # scene-relative speed or dissipation rate above which a contact opens or slides
 
@@ -66,6 +78,18 @@ class ForcesAtTwist:
         values = np.r_[self.edges.ravel(), np.ones(m)]
         M = sp.csr_matrix((values, (rows, cols)), shape=(m * d, self.fixed.size))
         return ConsistentForces(self.A, self.rhs, M)
+
+    @cached_property
+    def _consistent(self) -> ConsistentForces:
+        return self.consistent()
+
+    def ranges(self, functionals: np.ndarray) -> list[Bounds]:
+        """As :meth:`ConsistentForces.ranges` (a :class:`~quasistatic.laws.ForceSet`; the map is built when first read)."""
+        return self._consistent.ranges(functionals)
+
+    def feasible(self, functionals: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
+        """As :meth:`ConsistentForces.feasible`."""
+        return self._consistent.feasible(functionals, lower, upper)
 
 
 @dataclass(frozen=True)
@@ -142,7 +166,7 @@ def forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: M
     return ForcesAtTwist(polytope, edges, A, rhs, fixed)
 
 
-def _measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeMasks:
+def measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeMasks:
     """Modes as the velocities at ``q`` show them: open beyond ``_MOVING``, sliding where some edge dissipates."""
     u = problem.velocities(q)
     drive = -np.einsum("mkt,mt->mk", edges, u[:, :-1])
@@ -151,15 +175,106 @@ def _measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeM
     return ModeMasks(closed, closed & ~sliding & (problem.mu > 0), sliding)
 
 
-def force_ranges(problem: Problem, edges: np.ndarray, q: np.ndarray) -> tuple[list[Range], ConsistentForces] | None:
-    """Normal-force ranges (scene-relative) over all forces consistent with twist ``q``, and that set; None when the forces are unique."""
-    forces = forces_at_twist(problem, edges, q, _measured_masks(problem, edges, q))
+@dataclass(frozen=True)
+class IndeterminateForces:
+    """The normal-force ranges (scene-relative) of a motion whose forces are indeterminate, and their set.
+
+    ``known`` holds the ranges when they were worked out to decide it; otherwise ``lazy`` works them
+    out when called (two LPs per contact at most).
+    """
+
+    known: tuple[Range, ...] | None
+    lazy: Callable[[], tuple[Range, ...]] | None
+    force_set: ForcesAtTwist
+
+
+def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> IndeterminateForces | None:
+    """The normal-force ranges over every force consistent with twist ``q``; None when no range is wide.
+
+    Wide means wider than ``LP_FEASIBILITY`` (:func:`~.ranges.ranges_are_wide`), as before the ranges
+    were deferred. Free columns of full rank: one force distribution, None. Every normal force a
+    combination of the equations (only the edge intensities vary, as both edges of a 2-D contact
+    that sticks): None, as :func:`~.ranges.value_ranges` finds them constant. Otherwise
+    :func:`_normal_range_proven_wide` proves some range wide with one LP where it can, and the ranges
+    wait until they are read; where it cannot, they are worked out now and decide.
+    """
+    forces = forces_at_twist(problem, edges, q, measured_masks(problem, edges, q))
     free = ~forces.fixed
     if full_column_rank(forces.A.tocsc()[:, free], FORCE_RANK):
         return None
     normal = np.arange(forces.fixed.size)[forces.polytope.normal]
-    ranges = value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size))
-    return (ranges, forces.consistent()) if ranges_are_wide(ranges) else None
+    if np.all(in_row_space(forces.A, normal)):
+        return None  # each normal force is fixed by the equations (the ranges' LPs would find it constant)
+    work = partial(_normal_ranges, forces, normal)
+    if _normal_range_proven_wide(forces, normal):
+        return IndeterminateForces(None, work, forces)
+    ranges = work()
+    return IndeterminateForces(ranges, None, forces) if ranges_are_wide(list(ranges)) else None
+
+
+def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ...]:
+    return tuple(value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size)))
+
+
+def _normal_range_proven_wide(forces: ForcesAtTwist, normal: np.ndarray) -> bool:
+    """True when some normal force provably varies by more than ``LP_FEASIBILITY`` over the set.
+
+    The set is ``{x >= 0 : A x = rhs}``. Take a point ``x`` of it with as many
+    columns positive as one LP finds (:func:`_slack_point`), ``P`` those columns.
+    Any ``z`` with ``A z = 0`` and ``z = 0`` off ``P`` keeps ``x + t z`` in the
+    set for ``-t_minus <= t <= t_plus`` (until a positive column reaches 0), so
+    coordinate ``j`` spans at least ``z_j (t_plus + t_minus)``. For each normal
+    column ``j`` in ``P``, ``z`` is ``e_j`` projected on that null space (the
+    direction that moves ``x_j`` most per unit length); ``t`` also stops where
+    ``A (x + t z)`` would leave ``rhs`` by ``ZERO`` (the basis is a null space to
+    ``FORCE_RANK``). False proves nothing:
+    the caller then computes the ranges. Small sets only (dense linear algebra).
+    """
+    if min(forces.A.shape) > DENSE_MAX:
+        return False
+    A = forces.A.toarray()
+    x = _slack_point(A, forces.rhs, forces.fixed)
+    if x is None:
+        return False
+    positive = np.flatnonzero(x > ZERO)
+    basis = null_space(A[:, positive], FORCE_RANK)
+    if basis.shape[1] == 0:
+        return False
+    at = {int(col): k for k, col in enumerate(positive.tolist())}
+    for j in normal.tolist():
+        if j not in at:
+            continue
+        z = basis @ basis[at[j]]
+        if z[at[j]] <= 0.0:
+            continue
+        # The basis is a null space to FORCE_RANK: stop before A (x + t z) leaves rhs by more than ZERO.
+        drift = float(np.max(np.abs(A[:, positive] @ z), initial=0.0))
+        cap = ZERO / drift if drift > 0.0 else np.inf
+        reach = min(_step(x[positive], z), cap) + min(_step(x[positive], -z), cap)
+        if z[at[j]] * reach > LP_FEASIBILITY:
+            return True
+    return False
+
+
+def _slack_point(A: np.ndarray, rhs: np.ndarray, fixed: np.ndarray) -> np.ndarray | None:
+    """A point of ``{x >= 0 : A x = rhs}`` maximising ``sum min(x_j, 1)`` over the free columns (one LP), or None."""
+    n = fixed.size
+    free = np.flatnonzero(~fixed)
+    k = free.size
+    lift = np.zeros((k, n))
+    lift[np.arange(k), free] = 1.0
+    rows = np.block([[A, np.zeros((A.shape[0], k))], [lift, -np.eye(k)]])  # A x = rhs; x_j - t_j >= 0
+    lower = np.r_[rhs, np.zeros(k)]
+    upper = np.r_[rhs, np.full(k, np.inf)]
+    cost = np.r_[np.zeros(n), np.ones(k)]
+    lp = solve_lp(cost, rows, lower, upper, np.zeros(n + k), np.r_[np.full(n, np.inf), np.ones(k)], maximize=True)
+    return lp.x[:n] if lp.status == "optimal" else None
+
+
+def _step(x: np.ndarray, z: np.ndarray) -> float:
+    """Largest ``t >= 0`` with ``x + t z >= 0`` (``x >= 0``); infinite when no entry of ``z`` is negative."""
+    falling = z < 0.0
+    return float(np.min(x[falling] / -z[falling])) if falling.any() else np.inf
 
 
 def least_normal_forces(problem: Problem, q: np.ndarray, masks: ModeMasks, edge_count: int) -> np.ndarray | None:
