@@ -160,8 +160,12 @@ def forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: M
     fixed[polytope.slack] = masks.sliding
     # One unit row per fixed column, sparse: an identity as wide as all the columns would grow as their square.
     held = np.flatnonzero(fixed)
-    pinned = sp.csr_matrix((np.ones(held.size), (np.arange(held.size), held)), shape=(held.size, fixed.size))
-    A = sp.vstack([sp.csr_matrix(polytope.A), pinned], format="csr")
+    # One build from index arrays (sparse vstack of small matrices costs more than the rest of this function).
+    laws = polytope.A.tocoo()
+    rows = np.r_[laws.row, polytope.A.shape[0] + np.arange(held.size)]
+    A = sp.csr_matrix(
+        (np.r_[laws.data, np.ones(held.size)], (rows, np.r_[laws.col, held])), shape=(polytope.A.shape[0] + held.size, fixed.size)
+    )
     rhs = np.r_[polytope.rhs, np.zeros(int(fixed.sum()))]
     return ForcesAtTwist(polytope, edges, A, rhs, fixed)
 
@@ -199,14 +203,15 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     wait until they are read; where it cannot, they are worked out now and decide.
     """
     forces = forces_at_twist(problem, edges, q, measured_masks(problem, edges, q))
-    free = ~forces.fixed
-    if full_column_rank(forces.A.tocsc()[:, free], FORCE_RANK):
+    # A small set is read densely once: each sparse conversion of a grasp's matrix costs ~0.1 ms.
+    A = forces.A.toarray() if min(forces.A.shape) <= DENSE_MAX else forces.A.tocsc()
+    if full_column_rank(A[:, ~forces.fixed], FORCE_RANK):
         return None
     normal = np.arange(forces.fixed.size)[forces.polytope.normal]
-    if np.all(in_row_space(forces.A, normal)):
+    if np.all(in_row_space(A, normal)):
         return None  # each normal force is fixed by the equations (the ranges' LPs would find it constant)
     work = partial(_normal_ranges, forces, normal)
-    if _normal_range_proven_wide(forces, normal):
+    if isinstance(A, np.ndarray) and _normal_range_proven_wide(A, forces, normal):
         return IndeterminateForces(None, work, forces)
     ranges = work()
     return IndeterminateForces(ranges, None, forces) if ranges_are_wide(list(ranges)) else None
@@ -216,7 +221,7 @@ def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ..
     return tuple(value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size)))
 
 
-def _normal_range_proven_wide(forces: ForcesAtTwist, normal: np.ndarray) -> bool:
+def _normal_range_proven_wide(A: np.ndarray, forces: ForcesAtTwist, normal: np.ndarray) -> bool:
     """True when some normal force provably varies by more than ``LP_FEASIBILITY`` over the set.
 
     The set is ``{x >= 0 : A x = rhs}``. Take a point ``x`` of it with as many
@@ -228,11 +233,8 @@ def _normal_range_proven_wide(forces: ForcesAtTwist, normal: np.ndarray) -> bool
     direction that moves ``x_j`` most per unit length); ``t`` also stops where
     ``A (x + t z)`` would leave ``rhs`` by ``ZERO`` (the basis is a null space to
     ``FORCE_RANK``). False proves nothing:
-    the caller then computes the ranges. Small sets only (dense linear algebra).
+    the caller then computes the ranges. ``A``: ``forces.A``, dense (small sets only).
     """
-    if min(forces.A.shape) > DENSE_MAX:
-        return False
-    A = forces.A.toarray()
     x = _slack_point(A, forces.rhs, forces.fixed)
     if x is None:
         return False
