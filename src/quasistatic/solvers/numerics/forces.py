@@ -198,9 +198,9 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     Wide means wider than ``LP_FEASIBILITY`` (:func:`~.ranges.ranges_are_wide`), as before the ranges
     were deferred. Free columns of full rank: one force distribution, None. Every normal force a
     combination of the equations (only the edge intensities vary, as both edges of a 2-D contact
-    that sticks): None, as :func:`~.ranges.value_ranges` finds them constant. Otherwise
-    :func:`_normal_range_proven_wide` proves some range wide with one LP where it can, and the ranges
-    wait until they are read; where it cannot, they are worked out now and decide.
+    that sticks): None, as :func:`~.ranges.value_ranges` finds them constant. Otherwise one LP
+    decides (:func:`_normal_forces_vary`), and the ranges wait until they are read; where it
+    cannot decide, they are worked out now and decide.
     """
     forces = forces_at_twist(problem, edges, q, measured_masks(problem, edges, q))
     # A small set is read densely once: each sparse conversion of a grasp's matrix costs ~0.1 ms.
@@ -211,8 +211,9 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     if np.all(in_row_space(A, normal)):
         return None  # each normal force is fixed by the equations (the ranges' LPs would find it constant)
     work = partial(_normal_ranges, forces, normal)
-    if isinstance(A, np.ndarray) and _normal_range_proven_wide(A, forces, normal):
-        return IndeterminateForces(None, work, forces)
+    vary = _normal_forces_vary(A, forces, normal) if isinstance(A, np.ndarray) else None
+    if vary is not None:
+        return IndeterminateForces(None, work, forces) if vary else None
     ranges = work()
     return IndeterminateForces(ranges, None, forces) if ranges_are_wide(list(ranges)) else None
 
@@ -221,56 +222,75 @@ def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ..
     return tuple(value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size)))
 
 
-def _normal_range_proven_wide(A: np.ndarray, forces: ForcesAtTwist, normal: np.ndarray) -> bool:
-    """True when some normal force provably varies by more than ``LP_FEASIBILITY`` over the set.
+def _normal_forces_vary(A: np.ndarray, forces: ForcesAtTwist, normal: np.ndarray) -> bool | None:
+    """True: some normal force provably spans more than ``LP_FEASIBILITY`` over the set; False: every
+    normal force is constant on it; None: undecided. ``A``: ``forces.A``, dense (small sets only).
 
-    The set is ``{x >= 0 : A x = rhs}``. Take a point ``x`` of it with as many
-    columns positive as one LP finds (:func:`_slack_point`), ``P`` those columns.
-    Any ``z`` with ``A z = 0`` and ``z = 0`` off ``P`` keeps ``x + t z`` in the
-    set for ``-t_minus <= t <= t_plus`` (until a positive column reaches 0), so
-    coordinate ``j`` spans at least ``z_j (t_plus + t_minus)``. For each normal
-    column ``j`` in ``P``, ``z`` is ``e_j`` projected on that null space (the
+    The set is ``{x >= 0 : A x = rhs}``. One LP finds the columns ``P`` that are
+    positive somewhere in it and a point ``x`` positive on all of them
+    (:func:`_relative_interior`). The set then lies in ``{x : A x = rhs, x = 0
+    off P}``, whose directions are the null space of ``A_P``: a normal force
+    whose column is in ``A_P``'s row space (or outside ``P``) is constant. Any
+    ``z`` in that null space keeps ``x + t z`` in the set for ``-t_minus <= t <=
+    t_plus`` (until a positive column reaches 0), so column ``j`` spans at least
+    ``z_j (t_plus + t_minus)``, with ``z`` the projection of ``e_j`` (the
     direction that moves ``x_j`` most per unit length); ``t`` also stops where
     ``A (x + t z)`` would leave ``rhs`` by ``ZERO`` (the basis is a null space to
-    ``FORCE_RANK``). False proves nothing:
-    the caller then computes the ranges. ``A``: ``forces.A``, dense (small sets only).
+    ``FORCE_RANK``).
     """
-    x = _slack_point(A, forces.rhs, forces.fixed)
-    if x is None:
+    found = _relative_interior(A, forces.rhs, forces.fixed)
+    if found is None:
+        return None
+    x, support = found
+    positive = np.flatnonzero(support)
+    normal = normal[support[normal]]
+    at = np.searchsorted(positive, normal)  # each normal column's place among the positive ones
+    varying = at[~in_row_space(A[:, positive], at)]
+    if varying.size == 0:
         return False
-    positive = np.flatnonzero(x > ZERO)
     basis = null_space(A[:, positive], FORCE_RANK)
-    if basis.shape[1] == 0:
-        return False
-    at = {int(col): k for k, col in enumerate(positive.tolist())}
-    for j in normal.tolist():
-        if j not in at:
+    for k in varying.tolist():
+        z = basis @ basis[k]
+        if z[k] <= 0.0:
             continue
-        z = basis @ basis[at[j]]
-        if z[at[j]] <= 0.0:
-            continue
-        # The basis is a null space to FORCE_RANK: stop before A (x + t z) leaves rhs by more than ZERO.
         drift = float(np.max(np.abs(A[:, positive] @ z), initial=0.0))
         cap = ZERO / drift if drift > 0.0 else np.inf
         reach = min(_step(x[positive], z), cap) + min(_step(x[positive], -z), cap)
-        if z[at[j]] * reach > LP_FEASIBILITY:
+        if z[k] * reach > LP_FEASIBILITY:
             return True
-    return False
+    return None
 
 
-def _slack_point(A: np.ndarray, rhs: np.ndarray, fixed: np.ndarray) -> np.ndarray | None:
-    """A point of ``{x >= 0 : A x = rhs}`` maximising ``sum min(x_j, 1)`` over the free columns (one LP), or None."""
+def _relative_interior(A: np.ndarray, rhs: np.ndarray, fixed: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """A point of ``{x >= 0 : A x = rhs}`` and the columns positive somewhere in the set (one LP), or None.
+
+    The LP (Freund, Roundy and Todd's) runs on the cone ``A x = a rhs, a >= 1``:
+    maximise ``sum t_j`` with ``0 <= t_j <= x_j`` and ``t_j <= 1``. Scaling and
+    adding points of the cone reaches ``t_j = 1`` on every column positive
+    somewhere in the set at once, and ``t_j = 0`` elsewhere, so the optimum
+    marks the columns, and ``x / a`` is a point positive on all of them.
+    """
     n = fixed.size
     free = np.flatnonzero(~fixed)
     k = free.size
     lift = np.zeros((k, n))
     lift[np.arange(k), free] = 1.0
-    rows = np.block([[A, np.zeros((A.shape[0], k))], [lift, -np.eye(k)]])  # A x = rhs; x_j - t_j >= 0
-    lower = np.r_[rhs, np.zeros(k)]
-    upper = np.r_[rhs, np.full(k, np.inf)]
-    cost = np.r_[np.zeros(n), np.ones(k)]
-    lp = solve_lp(cost, rows, lower, upper, np.zeros(n + k), np.r_[np.full(n, np.inf), np.ones(k)], maximize=True)
-    return lp.x[:n] if lp.status == "optimal" else None
+    # Columns [x, a, t]: A x - a rhs = 0; x_j - t_j >= 0.
+    rows = np.block([[A, -rhs[:, None], np.zeros((A.shape[0], k))], [lift, np.zeros((k, 1)), -np.eye(k)]])
+    lower = np.zeros(rows.shape[0])
+    upper = np.r_[np.zeros(A.shape[0]), np.full(k, np.inf)]
+    cost = np.r_[np.zeros(n + 1), np.ones(k)]
+    col_lower = np.r_[np.zeros(n), 1.0, np.zeros(k)]
+    col_upper = np.r_[np.full(n + 1, np.inf), np.ones(k)]
+    lp = solve_lp(cost, rows, lower, upper, col_lower, col_upper, maximize=True)
+    if lp.status != "optimal":
+        return None
+    t = lp.x[n + 1 :]
+    if np.any(np.abs(t - np.round(t)) > LP_FEASIBILITY):
+        return None  # not the 0/1 optimum the argument needs: decide by the ranges instead
+    support = np.zeros(n, dtype=bool)
+    support[free[t > 0.5]] = True
+    return lp.x[:n] / lp.x[n], support
 
 
 def _step(x: np.ndarray, z: np.ndarray) -> float:
