@@ -15,10 +15,12 @@ import pytest
 
 import quasistatic as qs
 from quasistatic.laws.polyhedral import aligned_edges, polyhedral_form
-from quasistatic.solvers import Options
+from quasistatic.solvers import BACKENDS, Options
 from quasistatic.solvers.certify.cheap import kinematic_radius, seed_point
 from quasistatic.solvers.certify.search import enumerate_motions
+from quasistatic.solvers.numerics.forces import forces_at_twist, indeterminate_forces, measured_masks
 from quasistatic.solvers.numerics.highs import solve_lp
+from quasistatic.solvers.numerics.ranges import ranges_are_wide, value_ranges
 from quasistatic.tools.bench.families import grasp_2d
 from random_scenes import random_scene
 
@@ -138,3 +140,43 @@ def test_seeded_search_lists_the_same_motions(seed: int) -> None:
     assert complete == seeded_complete and len(plain) == len(seeded)
     for a in seeded:
         assert any(np.max(np.abs(a.q - b.q)) <= 1e-6 and a.continuum == b.continuum for b in plain)
+
+
+def _eager_normal_ranges(problem: qs.Problem, edges: np.ndarray, q: np.ndarray) -> list[tuple[float, float | None]]:
+    """Every normal force's range at twist ``q`` by two LPs each: what the lazy decision must agree with."""
+    masks = measured_masks(problem, edges, q)
+    forces = forces_at_twist(problem, edges, q, masks)
+    normal = np.arange(forces.fixed.size)[forces.polytope.normal]
+    return value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size))
+
+
+@pytest.mark.parametrize("scene", [grasp_2d(m, i) for m in (2, 4, 6, 8) for i in range(6)] + [random_scene(2, seed) for seed in range(30)])
+def test_deferred_frictional_force_ranges_decide_indeterminacy_as_the_ranges_do(scene: qs.Scene) -> None:
+    """``indeterminate_forces`` says "indeterminate" exactly when some normal range, worked out by LPs, is wide,
+    and the ranges it defers are those LPs' ranges."""
+    problem = qs.assemble(scene)
+    edges = aligned_edges(problem, problem.friction.edges)
+    result = BACKENDS["scip"].solver(problem, Options())
+    for motion in (m for m in result.motions if not m.continuum):
+        eager = _eager_normal_ranges(problem, edges, motion.q)
+        found = indeterminate_forces(problem, edges, motion.q)
+        assert (found is not None) == ranges_are_wide(eager)
+        if found is not None:
+            ranges = found.known if found.known is not None else found.lazy()
+            assert [lo for lo, _ in ranges] == pytest.approx([lo for lo, _ in eager], abs=1e-9)
+            assert [hi for _, hi in ranges] == pytest.approx([hi for _, hi in eager], abs=1e-9)
+
+
+def test_indeterminate_frictional_forces_are_reported_without_running_their_ranges() -> None:
+    """The 8-finger grasps are proven unique by kinematics with indeterminate forces: the ranges wait until read."""
+    for instance in range(3):
+        problem = qs.assemble(grasp_2d(8, instance))
+        raw = BACKENDS["certified"].solver(problem, Options())
+        assert raw.status == "solved" and raw.motions[0].forces_indeterminate
+        assert raw.motions[0].force_ranges is None and raw.motions[0].lazy_ranges is not None
+        solution = qs.solve(problem)
+        assert solution.forces_indeterminate
+        widths = [
+            hi - lo if hi is not None else np.inf for lo, hi in (c.normal_force_range for c in solution.contacts if c.normal_force_range)
+        ]
+        assert max(widths) > 0.0

@@ -23,7 +23,7 @@ from ...laws import Problem, RawMotion, contact_modes
 from ...laws.polyhedral import LCPForm, polyhedral_form
 from ...solution import Diagnosis
 from ...tolerances import DISTINCT_TWIST, MODE_SPEED, SAME_TWIST
-from ..numerics.forces import force_ranges
+from ..numerics.forces import indeterminate_forces
 from ..numerics.highs import solve_lp
 from ..numerics.ranges import twist_extremes
 from ..numerics.scip_model import exclude_box, linear, new_model, optimize
@@ -58,7 +58,7 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
         return BackendResult("failed", message, tuple(motions), certified=False, search_complete=False)
     motions = [_with_force_ranges(form, motion) for motion in motions]
     if len(motions) == 1 and not motions[0].continuum:
-        indeterminate = motions[0].force_ranges is not None
+        indeterminate = motions[0].forces_indeterminate
         message = "solved: one motion" + ("; the contact forces are indeterminate" if indeterminate else " with unique contact forces")
         return BackendResult("solved", message, tuple(motions), search_complete=True)
     kinds = "a continuum of motions" if len(motions) == 1 else f"{len(motions)} distinct motions"
@@ -72,14 +72,16 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
 
 
 def _with_force_ranges(form: LCPForm, motion: RawMotion) -> RawMotion:
-    """A single motion with its normal-force ranges when its forces are indeterminate (a continuum's forces vary along it)."""
+    """A single motion with its normal-force ranges when its forces are indeterminate (a continuum's forces vary along it).
+
+    The ranges are usually left to be worked out when read (:func:`~..numerics.forces.indeterminate_forces`).
+    """
     if motion.continuum:
         return motion
-    found = force_ranges(form.problem, form.edges, motion.q)
+    found = indeterminate_forces(form.problem, form.edges, motion.q)
     if found is None:
         return motion
-    ranges, consistent = found
-    return dataclasses.replace(motion, force_ranges=tuple(ranges), force_set=consistent)
+    return dataclasses.replace(motion, force_ranges=found.known, lazy_ranges=found.lazy, force_set=found.force_set)
 
 
 @dataclass

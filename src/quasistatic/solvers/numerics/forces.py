@@ -6,7 +6,9 @@ an open contact carries nothing, a sliding one pushes on the
 maximum-dissipation face of its friction polygon, a rolling one anywhere in
 its polygon, and together they balance the load. The set is a polytope; the
 certified search reports each normal force's range over it
-(:func:`force_ranges`), the exact-cone refinement picks its point of least
+(:func:`indeterminate_forces`: whether some range is wide is usually proven
+by one LP, and the ranges' two LPs per contact run when they are first
+read), the exact-cone refinement picks its point of least
 total normal force (:func:`least_normal_forces`). A :class:`ConsistentForces`
 keeps the set with the motion, for the ranges of what else the forces
 determine (a robot's joint torques, a mover's wrench) and whether limits on
@@ -15,28 +17,31 @@ them can be met, worked out only when they are read.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 
 import numpy as np
 import scipy.sparse as sp
 
 from ...laws import ModeMasks, Problem, slips
 from ...laws.polyhedral import ForcePolytope, aligned_edges, force_polytope
-from ...tolerances import FORCE_RANK, ZERO
+from ...tolerances import FORCE_RANK, LP_FEASIBILITY, ZERO
 from ..result import Range
 from .highs import solve_lp
-from .ranges import Bounds, linear_ranges, ranges_are_wide, rows_feasible, value_ranges
-from .rank import full_column_rank
+from .ranges import Bounds, in_row_space, linear_ranges, null_space, ranges_are_wide, rows_feasible, value_ranges
+from .rank import DENSE_MAX, full_column_rank
 
 __all__ = [
     "ForcesAtTwist",
     "ConsistentForces",
     "FrictionlessForces",
+    "IndeterminateForces",
     "forces_at_twist",
+    "indeterminate_forces",
     "measured_forces_at_twist",
-    "force_ranges",
     "least_normal_forces",
+    "measured_masks",
 ]
 
 _MOVING = ZERO * 10  # scene-relative speed or dissipation rate above which a contact opens or slides
@@ -74,6 +79,18 @@ class ForcesAtTwist:
         values = np.r_[self.edges.ravel(), np.ones(m)]
         M = sp.csr_matrix((values, (rows, cols)), shape=(m * d, self.fixed.size))
         return ConsistentForces(self.A, self.rhs, M)
+
+    @cached_property
+    def _consistent(self) -> ConsistentForces:
+        return self.consistent()
+
+    def ranges(self, functionals: np.ndarray) -> list[Bounds]:
+        """As :meth:`ConsistentForces.ranges` (a :class:`~quasistatic.laws.ForceSet`; the map is built when first read)."""
+        return self._consistent.ranges(functionals)
+
+    def feasible(self, functionals: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
+        """As :meth:`ConsistentForces.feasible`."""
+        return self._consistent.feasible(functionals, lower, upper)
 
 
 @dataclass(frozen=True)
@@ -144,13 +161,17 @@ def forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: M
     fixed[polytope.slack] = masks.sliding
     # One unit row per fixed column, sparse: an identity as wide as all the columns would grow as their square.
     held = np.flatnonzero(fixed)
-    pinned = sp.csr_matrix((np.ones(held.size), (np.arange(held.size), held)), shape=(held.size, fixed.size))
-    A = sp.vstack([sp.csr_matrix(polytope.A), pinned], format="csr")
+    # One build from index arrays (sparse vstack of small matrices costs more than the rest of this function).
+    laws = polytope.A.tocoo()
+    rows = np.r_[laws.row, polytope.A.shape[0] + np.arange(held.size)]
+    A = sp.csr_matrix(
+        (np.r_[laws.data, np.ones(held.size)], (rows, np.r_[laws.col, held])), shape=(polytope.A.shape[0] + held.size, fixed.size)
+    )
     rhs = np.r_[polytope.rhs, np.zeros(int(fixed.sum()))]
     return ForcesAtTwist(polytope, edges, A, rhs, fixed)
 
 
-def _measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeMasks:
+def measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeMasks:
     """Modes as the velocities at ``q`` show them: open beyond ``_MOVING``, sliding where some edge dissipates."""
     u = problem.velocities(q)
     drive = -np.einsum("mkt,mt->mk", edges, u[:, :-1])
@@ -161,18 +182,127 @@ def _measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeM
 
 def measured_forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ForcesAtTwist:
     """:func:`forces_at_twist` with the modes the velocities at ``q`` show."""
-    return forces_at_twist(problem, edges, q, _measured_masks(problem, edges, q))
+    return forces_at_twist(problem, edges, q, measured_masks(problem, edges, q))
 
 
-def force_ranges(problem: Problem, edges: np.ndarray, q: np.ndarray) -> tuple[list[Range], ConsistentForces] | None:
-    """Normal-force ranges (scene-relative) over all forces consistent with twist ``q``, and that set; None when the forces are unique."""
-    forces = measured_forces_at_twist(problem, edges, q)
-    free = ~forces.fixed
-    if full_column_rank(forces.A.tocsc()[:, free], FORCE_RANK):
+@dataclass(frozen=True)
+class IndeterminateForces:
+    """The normal-force ranges (scene-relative) of a motion whose forces are indeterminate, and their set.
+
+    ``known`` holds the ranges when they were worked out to decide it; otherwise ``lazy`` works them
+    out when called (two LPs per contact at most).
+    """
+
+    known: tuple[Range, ...] | None
+    lazy: Callable[[], tuple[Range, ...]] | None
+    force_set: ForcesAtTwist
+
+
+def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> IndeterminateForces | None:
+    """The normal-force ranges over every force consistent with twist ``q``; None when no range is wide.
+
+    Wide means wider than ``LP_FEASIBILITY`` (:func:`~.ranges.ranges_are_wide`), as before the ranges
+    were deferred. Free columns of full rank: one force distribution, None. Every normal force a
+    combination of the equations (only the edge intensities vary, as both edges of a 2-D contact
+    that sticks): None, as :func:`~.ranges.value_ranges` finds them constant. Otherwise one LP
+    decides (:func:`_normal_forces_vary`), and the ranges wait until they are read; where it
+    cannot decide, they are worked out now and decide.
+    """
+    forces = forces_at_twist(problem, edges, q, measured_masks(problem, edges, q))
+    # A small set is read densely once: each sparse conversion of a grasp's matrix costs ~0.1 ms.
+    A = forces.A.toarray() if min(forces.A.shape) <= DENSE_MAX else forces.A.tocsc()
+    if full_column_rank(A[:, ~forces.fixed], FORCE_RANK):
         return None
     normal = np.arange(forces.fixed.size)[forces.polytope.normal]
-    ranges = value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size))
-    return (ranges, forces.consistent()) if ranges_are_wide(ranges) else None
+    if np.all(in_row_space(A, normal)):
+        return None  # each normal force is fixed by the equations (the ranges' LPs would find it constant)
+    work = partial(_normal_ranges, forces, normal)
+    vary = _normal_forces_vary(A, forces, normal) if isinstance(A, np.ndarray) else None
+    if vary is not None:
+        return IndeterminateForces(None, work, forces) if vary else None
+    ranges = work()
+    return IndeterminateForces(ranges, None, forces) if ranges_are_wide(list(ranges)) else None
+
+
+def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ...]:
+    return tuple(value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size)))
+
+
+def _normal_forces_vary(A: np.ndarray, forces: ForcesAtTwist, normal: np.ndarray) -> bool | None:
+    """True: some normal force provably spans more than ``LP_FEASIBILITY`` over the set; False: every
+    normal force is constant on it; None: undecided. ``A``: ``forces.A``, dense (small sets only).
+
+    The set is ``{x >= 0 : A x = rhs}``. One LP finds the columns ``P`` that are
+    positive somewhere in it and a point ``x`` positive on all of them
+    (:func:`_relative_interior`). The set then lies in ``{x : A x = rhs, x = 0
+    off P}``, whose directions are the null space of ``A_P``: a normal force
+    whose column is in ``A_P``'s row space (or outside ``P``) is constant. Any
+    ``z`` in that null space keeps ``x + t z`` in the set for ``-t_minus <= t <=
+    t_plus`` (until a positive column reaches 0), so column ``j`` spans at least
+    ``z_j (t_plus + t_minus)``, with ``z`` the projection of ``e_j`` (the
+    direction that moves ``x_j`` most per unit length); ``t`` also stops where
+    ``A (x + t z)`` would leave ``rhs`` by ``ZERO`` (the basis is a null space to
+    ``FORCE_RANK``).
+    """
+    found = _relative_interior(A, forces.rhs, forces.fixed)
+    if found is None:
+        return None
+    x, support = found
+    positive = np.flatnonzero(support)
+    normal = normal[support[normal]]
+    at = np.searchsorted(positive, normal)  # each normal column's place among the positive ones
+    varying = at[~in_row_space(A[:, positive], at)]
+    if varying.size == 0:
+        return False
+    basis = null_space(A[:, positive], FORCE_RANK)
+    for k in varying.tolist():
+        z = basis @ basis[k]
+        if z[k] <= 0.0:
+            continue
+        drift = float(np.max(np.abs(A[:, positive] @ z), initial=0.0))
+        cap = ZERO / drift if drift > 0.0 else np.inf
+        reach = min(_step(x[positive], z), cap) + min(_step(x[positive], -z), cap)
+        if z[k] * reach > LP_FEASIBILITY:
+            return True
+    return None
+
+
+def _relative_interior(A: np.ndarray, rhs: np.ndarray, fixed: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """A point of ``{x >= 0 : A x = rhs}`` and the columns positive somewhere in the set (one LP), or None.
+
+    The LP (Freund, Roundy and Todd's) runs on the cone ``A x = a rhs, a >= 1``:
+    maximise ``sum t_j`` with ``0 <= t_j <= x_j`` and ``t_j <= 1``. Scaling and
+    adding points of the cone reaches ``t_j = 1`` on every column positive
+    somewhere in the set at once, and ``t_j = 0`` elsewhere, so the optimum
+    marks the columns, and ``x / a`` is a point positive on all of them.
+    """
+    n = fixed.size
+    free = np.flatnonzero(~fixed)
+    k = free.size
+    lift = np.zeros((k, n))
+    lift[np.arange(k), free] = 1.0
+    # Columns [x, a, t]: A x - a rhs = 0; x_j - t_j >= 0.
+    rows = np.block([[A, -rhs[:, None], np.zeros((A.shape[0], k))], [lift, np.zeros((k, 1)), -np.eye(k)]])
+    lower = np.zeros(rows.shape[0])
+    upper = np.r_[np.zeros(A.shape[0]), np.full(k, np.inf)]
+    cost = np.r_[np.zeros(n + 1), np.ones(k)]
+    col_lower = np.r_[np.zeros(n), 1.0, np.zeros(k)]
+    col_upper = np.r_[np.full(n + 1, np.inf), np.ones(k)]
+    lp = solve_lp(cost, rows, lower, upper, col_lower, col_upper, maximize=True)
+    if lp.status != "optimal":
+        return None
+    t = lp.x[n + 1 :]
+    if np.any(np.abs(t - np.round(t)) > LP_FEASIBILITY):
+        return None  # not the 0/1 optimum the argument needs: decide by the ranges instead
+    support = np.zeros(n, dtype=bool)
+    support[free[t > 0.5]] = True
+    return lp.x[:n] / lp.x[n], support
+
+
+def _step(x: np.ndarray, z: np.ndarray) -> float:
+    """Largest ``t >= 0`` with ``x + t z >= 0`` (``x >= 0``); infinite when no entry of ``z`` is negative."""
+    falling = z < 0.0
+    return float(np.min(x[falling] / -z[falling])) if falling.any() else np.inf
 
 
 def least_normal_forces(problem: Problem, q: np.ndarray, masks: ModeMasks, edge_count: int) -> np.ndarray | None:

@@ -14,7 +14,16 @@ from ..result import Range
 from .highs import INF, WarmLP, optimise_each, solve_lp
 from .rank import DENSE_MAX, full_column_rank
 
-__all__ = ["null_space", "cone_is_trivial", "twist_extremes", "value_ranges", "ranges_are_wide", "linear_ranges", "rows_feasible"]
+__all__ = [
+    "null_space",
+    "cone_is_trivial",
+    "twist_extremes",
+    "value_ranges",
+    "ranges_are_wide",
+    "linear_ranges",
+    "rows_feasible",
+    "in_row_space",
+]
 
 Bounds = tuple[float | None, float | None]
 
@@ -111,7 +120,7 @@ def value_ranges(A_eq: np.ndarray | sp.spmatrix, b_eq: np.ndarray, columns: np.n
     minima are found this way.
     """
     model = WarmLP(A_eq, b_eq, b_eq, col_lower)
-    constant = _in_row_space(A_eq, columns)
+    constant = in_row_space(A_eq, columns)
     at_bound = np.zeros(A_eq.shape[1], dtype=bool)  # coordinates seen at their lower bound
     ranges: list[Range] = []
     for j, fixed in zip(columns.tolist(), constant.tolist(), strict=True):
@@ -172,7 +181,7 @@ def rows_feasible(
     return solve_lp(np.zeros(A.shape[1]), A, row_lower, row_upper, col_lower).status == "optimal"
 
 
-def _in_row_space(A: np.ndarray | sp.spmatrix, columns: np.ndarray) -> np.ndarray:
+def in_row_space(A: np.ndarray | sp.spmatrix, columns: np.ndarray) -> np.ndarray:
     """Which coordinates ``x[j]`` are combinations of A's rows (constant wherever ``A x`` is fixed).
 
     Only worked out when A's smaller side is small (a thin SVD); on a large

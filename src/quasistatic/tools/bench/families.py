@@ -277,6 +277,17 @@ FAMILIES: dict[str, Family] = {
             size_label="contacts",
         ),
         Family(
+            "grasp-2d-nf",
+            "the grasp-2d scenes with friction: none (linprog on their velocity LP: the speed targets' yardstick)",
+            _variant(grasp_2d, "none"),
+            quick_sizes=(2, 4, 8),
+            full_sizes=(2, 3, 4, 6, 8),
+            quick_instances=3,
+            full_instances=6,
+            size_label="contacts",
+            frictionless=True,
+        ),
+        Family(
             "grasp-3d",
             "ellipsoid held by point fingers moving at random, exact 3-D cones, mu ~ U[0.1, 1]",
             _variant(grasp_3d, "exact"),
