@@ -21,7 +21,7 @@ import scipy.sparse as sp
 from ...errors import SolverError
 from ...tolerances import HIGHS_SMALLEST_ENTRY
 
-__all__ = ["LPResult", "solve_lp", "optimise_each", "WarmLP", "INF"]
+__all__ = ["LPResult", "solve_lp", "solve_qp", "optimise_each", "WarmLP", "INF"]
 
 INF = float("inf")
 LPStatus = Literal["optimal", "infeasible", "unbounded", "unbounded_or_infeasible", "error"]
@@ -108,6 +108,32 @@ def solve_lp(
         return _without_columns(row_lower, row_upper)
     solver = _load(_thread_highs(), cost, A, row_lower, row_upper, col_lower, col_upper, maximize)
     return _run(solver, cost, maximize)
+
+
+def solve_qp(
+    hessian: np.ndarray,
+    cost: np.ndarray,
+    A: np.ndarray | sp.spmatrix,
+    row_lower: np.ndarray,
+    row_upper: np.ndarray,
+    col_lower: np.ndarray | None = None,
+    col_upper: np.ndarray | None = None,
+) -> LPResult:
+    """Solve ``min x.H x / 2 + cost.x  s.t.  row_lower <= A x <= row_upper, col_lower <= x <= col_upper`` (H symmetric PSD).
+
+    On a fresh HiGHS instance: a Hessian stays with a model, and the thread's instance is for LPs.
+    """
+    if cost.size == 0:
+        return _without_columns(row_lower, row_upper)
+    solver = _load(_new_highs(), cost, A, row_lower, row_upper, col_lower, col_upper, False)
+    lower = sp.csc_matrix(np.tril(hessian))  # HiGHS reads the lower triangle, column by column
+    try:
+        solver.passHessian(cost.size, lower.nnz, int(highspy.HessianFormat.kTriangular), lower.indptr, lower.indices, lower.data)
+    except Exception as exc:  # a crash inside HiGHS, not a status
+        raise SolverError("highs", f"HiGHS failed: {exc}") from exc
+    result = _run(solver, cost, False)
+    objective = float(0.5 * result.x @ hessian @ result.x + cost @ result.x) if result.status == "optimal" else float("nan")
+    return LPResult(result.status, result.x, result.row_dual, objective)
 
 
 def _without_columns(row_lower: np.ndarray, row_upper: np.ndarray) -> LPResult:
