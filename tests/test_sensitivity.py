@@ -148,3 +148,17 @@ def test_an_unknown_input_is_named() -> None:
     scene = random_scene(2, 1)
     with pytest.raises(ValueError, match="inputs: 'nobody'"):
         qs.sensitivity(scene, inputs=["nobody"])
+
+
+def test_a_robot_joint_turns_the_box_through_its_jacobian() -> None:
+    """examples/robot_tip.yaml: the box turns about the notch corner, so its fingertip point moves at (0, 0.1 w); the
+    closed frictionless fingertip (normal n = (-0.6, 0.8)) makes 0.08 w = n . (J qdot). With J = [[0, 0.2],
+    [-0.3, -0.15]]: dw/dqdot = n^T J / 0.08 = [-3, -3] (J transposed would give [2, 0.75]), and the com, at
+    (0.05, 0.05) from the corner, moves at w (-0.05, 0.05)."""
+    scene = qs.load_scene(EXAMPLES / "robot_tip.yaml")
+    result = qs.sensitivity(scene, inputs=["arm"])
+    assert isinstance(result, qs.Sensitivity)
+    assert result.inputs == ("arm.joint[0]", "arm.joint[1]")
+    np.testing.assert_allclose(result.twists["box"], [[0.15, 0.15], [-0.15, -0.15], [-3.0, -3.0]], atol=1e-12)
+    np.testing.assert_allclose(result.forces, 0.0, atol=1e-12)  # frictionless: the forces balance gravity alone
+    assert result.certified and result.margins_exact
