@@ -194,3 +194,15 @@ def test_the_plan_command_names_bad_input(tmp_path: Path, arguments: list[str], 
     done = _run("plan", str(scene), *arguments, "--free", "finger")
     assert done.returncode == 2
     assert done.stderr.startswith(message) and done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
+
+
+def test_a_robot_plan_is_the_least_norm_joint_velocity() -> None:
+    """examples/robot_tip.yaml, wanted: its own answer's twist (turning at 0.06 rad/s about the notch corner). Only the
+    fingertip's normal speed is constrained, n . (J qdot) = 0.08 w = 0.0048 with n^T J = [-0.24, -0.24]: the least-norm
+    joint velocities are [-0.01, -0.01] (the scene's own [-0.04, 0.02] costs more), and the fingertip still slips."""
+    scene = qs.load_scene(Path(__file__).resolve().parents[1] / "examples" / "robot_tip.yaml")
+    result = qs.plan(scene, {"box": [-0.003, 0.003, 0.06]}, ["rolling", "rolling", "sliding"], certify=True)
+    assert result.status == "planned", result.message
+    assert result.input_names == ("arm.joint[0]", "arm.joint[1]")
+    np.testing.assert_allclose(result.inputs, [-0.01, -0.01], atol=1e-12)
+    assert result.unique is True

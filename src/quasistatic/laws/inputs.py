@@ -76,7 +76,8 @@ class Inputs:
         for entry, value in zip(self.entries, np.asarray(values, dtype=float), strict=True):
             (joints if entry.kind == "joint" else twists)[entry.owner][entry.index] = value
         robots = [Robot(r.name, joints[r.name], joint_names=r.joint_names, torque_limits=r.torque_limits) for r in scene.robots]
-        movers = [m if m.robot is not None else Mover(m.name, twists[m.name], m.origin, None) for m in scene.movers]
+        # A Scene fills in a robot-driven mover's twist with zeros, which a new Scene refuses: rebuilt without it.
+        movers = [Mover(m.name, None if m.robot else twists[m.name], m.origin, m.robot) for m in scene.movers]
         return Scene(scene.bodies, scene.contacts, movers, robots, scene.dimension, scene.gravity, scene.friction)
 
     def point_velocity_map(self, scene: Scene) -> FloatArray:
