@@ -23,7 +23,6 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-import scipy.optimize
 
 from ..laws import Problem
 from ..laws.fixed_modes import ROLLING, SEPARATING, SLIDING, columns, system
@@ -217,6 +216,8 @@ def _spatial(setup: _Setup) -> PlannedInputs:
     start = _spatial_start(setup)
     if start is None:
         return _infeasible(setup, "no start: the inputs or the forces cannot meet the modes' linear conditions")
+    import scipy.optimize  # here, not at module level: it costs every `import quasistatic` 0.2-0.6 s otherwise
+
     nlp = _SpatialNLP(setup)
     z0 = nlp.pack(*start)
     scale = abs(nlp.cost(z0)) or 1.0  # SLSQP's stopping rule is absolute: the cost in units of its start
