@@ -24,6 +24,8 @@ from .errors import BackendUnavailableError, QuasistaticError, SceneError, Solve
 from .laws import Problem, assemble
 from .loading import load_scene, load_world
 from .model import Body, Contact, FrictionModel, Mover, Robot, Scene, Stiffness
+from .plan import PlanResult, QuadraticCost, plan
+from .sensitivity import InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, sensitivity
 from .sim import Inputs, InputTable, Trajectory, simulate
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
@@ -33,6 +35,15 @@ from .viz import plot, view
 __version__ = "0.1.0"
 
 __all__ = [
+    "sensitivity",
+    "plan",
+    "Sensitivity",
+    "QuadraticCost",
+    "PlanResult",
+    "NoSensitivityReason",
+    "NoSensitivity",
+    "ModeChange",
+    "InputMargin",
     "Attempt",
     "Audit",
     "BackendUnavailableError",

@@ -1,4 +1,4 @@
-"""Command line: ``quasistatic demo | solve | simulate | animate | plot | view | sweep | check | contacts | validate | bench``.
+"""Command line: ``quasistatic demo | solve | simulate | animate | plot | view | sweep | plan | check | contacts | validate | bench``.
 
 A thin layer, no physics.
 
@@ -456,6 +456,63 @@ def validate(
     results = _guarded(lambda: run_validation(folder))
     render_results(results, make_console())
     raise typer.Exit(0 if all(r.ok for r in results) else 1)
+
+
+@app.command("plan")
+def plan_command(
+    scene_file: SceneArgument,
+    twist: Annotated[
+        list[str], typer.Option(help="Wanted twist of a body, BODY=v1,v2,... (repeat per body; a one-body scene may omit BODY=).")
+    ],
+    modes: Annotated[str, typer.Option(help="Wanted contact modes, one per contact in order: rolling, sliding or separating.")],
+    free: Annotated[
+        list[str] | None, typer.Option(help="A robot or mover whose inputs the planner chooses (repeatable; default: every robot).")
+    ] = None,
+    certify: Annotated[
+        bool, typer.Option("--certify/--no-certify", help="Also solve the planned scene forward: is the motion the only one?")
+    ] = False,
+    min_speed: Annotated[float | None, typer.Option(help="Smallest slip or separation speed to plan for [length/time].")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the plan as JSON (PlanResult.to_dict()) and nothing else.")] = False,
+) -> None:
+    """Plan the inputs (joint velocities, mover twists) that give a wanted motion with wanted contact modes."""
+    from .plan import plan  # the planner's numerics load only for this command
+
+    scene, _ = _loaded(scene_file)
+    wanted = _guarded(lambda: _parse_twists(twist))
+    wanted_modes = _guarded(lambda: _parse_plan_modes(modes))
+    result = _guarded(
+        lambda: plan(scene, wanted, wanted_modes, free=free, certify=certify, min_speed=min_speed)  # type: ignore[arg-type]
+    )
+    if as_json:
+        typer.echo(json.dumps(result.to_dict(), indent=2, allow_nan=False))
+    else:
+        typer.echo(f"{result.status}: {result.message}")
+        for name, value in zip(result.input_names, result.inputs, strict=True):
+            typer.echo(f"  {name} = {float(value) + 0.0:.6g}")
+    raise typer.Exit(1 if result.status == "failed" else 0)
+
+
+def _parse_twists(entries: list[str]) -> dict[str, list[float]] | list[float]:
+    """``BODY=v1,v2,...`` per entry, or one bare ``v1,v2,...`` for a one-body scene."""
+    parsed: dict[str, list[float]] = {}
+    for entry in entries:
+        name, _, numbers = entry.rpartition("=")
+        try:
+            values = [float(x) for x in numbers.split(",")]
+        except ValueError:
+            raise ValueError(f"--twist {entry!r}: expected BODY=v1,v2,... with numbers") from None
+        if not name and len(entries) == 1:
+            return values
+        parsed[name] = values
+    return parsed
+
+
+def _parse_plan_modes(text: str) -> list[Mode]:
+    words = [word.strip().lower() for word in text.split(",")]
+    for index, word in enumerate(words):
+        if word not in ("rolling", "sliding", "separating"):
+            raise ValueError(f"--modes entry {index} is {word!r}; expected rolling, sliding or separating")
+    return words  # type: ignore[return-value]
 
 
 def main() -> None:

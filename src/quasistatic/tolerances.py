@@ -48,6 +48,9 @@ __all__ = [
     "NEWTON_DAMPING",
     "LEAST_SQUARES_STEP",
     "JACOBI_ORTHOGONAL",
+    "MODE_BOUNDARY",
+    "PLAN_SPEED",
+    "PLAN_COST",
     "ROTATION_ORTHONORMAL",
     "QUATERNION_NORM",
     "CONTACT_SEPARATION",
@@ -181,6 +184,23 @@ LEAST_SQUARES_STEP = 1e-15
 
 JACOBI_ORTHOGONAL = 1e-15
 """Two columns of a one-sided Jacobi SVD are orthogonal when their cosine is below this (working precision) [-]."""
+
+# --------------------------------------------------------------------------- sensitivities and planning
+
+MODE_BOUNDARY = 1e-6
+"""A quantity that decides a contact's mode (normal speed, slip speed, normal force, distance of a rolling
+contact's force from its cone) below this, scene-relative, puts the motion on a mode boundary: the one-sided
+derivatives differ there, so no derivative is given. The same size as :data:`MODE_SPEED` and :data:`AUDIT`,
+to which the reported motion itself is known [-]."""
+
+PLAN_SPEED = 1e-2
+"""Default smallest speed the planner gives a sliding contact's slip and a separating contact's normal velocity,
+relative to the wanted motion's speed at the scene's length scale [-]: well above :data:`MODE_SPEED` (1e-6), so
+the audit names the planned mode, and small enough not to cost a visible part of the inputs."""
+
+PLAN_COST = 1e-12
+"""The 3-D planner's NLP (SLSQP) stops when its cost changes by less than this fraction of its starting cost [-]:
+on Brock's controlled slip it converges in 2 iterations; an absolute 1e-15 on its cost of 2e-5 ran all 500 (round-off)."""
 
 # --------------------------------------------------------------------------- geometry and contact detection (adapters/)
 

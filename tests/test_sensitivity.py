@@ -1,0 +1,164 @@
+"""Sensitivities (issue 15, section 3): derivatives against finite differences of ``qs.solve``, margins, refusals."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import quasistatic as qs
+from quasistatic.laws.inputs import Inputs
+from random_scenes import random_scene
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+SEEDS = {2: range(30), 3: range(40)}
+CHECKED_INPUTS = 4  # per scene: a 3-D scene has up to 24 inputs, each costing two solves
+
+
+def _stacked(solution: qs.Solution) -> tuple[np.ndarray, np.ndarray]:
+    return np.concatenate(list(solution.twists.values())), np.array([c.force for c in solution.contacts])
+
+
+def _central_difference(scene: qs.Scene, j: int, h: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """(d twist, d forces) per unit of input j by central differences of the forward solve; None if a side is not solved."""
+    inputs = Inputs.of(scene)
+    values = inputs.values(scene)
+    sides = []
+    for sign in (1.0, -1.0):
+        moved = values.copy()
+        moved[j] += sign * h
+        solution = qs.solve(inputs.apply(scene, moved))
+        if solution.status != "solved":
+            return None
+        sides.append(_stacked(solution))
+    return (sides[0][0] - sides[1][0]) / (2 * h), (sides[0][1] - sides[1][1]) / (2 * h)
+
+
+def _differentiable(dimension: int) -> list[tuple[qs.Scene, qs.Solution, qs.Sensitivity]]:
+    found = []
+    for seed in SEEDS[dimension]:
+        scene = random_scene(dimension, seed)
+        solution = qs.solve(scene)
+        result = qs.sensitivity(scene, solution)
+        if isinstance(result, qs.Sensitivity):
+            found.append((scene, solution, result))
+    return found
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_derivatives_match_finite_differences_of_the_solve(dimension: int) -> None:
+    """Every column of d(twist)/d(input) and d(force)/d(input) against central differences of qs.solve.
+
+    The tolerance is relative to the largest column: a column that is more than a thousandth of it and has
+    the wrong sign, or belongs to another input (a transpose), fails.
+    """
+    cases = _differentiable(dimension)
+    assert len(cases) >= 5, f"only {len(cases)} random {dimension}-D scenes had a derivative"
+    compared = 0
+    for scene, _, result in cases:
+        twist, forces = _stacked(qs.solve(scene))
+        for j, margin in enumerate(result.margins[:CHECKED_INPUTS]):
+            h = 1e-3 * min(1.0, margin.below, margin.above)  # inside the mode on both sides
+            # The solves' own round-off (1e-10 of the values) divided by the step, plus a thousandth of the largest column:
+            twist_scale = 1e-3 * float(np.max(np.abs(result.twist_jacobian))) + 1e-10 * float(np.max(np.abs(twist))) / h
+            force_scale = 1e-3 * float(np.max(np.abs(result.forces))) + 1e-10 * float(np.max(np.abs(forces))) / h
+            difference = _central_difference(scene, j, h)
+            if difference is None:
+                continue
+            d_twist, d_forces = difference
+            compared += 1
+            assert np.allclose(result.twist_jacobian[:, j], d_twist, rtol=1e-3, atol=twist_scale), (result.inputs[j], d_twist)
+            assert np.allclose(result.forces[:, :, j], d_forces, rtol=1e-3, atol=force_scale), (result.inputs[j], d_forces)
+    assert compared >= 15
+
+
+def test_a_pushed_box_follows_its_pusher() -> None:
+    """A box pushed along a floor by a rolling finger moves with the finger: d v_x/d finger.v_x = 1, forces constant."""
+    scene = qs.Scene(
+        bodies=[qs.Body("box", 0.5, [0.0, 0.05])],
+        movers=[qs.Mover("floor"), qs.Mover("finger", twist=[0.01, 0.0, 0.0], origin=[-0.05, 0.05])],
+        contacts=[
+            qs.Contact("box", "floor", [-0.05, 0.0], [0.0, 1.0], mu=0.3),
+            qs.Contact("box", "floor", [0.05, 0.0], [0.0, 1.0], mu=0.3),
+            qs.Contact("box", "finger", [-0.05, 0.05], [1.0, 0.0]),  # frictionless: the forces are unique
+        ],
+        dimension=2,
+    )
+    result = qs.sensitivity(scene, inputs=["finger"])
+    assert isinstance(result, qs.Sensitivity)
+    assert result.inputs == ("finger.v_x", "finger.v_y", "finger.omega_z")
+    np.testing.assert_allclose(result.twists["box"][:, 0], [1.0, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(result.forces[:, :, 0], 0.0, atol=1e-12)
+    # Slowing the finger to zero stops the slide: the floor contacts stick at finger.v_x = 0, 0.01 below.
+    assert result.margins[0].below == pytest.approx(0.01, rel=1e-9)
+    assert result.margins[0].below_change is not None and result.margins[0].below_change.what == "slip"
+    assert result.margins_exact
+
+
+def test_the_margin_is_exact_in_2d() -> None:
+    """Along one input, the predicted motion is the forward answer up to the margin, and the motion there sits on a
+    mode boundary: the sensitivity then refuses with the reason."""
+    checked = 0
+    for scene, solution, result in _differentiable(2):
+        inputs = Inputs.of(scene)
+        values = inputs.values(scene)
+        for j, margin in enumerate(result.margins):
+            if not np.isfinite(margin.above) or margin.above > 1.0:
+                continue
+            inside = values.copy()
+            inside[j] += 0.5 * margin.above
+            moved = qs.solve(inputs.apply(scene, inside))
+            predicted = _stacked(solution)[0] + 0.5 * margin.above * result.twist_jacobian[:, j]
+            motions = moved.solutions or ((moved.motion,) if moved.motion else ())
+            assert any(np.allclose(np.concatenate(list(m.twists.values())), predicted, atol=1e-7) for m in motions)
+            edge = values.copy()
+            edge[j] += margin.above
+            at_edge = inputs.apply(scene, edge)
+            refused = qs.sensitivity(at_edge)
+            assert isinstance(refused, qs.NoSensitivity)
+            assert refused.reason in (
+                qs.NoSensitivityReason.MODE_BOUNDARY,
+                qs.NoSensitivityReason.NOT_SOLVED,
+                qs.NoSensitivityReason.FORCES_INDETERMINATE,
+            )
+            checked += 1
+    assert checked >= 5
+
+
+def test_what_has_no_derivative_says_why() -> None:
+    jammed = qs.load_scene(EXAMPLES / "push_into_wall.yaml")
+    refused = qs.sensitivity(jammed)
+    assert isinstance(refused, qs.NoSensitivity) and refused.reason is qs.NoSensitivityReason.NOT_SOLVED
+    assert "jammed" in refused.message
+    refused = qs.sensitivity(random_scene(3, 0, "pyramid:8"))
+    assert isinstance(refused, qs.NoSensitivity) and refused.reason is qs.NoSensitivityReason.UNSUPPORTED_FRICTION
+    assert refused.to_dict()["available"] is False
+
+
+def test_forces_indeterminate_have_no_force_derivative() -> None:
+    squeeze = qs.load_scene(EXAMPLES / "squeeze.yaml")
+    solution = qs.solve(squeeze)
+    refused = qs.sensitivity(squeeze, solution)
+    assert isinstance(refused, qs.NoSensitivity)
+    assert refused.reason in (qs.NoSensitivityReason.FORCES_INDETERMINATE, qs.NoSensitivityReason.NOT_SOLVED)
+
+
+def test_an_unknown_input_is_named() -> None:
+    scene = random_scene(2, 1)
+    with pytest.raises(ValueError, match="inputs: 'nobody'"):
+        qs.sensitivity(scene, inputs=["nobody"])
+
+
+def test_a_robot_joint_turns_the_box_through_its_jacobian() -> None:
+    """examples/robot_tip.yaml: the box turns about the notch corner, so its fingertip point moves at (0, 0.1 w); the
+    closed frictionless fingertip (normal n = (-0.6, 0.8)) makes 0.08 w = n . (J qdot). With J = [[0, 0.2],
+    [-0.3, -0.15]]: dw/dqdot = n^T J / 0.08 = [-3, -3] (J transposed would give [2, 0.75]), and the com, at
+    (0.05, 0.05) from the corner, moves at w (-0.05, 0.05)."""
+    scene = qs.load_scene(EXAMPLES / "robot_tip.yaml")
+    result = qs.sensitivity(scene, inputs=["arm"])
+    assert isinstance(result, qs.Sensitivity)
+    assert result.inputs == ("arm.joint[0]", "arm.joint[1]")
+    np.testing.assert_allclose(result.twists["box"], [[0.15, 0.15], [-0.15, -0.15], [-3.0, -3.0]], atol=1e-12)
+    np.testing.assert_allclose(result.forces, 0.0, atol=1e-12)  # frictionless: the forces balance gravity alone
+    assert result.certified and result.margins_exact
