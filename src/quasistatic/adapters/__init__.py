@@ -19,7 +19,7 @@ Rules:
   field and the value.
 """
 
-from .detect import Collider, ContactPoint, candidate_pairs, detect
+from .detect import Collider, ContactPoint, Layout, candidate_pairs, detect
 from .robot import ROBOTS_INSTALL_HINT, UrdfRobot
 from .shapes import Box, Capsule, Convex, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere, shape_from_coal
 from .world import ContactDetection, Detection, FrictionPair, ShapedMover, SolidBody, World
@@ -37,6 +37,7 @@ __all__ = [
     "Detection",
     "FrictionPair",
     "Halfspace",
+    "Layout",
     "Mesh",
     "Pose",
     "Shape",
