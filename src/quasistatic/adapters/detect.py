@@ -456,27 +456,37 @@ def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margi
 
 
 def _polygon_vertices(points: FloatArray, tolerance: float) -> list[int]:
-    """Indices of the corners of a polygon given in order (k, 3): no duplicates, no points along an edge."""
-    if len(points) < 2:
-        return list(range(len(points)))
-    offsets = points[:, None, :] - points[None, :, :]
-    apart = (np.einsum("ijk,ijk->ij", offsets, offsets) > tolerance**2).tolist()
+    """Indices of the corners of a polygon given in order (k, 3): no duplicates, no points along an edge.
+
+    In plain floats: a patch has at most a few dozen points, where each numpy call costs more than the arithmetic.
+    """
+    rows = points.tolist()
+    limit = tolerance * tolerance
     kept: list[int] = []
-    for k, row in enumerate(apart):
-        if all(row[m] for m in kept):
+    for k, point in enumerate(rows):
+        if all(_squared_distance(point, rows[m]) > limit for m in kept):
             kept.append(k)
     while len(kept) > 2:  # drop one edge point at a time: a removal can make its neighbour an edge point too
-        ring = points[kept]
-        turn = np.arange(len(kept))
-        before, after = ring[turn - 1], ring[(turn + 1) % len(kept)]
-        along = after - before
-        t = np.clip(np.einsum("ij,ij->i", ring - before, along) / np.maximum(np.einsum("ij,ij->i", along, along), 1e-300), 0.0, 1.0)
-        off = ring - (before + t[:, None] * along)
-        on_edge = np.flatnonzero(np.einsum("ij,ij->i", off, off) <= tolerance**2)
-        if not on_edge.size:
+        count = len(kept)
+        on_edge = (n for n in range(count) if _near_segment(rows[kept[n]], rows[kept[n - 1]], rows[kept[(n + 1) % count]], limit))
+        edge_point = next(on_edge, None)
+        if edge_point is None:
             break
-        del kept[int(on_edge[0])]
+        del kept[edge_point]
     return kept
+
+
+def _squared_distance(p: list[float], q: list[float]) -> float:
+    return (p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2
+
+
+def _near_segment(point: list[float], start: list[float], end: list[float], limit: float) -> bool:
+    """Whether ``point`` is within ``sqrt(limit)`` of the segment from ``start`` to ``end``."""
+    along = [end[0] - start[0], end[1] - start[1], end[2] - start[2]]
+    length = max(along[0] ** 2 + along[1] ** 2 + along[2] ** 2, 1e-300)
+    t = sum((point[i] - start[i]) * along[i] for i in range(3)) / length
+    t = min(max(t, 0.0), 1.0)
+    return _squared_distance(point, [start[i] + t * along[i] for i in range(3)]) <= limit
 
 
 # --------------------------------------------------------------------------- a shape along a line
