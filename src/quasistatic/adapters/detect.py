@@ -390,17 +390,23 @@ def _pair_contacts(query: _Query, a: Collider, b: Collider, i: int, j: int) -> l
     direction, gap = rough
     if direction is not None and _exact_normal(a, b, gap):
         return _one_point(query, a, b, direction, size)
-    if direction is None:
-        direction, gap = _least_overlap(a, b)
-    # Move a away from b until they are apart by CONTACT_SEPARATION * size: GJK then gives the exact normal.
-    shift = max(0.0, CONTACT_SEPARATION * size - gap)
-    moved = _transform(coal, a.pose, direction * shift)
-    result, request = query.result, query.moved_request
-    request.security_margin = margin + 2.0 * shift
-    result.clear()
-    coal.collide(ga, moved, gb, tb, request, result)
-    if not result.isCollision() or _unit(result.getContact(0).normal) is None:
-        raise SolverError("coal", f"no finite contact normal between {a.owner!r} and {b.owner!r}, even moved apart")
+    result = query.result
+    if direction is not None and (isinstance(a.shape, Halfspace) or isinstance(b.shape, Halfspace)):
+        # coal's test against a halfspace is analytic, not EPA: its normal is the halfspace's own, exact even
+        # for overlapping shapes, so its first answer gives the patch without moving the pair apart.
+        shift, moved = 0.0, query.transform(i)
+    else:
+        if direction is None:
+            direction, gap = _least_overlap(a, b)
+        # Move a away from b until they are apart by CONTACT_SEPARATION * size: GJK then gives the exact normal.
+        shift = max(0.0, CONTACT_SEPARATION * size - gap)
+        moved = _transform(coal, a.pose, direction * shift)
+        request = query.moved_request
+        request.security_margin = margin + 2.0 * shift
+        result.clear()
+        coal.collide(ga, moved, gb, tb, request, result)
+        if not result.isCollision() or _unit(result.getContact(0).normal) is None:
+            raise SolverError("coal", f"no finite contact normal between {a.owner!r} and {b.owner!r}, even moved apart")
     thickness = max(margin - gap, 0.0) + PATCH_THICKNESS * size
     patch_request = coal.ContactPatchRequest(1, CURVED_PATCH_POINTS, thickness)
     patches = coal.ContactPatchResult(patch_request)

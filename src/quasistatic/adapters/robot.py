@@ -201,7 +201,9 @@ class UrdfRobot:
         folders = [Path(d) for d in package_dirs] + installed_model_folders()
         path = resolve_package_path(str(urdf), folders, f"{field}.urdf")
         kinematics = _Kinematics(path, folders, f"{field}.urdf")
-        self._build(name, path, kinematics, base or Pose(), q, joint_velocities, field)
+        names = kinematics.joint_names
+        angles, velocities = _per_joint(q, names, f"{field}.q"), _per_joint(joint_velocities, names, f"{field}.joint_velocities")
+        self._build(name, path, kinematics, base or Pose(), angles, velocities, field)
         self.torque_limits = _limits(torque_limits, kinematics.joint_names, f"{field}.torque_limits")
 
     def _build(
@@ -210,17 +212,20 @@ class UrdfRobot:
         urdf: Path,
         kinematics: _Kinematics,
         base: Pose,
-        q: Sequence[float] | Mapping[str, float] | FloatArray | None,
-        joint_velocities: Sequence[float] | Mapping[str, float] | FloatArray | None,
+        q: FloatArray,
+        joint_velocities: FloatArray,
         field: str,
     ) -> None:
+        """Set the robot at a configuration whose arrays are already checked (one entry per joint)."""
         self.name = name
         self.urdf = urdf
         self.base = base
         self._kinematics = kinematics
         self._field = field
-        self.q = _per_joint(q, kinematics.joint_names, f"{field}.q")
-        self.joint_velocities = _per_joint(joint_velocities, kinematics.joint_names, f"{field}.joint_velocities")
+        q.setflags(write=False)  # shared by the robots at() gives, so nobody changes them behind the others' back
+        joint_velocities.setflags(write=False)
+        self.q = q
+        self.joint_velocities = joint_velocities
         self._placement = _place(kinematics, self.q, base)
         self._colliders: tuple[RobotCollider, ...] | None = None
         self._collider_placements: tuple[FloatArray, FloatArray] | None = None
@@ -232,17 +237,12 @@ class UrdfRobot:
         base: Pose | None = None,
     ) -> UrdfRobot:
         """The same robot at another configuration (what is not given is kept); the URDF is not parsed again."""
+        names, field = self.joint_names, self._field
+        angles = self.q if q is None else _per_joint(q, names, f"{field}.q")
+        velocities = self.joint_velocities if joint_velocities is None else _per_joint(joint_velocities, names, f"{field}.joint_velocities")
         robot = UrdfRobot.__new__(UrdfRobot)
         robot.torque_limits = self.torque_limits
-        robot._build(
-            self.name,
-            self.urdf,
-            self._kinematics,
-            self.base if base is None else base,
-            self.q if q is None else q,
-            self.joint_velocities if joint_velocities is None else joint_velocities,
-            self._field,
-        )
+        robot._build(self.name, self.urdf, self._kinematics, self.base if base is None else base, angles, velocities, field)
         return robot
 
     @property
@@ -333,7 +333,7 @@ def _place(kinematics: _Kinematics, angles: FloatArray, base: Pose) -> _Placemen
     pinocchio = _pinocchio()
     model, data = kinematics.model, kinematics.data
     pinocchio.computeJointJacobians(model, data, kinematics.configuration(angles))  # runs the forward kinematics too
-    joints = np.array([placement.homogeneous for placement in data.oMi])
+    joints = np.array([placement.homogeneous for placement in data.oMi.tolist()])  # a list iterates faster than Pinocchio's vector
     return _Placement(base.matrix() @ joints, np.array(data.J, dtype=float))
 
 
