@@ -80,6 +80,20 @@ def test_moved_contacts_carry_the_point_jacobian_of_their_link() -> None:
         np.testing.assert_allclose(contact.jacobian, hand.point_jacobian(link, contact.point), rtol=0, atol=1e-14)
 
 
+def test_moved_mover_poses_and_twists_reach_the_scene() -> None:
+    """A pusher moved along its twist and given a new one: detection and the Scene see both."""
+    from quasistatic.tools.bench.pipeline import resting_rows
+
+    world = resting_rows(1)  # one sphere of radius 0.02 on the table at the origin
+    pusher = qs.ShapedMover("pusher", qs.Sphere(0.01), qs.Pose((-0.1, 0.0, 0.02)), twist=[0.01, 0.0, 0.0, 0.0, 0.0, 0.0])
+    world = qs.World(bodies=world.bodies, movers=(*world.movers, pusher), detection=world.detection)
+    assert {c.other for c in world.detect().contacts} == {"table"}
+    touching = world.moved(mover_poses={"pusher": qs.Pose((-0.03, 0.0, 0.02))}, mover_twists={"pusher": [0.0, 0.02, 0.0, 0.0, 0.0, 0.0]})
+    assert {c.other for c in touching.detect().contacts} == {"table", "pusher"}
+    assert np.array_equal(touching.scene().mover("pusher").twist, [0.0, 0.02, 0.0, 0.0, 0.0, 0.0])
+    assert np.array_equal(world.scene().mover("pusher").twist, [0.01, 0.0, 0.0, 0.0, 0.0, 0.0])  # the original is unchanged
+
+
 def test_moved_keeps_the_parsed_robot_and_shapes() -> None:
     world, q = allegro_grasp()
     moved = world.moved({"cube": qs.Pose((0.0, 0.0, 1.0))}, {"hand": q})
@@ -99,6 +113,7 @@ def test_moved_keeps_the_parsed_robot_and_shapes() -> None:
         ({"robot_q": {"hand": {"joint_99": 0.1}}}, "robots.hand.q.joint_99"),
         ({"mover_poses": {"floor": qs.Pose()}}, "mover_poses.floor"),
         ({"joint_velocities": {"arm": [0.0]}}, "joint_velocities.arm"),
+        ({"mover_twists": {"floor": [0.0] * 6}}, "mover_twists.floor"),
     ],
 )
 def test_moved_names_a_bad_argument(arguments: dict[str, object], field: str) -> None:

@@ -147,6 +147,7 @@ class World:
         *,
         mover_poses: Mapping[str, Pose] | None = None,
         joint_velocities: Mapping[str, JointValues] | None = None,
+        mover_twists: Mapping[str, npt.ArrayLike] | None = None,
     ) -> World:
         """The same world with some parts elsewhere: a simulation's next step.
 
@@ -161,6 +162,8 @@ class World:
             New poses of movers (a pusher that has moved along its twist).
         joint_velocities : mapping robot name -> joint velocities, optional
             New joint velocities, in the forms of ``robot_q``.
+        mover_twists : mapping mover name -> twist, optional
+            New twists of movers ([v of the pose origin, w], world frame; checked when the Scene is built).
 
         Everything that does not depend on where the parts are is kept and shared with this world:
         the parsed robots, the shapes and their coal geometries, the detection layout, the margin, the
@@ -168,6 +171,9 @@ class World:
         """
         bodies = _moved_parts(self.bodies, body_poses, "body_poses")
         movers = _moved_parts(self.movers, mover_poses, "mover_poses")
+        if mover_twists:
+            _check_names(mover_twists, {m.name for m in movers}, "mover_twists", "mover")
+            movers = tuple(replace(m, twist=mover_twists[m.name]) if m.name in mover_twists else m for m in movers)
         robots = _moved_robots(self.robots, robot_q or {}, joint_velocities or {})
         world = object.__new__(World)
         world.__dict__.update(self.__dict__, bodies=bodies, movers=movers, robots=robots)  # the names are unchanged
@@ -299,24 +305,26 @@ def _moved_parts(parts: tuple[P, ...], poses: Mapping[str, Pose] | None, field: 
     """``parts`` with the poses named in ``poses`` replaced (an unknown name or a non-Pose is a SceneError)."""
     if not poses:
         return parts
-    known = {p.name for p in parts}
+    _check_names(poses, {p.name for p in parts}, field, "part")
     for name, pose in poses.items():
-        if name not in known:
-            raise SceneError(f"{field}.{name}", name, f"no such part; the known ones are {', '.join(sorted(known)) or 'none'}")
         if not isinstance(pose, Pose):
             raise SceneError(f"{field}.{name}", pose, "expected a Pose")
     return tuple(replace(p, pose=poses[p.name]) if p.name in poses else p for p in parts)
+
+
+def _check_names(given: Mapping[str, object], known: set[str], field: str, kind: str) -> None:
+    """Every name in ``given`` is one of ``known`` (else a SceneError naming ``field.name``)."""
+    for name in given:
+        if name not in known:
+            raise SceneError(f"{field}.{name}", name, f"no such {kind}; the known ones are {', '.join(sorted(known)) or 'none'}")
 
 
 def _moved_robots(
     robots: tuple[UrdfRobot, ...], positions: Mapping[str, JointValues], velocities: Mapping[str, JointValues]
 ) -> tuple[UrdfRobot, ...]:
     """Each robot at its new joint positions and velocities (what is not given is kept)."""
-    known = {r.name for r in robots}
     for argument, given in (("robot_q", positions), ("joint_velocities", velocities)):
-        for name in given:
-            if name not in known:
-                raise SceneError(f"{argument}.{name}", name, f"no such robot; the robots are {', '.join(sorted(known)) or 'none'}")
+        _check_names(given, {r.name for r in robots}, argument, "robot")
     return tuple(
         r.at(q=positions.get(r.name), joint_velocities=velocities.get(r.name)) if r.name in positions or r.name in velocities else r
         for r in robots
