@@ -19,7 +19,7 @@ Rules:
   field and the value.
 """
 
-from .detect import Collider, ContactPoint, candidate_pairs, detect
+from .detect import Collider, ContactPoint, Layout, candidate_pairs, detect
 from .robot import ROBOTS_INSTALL_HINT, UrdfRobot
 from .shapes import Box, Capsule, Convex, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere, shape_from_coal
 from .world import ContactDetection, Detection, FrictionPair, ShapedMover, SolidBody, StiffnessPair, World
@@ -38,6 +38,7 @@ __all__ = [
     "FrictionPair",
     "StiffnessPair",
     "Halfspace",
+    "Layout",
     "Mesh",
     "Pose",
     "Shape",

@@ -32,11 +32,11 @@ import numpy.typing as npt
 from ..errors import SceneError, SolverError
 from ..tolerances import CONTACT_SEPARATION, CURVED_PATCH_POINTS, DUPLICATE_POINT, NORMAL_LENGTH, PATCH_THICKNESS
 from ._coal import import_coal
-from .shapes import Box, Capsule, Convex, Cylinder, FloatArray, Halfspace, Mesh, Pose, Shape, Sphere, shape_from_coal
+from .shapes import Box, Capsule, Convex, Cylinder, FloatArray, Halfspace, IntArray, Mesh, Pose, Shape, Sphere, shape_from_coal
 
 BoolArray = npt.NDArray[np.bool_]
 
-__all__ = ["Collider", "ContactPoint", "candidate_pairs", "detect", "nearest_gaps"]
+__all__ = ["Collider", "ContactPoint", "Layout", "candidate_pairs", "detect", "nearest_gaps"]
 
 _ALL_PAIRS = 48  # up to this many colliders, testing every pair at once is cheaper than sorting them first
 
@@ -125,12 +125,20 @@ def candidate_pairs(colliders: Sequence[Collider], margin: float = 0.0) -> list[
     margin = _margin(margin)
     if len(colliders) < 2:
         return []
-    low, high = _all_bounds(colliders)
-    low, high = low - margin / 2.0, high + margin / 2.0
-    if len(colliders) <= _ALL_PAIRS:
-        meet = np.all((low[:, None] <= high[None]) & (low[None] <= high[:, None]), axis=2)
-        i, j = np.nonzero(np.triu(meet, 1))  # row by row: already in order
-        return list(zip(i.tolist(), j.tolist(), strict=True))
+    layout = Layout([c.owner for c in colliders], [c.shape for c in colliders])
+    i, j = _near_pairs(*layout.bounds(*_placements(colliders), margin))
+    return list(zip(i.tolist(), j.tolist(), strict=True))
+
+
+def _near_pairs(low: FloatArray, high: FloatArray) -> tuple[IntArray, IntArray]:
+    """Indices ``(i, j)``, ``i < j``, sorted, of the boxes ``[low, high]`` (n, 3) that meet: all at once or by a sweep."""
+    if len(low) <= _ALL_PAIRS:
+        starts_before_end = low.T[:, :, None] <= high.T[:, None, :]  # (axis, i, j): one contiguous plane per axis
+        meet = starts_before_end[0] & starts_before_end[1] & starts_before_end[2]
+        meet &= meet.T
+        i, j = np.nonzero(meet)  # row by row: already in order
+        upper = i < j
+        return i[upper].astype(np.int64), j[upper].astype(np.int64)
     axis = _sweep_axis(low, high)
     order = np.argsort(low[:, axis], kind="stable")
     # Rank r meets the ranks after it that start before it ends along the axis: r+1 .. stops[r]-1.
@@ -142,7 +150,7 @@ def candidate_pairs(colliders: Sequence[Collider], margin: float = 0.0) -> list[
     near = np.all((low[j] <= high[i]) & (low[i] <= high[j]), axis=1)
     lower, upper = np.minimum(i[near], j[near]), np.maximum(i[near], j[near])
     kept = np.lexsort((upper, lower))
-    return list(zip(lower[kept].tolist(), upper[kept].tolist(), strict=True))
+    return lower[kept], upper[kept]
 
 
 def _sweep_axis(low: FloatArray, high: FloatArray) -> int:
@@ -152,18 +160,6 @@ def _sweep_axis(low: FloatArray, high: FloatArray) -> int:
         return 0
     centres = (low[bounded] + high[bounded]) / 2.0
     return int(np.argmax(np.var(centres, axis=0)))
-
-
-def _all_bounds(colliders: Sequence[Collider]) -> tuple[FloatArray, FloatArray]:
-    """World axis-aligned bounding boxes (lower, upper corners, each (n, 3)) of the colliders [length]; a halfspace's is everything."""
-    rotations = np.array([c.pose.rotation for c in colliders])
-    boxes = np.array([c.shape.derived("box", _local_box) for c in colliders])  # (n, 2, 3): centre, half extents
-    centres = np.einsum("nij,nj->ni", rotations, boxes[:, 0]) + np.array([c.pose.position for c in colliders])
-    halves = np.einsum("nij,nj->ni", np.abs(rotations), boxes[:, 1])
-    low, high = centres - halves, centres + halves
-    unbounded = [isinstance(c.shape, Halfspace) for c in colliders]
-    low[unbounded], high[unbounded] = -math.inf, math.inf
-    return low, high
 
 
 def _local_box(shape: Shape) -> tuple[FloatArray, FloatArray]:
@@ -220,28 +216,118 @@ def detect(
         When coal is not installed.
     SolverError
         When coal returns no finite normal even for shapes moved apart.
+
+    See Also
+    --------
+    Layout : the same detection for colliders that keep their shapes while they move (a simulation's steps).
     """
-    query = _Query(import_coal(), _margin(margin), colliders)
-    found: list[ContactPoint] = []
-    for i, j in candidate_pairs(colliders, query.margin):
-        a, b = colliders[i], colliders[j]
-        if a.owner == b.owner or (pairs is not None and not pairs(a.owner, b.owner)):
-            continue
-        if isinstance(a.shape, Halfspace) and isinstance(b.shape, Halfspace):
-            continue  # two unbounded shapes: environment against environment, no contact polygon
-        found += _pair_contacts(query, i, j)
-    return sorted(found, key=lambda c: (c.first, c.second, tuple(c.point)))
+    layout = Layout([c.owner for c in colliders], [c.shape for c in colliders], pairs)
+    positions, rotations = _placements(colliders)
+    return layout.detect(positions, rotations, margin, colliders)
+
+
+class Layout:
+    """What contact detection keeps while the colliders move: their owners, shapes, coal geometries and bounding boxes.
+
+    :func:`detect` builds one per call. A simulation whose parts keep their shapes builds it once and
+    calls :meth:`detect` with each step's placements: nothing is converted or checked again, and whether two
+    colliders may touch is asked once per pair that comes near, not at every step.
+
+    Parameters
+    ----------
+    owners : sequence of str
+        Each collider's owner (a body, mover or robot link); colliders of one owner never touch.
+    shapes : sequence of Shape
+        Each collider's shape, in its own frame.
+    pairs : callable (owner, owner) -> bool, optional
+        Whether two owners may touch, as for :func:`detect`.
+    """
+
+    def __init__(self, owners: Sequence[str], shapes: Sequence[Shape], pairs: Callable[[str, str], bool] | None = None) -> None:
+        self.owners, self.shapes, self._pairs = tuple(owners), tuple(shapes), pairs
+        boxes = np.array([shape.derived("box", _local_box) for shape in self.shapes], dtype=float).reshape(-1, 2, 3)
+        self._box_centres, self._box_halves = boxes[:, 0], boxes[:, 1]
+        self._unbounded = np.array([isinstance(shape, Halfspace) for shape in self.shapes], dtype=bool)
+        self._asked: dict[tuple[int, int], bool] = {}  # (i, j) -> may they touch: the owners never change
+        size = len(self.owners) if len(self.owners) <= _ALL_PAIRS else 0
+        self._allowed = np.full((size, size), -1, dtype=np.int8)  # the same, as a matrix for small layouts: -1 not asked yet
+
+    def __len__(self) -> int:
+        return len(self.owners)
+
+    def bounds(self, positions: FloatArray, rotations: FloatArray, margin: float) -> tuple[FloatArray, FloatArray]:
+        """World axis-aligned boxes (lower, upper corners, each (n, 3)) grown by ``margin / 2``; a halfspace's is everything."""
+        centres = np.einsum("nij,nj->ni", rotations, self._box_centres) + positions
+        halves = np.einsum("nij,nj->ni", np.abs(rotations), self._box_halves) + margin / 2.0
+        low, high = centres - halves, centres + halves
+        low[self._unbounded], high[self._unbounded] = -math.inf, math.inf
+        return low, high
+
+    def pairs(self, positions: FloatArray, rotations: FloatArray, margin: float) -> list[tuple[int, int]]:
+        """The pairs ``(i, j)``, ``i < j``, sorted, that are near and may touch: what the narrow phase gets."""
+        i, j = _near_pairs(*self.bounds(positions, rotations, margin))
+        if len(self) > _ALL_PAIRS:  # a matrix of every pair would be too large: ask per pair
+            return [(a, b) for a, b in zip(i.tolist(), j.tolist(), strict=True) if self._may_touch(a, b)]
+        allowed = self._allowed[i, j]
+        for k in np.flatnonzero(allowed < 0):  # pairs never near before: ask once
+            allowed[k] = self._allowed[i[k], j[k]] = self._may_touch(int(i[k]), int(j[k]))
+        keep = allowed > 0
+        return list(zip(i[keep].tolist(), j[keep].tolist(), strict=True))
+
+    def detect(
+        self, positions: FloatArray, rotations: FloatArray, margin: float, colliders: Sequence[Collider] | None = None
+    ) -> list[ContactPoint]:
+        """Every contact point within ``margin``, the colliders at ``positions`` (n, 3) and ``rotations`` (n, 3, 3).
+
+        The placements are trusted (forward kinematics, validated poses): they are not checked again.
+        ``colliders``, when the caller has them, are the same shapes already placed; else they are made
+        for the colliders near something. See :func:`detect` for the result and errors.
+        """
+        query = _Query(import_coal(), _margin(margin), positions, rotations)
+        found: list[ContactPoint] = []
+        placed: dict[int, Collider] = {} if colliders is None else dict(enumerate(colliders))
+        for i, j in self.pairs(positions, rotations, query.margin):
+            for k in (i, j):
+                if k not in placed:
+                    placed[k] = _placed(self.owners[k], self.shapes[k], Pose.from_trusted_arrays(positions[k], rotations[k]))
+            found += _pair_contacts(query, placed[i], placed[j], i, j)
+        return sorted(found, key=lambda c: (c.first, c.second, tuple(c.point)))
+
+    def _may_touch(self, i: int, j: int) -> bool:
+        """Colliders of different owners, not both unbounded, that the caller lets touch: asked once per pair."""
+        known = self._asked.get((i, j))
+        if known is None:
+            a, b = self.owners[i], self.owners[j]
+            unbounded = self._unbounded[i] and self._unbounded[j]  # environment against environment
+            known = self._asked[i, j] = a != b and not unbounded and (self._pairs is None or self._pairs(a, b))
+        return known
+
+
+def _placements(colliders: Sequence[Collider]) -> tuple[FloatArray, FloatArray]:
+    """The colliders' positions (n, 3) and rotations (n, 3, 3)."""
+    positions = np.array([c.pose.position for c in colliders], dtype=float).reshape(-1, 3)
+    rotations = np.array([c.pose.rotation for c in colliders], dtype=float).reshape(-1, 3, 3)
+    return positions, rotations
+
+
+def _placed(owner: str, shape: Shape, pose: Pose) -> Collider:
+    """A Collider from parts this module already holds checked: no validation again."""
+    collider = object.__new__(Collider)
+    object.__setattr__(collider, "owner", owner)
+    object.__setattr__(collider, "shape", shape)
+    object.__setattr__(collider, "pose", pose)
+    return collider
 
 
 class _Query:
     """coal's objects for one detection: the request and result, reused by every pair, and each collider's transform.
 
     Building them costs more than coal's own query on two primitives, so they are made once per
-    :func:`detect`, not per pair.
+    detection, not per pair.
     """
 
-    def __init__(self, coal: Any, margin: float, colliders: Sequence[Collider]) -> None:
-        self.coal, self.margin, self.colliders = coal, margin, colliders
+    def __init__(self, coal: Any, margin: float, positions: FloatArray, rotations: FloatArray) -> None:
+        self.coal, self.margin, self._positions, self._rotations = coal, margin, positions, rotations
         self.request = _request(coal, margin)
         self.moved_request = _request(coal, margin)  # its margin is set per pair
         self.result = coal.CollisionResult()
@@ -249,7 +335,7 @@ class _Query:
 
     def transform(self, index: int) -> Any:
         if index not in self._placed:
-            self._placed[index] = _transform(self.coal, self.colliders[index].pose)
+            self._placed[index] = self.coal.Transform3s(self._rotations[index], self._positions[index])
         return self._placed[index]
 
 
@@ -292,10 +378,9 @@ def _margin(value: Any) -> float:
     return float(value)
 
 
-def _pair_contacts(query: _Query, i: int, j: int) -> list[ContactPoint]:
-    """The contact polygon of colliders ``i`` and ``j`` within the margin, as ContactPoints from ``j`` into ``i``."""
+def _pair_contacts(query: _Query, a: Collider, b: Collider, i: int, j: int) -> list[ContactPoint]:
+    """The contact polygon of colliders ``a`` (index ``i``) and ``b`` (``j``) within the margin, as ContactPoints from ``b`` into ``a``."""
     coal, margin = query.coal, query.margin
-    a, b = query.colliders[i], query.colliders[j]
     size = min(a.shape.extent, b.shape.extent)
     ga, gb = _geometry(coal, a.shape), _geometry(coal, b.shape)
     tb = query.transform(j)
@@ -305,17 +390,23 @@ def _pair_contacts(query: _Query, i: int, j: int) -> list[ContactPoint]:
     direction, gap = rough
     if direction is not None and _exact_normal(a, b, gap):
         return _one_point(query, a, b, direction, size)
-    if direction is None:
-        direction, gap = _least_overlap(a, b)
-    # Move a away from b until they are apart by CONTACT_SEPARATION * size: GJK then gives the exact normal.
-    shift = max(0.0, CONTACT_SEPARATION * size - gap)
-    moved = _transform(coal, a.pose, direction * shift)
-    result, request = query.result, query.moved_request
-    request.security_margin = margin + 2.0 * shift
-    result.clear()
-    coal.collide(ga, moved, gb, tb, request, result)
-    if not result.isCollision() or _unit(result.getContact(0).normal) is None:
-        raise SolverError("coal", f"no finite contact normal between {a.owner!r} and {b.owner!r}, even moved apart")
+    result = query.result
+    if direction is not None and (isinstance(a.shape, Halfspace) or isinstance(b.shape, Halfspace)):
+        # coal's test against a halfspace is analytic, not EPA: its normal is the halfspace's own, exact even
+        # for overlapping shapes, so its first answer gives the patch without moving the pair apart.
+        shift, moved = 0.0, query.transform(i)
+    else:
+        if direction is None:
+            direction, gap = _least_overlap(a, b)
+        # Move a away from b until they are apart by CONTACT_SEPARATION * size: GJK then gives the exact normal.
+        shift = max(0.0, CONTACT_SEPARATION * size - gap)
+        moved = _transform(coal, a.pose, direction * shift)
+        request = query.moved_request
+        request.security_margin = margin + 2.0 * shift
+        result.clear()
+        coal.collide(ga, moved, gb, tb, request, result)
+        if not result.isCollision() or _unit(result.getContact(0).normal) is None:
+            raise SolverError("coal", f"no finite contact normal between {a.owner!r} and {b.owner!r}, even moved apart")
     thickness = max(margin - gap, 0.0) + PATCH_THICKNESS * size
     patch_request = coal.ContactPatchRequest(1, CURVED_PATCH_POINTS, thickness)
     patches = coal.ContactPatchResult(patch_request)
@@ -362,36 +453,46 @@ def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margi
     both = in_a & in_b
     on_a[both], on_b[both] = mid[both] - enter[both, None] * to_b, mid[both] - leave[both, None] * to_b
     gaps = (on_b - on_a) @ to_b
-    within = (gaps <= margin + PATCH_THICKNESS * size) & np.all(np.isfinite(on_a + on_b), axis=1)
+    within = (gaps <= margin + PATCH_THICKNESS * size) & np.isfinite(on_a + on_b).all(axis=1)
     points, gaps = ((on_a + on_b) / 2.0)[within], gaps[within]
+    points.setflags(write=False)  # each contact's point is a (read-only) row of it
     normal = -to_b
     normal.setflags(write=False)
-    return [
-        ContactPoint(a.owner, b.owner, _frozen(points[k]), normal, float(gaps[k]))
-        for k in _polygon_vertices(points, DUPLICATE_POINT * size)
-    ]
+    return [ContactPoint(a.owner, b.owner, points[k], normal, float(gaps[k])) for k in _polygon_vertices(points, DUPLICATE_POINT * size)]
 
 
 def _polygon_vertices(points: FloatArray, tolerance: float) -> list[int]:
-    """Indices of the corners of a polygon given in order (k, 3): no duplicates, no points along an edge."""
-    if len(points) < 2:
-        return list(range(len(points)))
-    apart = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2) > tolerance
+    """Indices of the corners of a polygon given in order (k, 3): no duplicates, no points along an edge.
+
+    In plain floats: a patch has at most a few dozen points, where each numpy call costs more than the arithmetic.
+    """
+    rows = points.tolist()
+    limit = tolerance * tolerance
     kept: list[int] = []
-    for k in range(len(points)):
-        if all(apart[k, kept]):
+    for k, point in enumerate(rows):
+        if all(_squared_distance(point, rows[m]) > limit for m in kept):
             kept.append(k)
     while len(kept) > 2:  # drop one edge point at a time: a removal can make its neighbour an edge point too
-        ring = points[kept]
-        turn = np.arange(len(kept))
-        before, after = ring[turn - 1], ring[(turn + 1) % len(kept)]
-        along = after - before
-        t = np.clip(np.einsum("ij,ij->i", ring - before, along) / np.maximum(np.einsum("ij,ij->i", along, along), 1e-300), 0.0, 1.0)
-        on_edge = np.flatnonzero(np.linalg.norm(ring - (before + t[:, None] * along), axis=1) <= tolerance)
-        if not on_edge.size:
+        count = len(kept)
+        on_edge = (n for n in range(count) if _near_segment(rows[kept[n]], rows[kept[n - 1]], rows[kept[(n + 1) % count]], limit))
+        edge_point = next(on_edge, None)
+        if edge_point is None:
             break
-        del kept[int(on_edge[0])]
+        del kept[edge_point]
     return kept
+
+
+def _squared_distance(p: list[float], q: list[float]) -> float:
+    return (p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2
+
+
+def _near_segment(point: list[float], start: list[float], end: list[float], limit: float) -> bool:
+    """Whether ``point`` is within ``sqrt(limit)`` of the segment from ``start`` to ``end``."""
+    along = [end[0] - start[0], end[1] - start[1], end[2] - start[2]]
+    length = max(along[0] ** 2 + along[1] ** 2 + along[2] ** 2, 1e-300)
+    t = sum((point[i] - start[i]) * along[i] for i in range(3)) / length
+    t = min(max(t, 0.0), 1.0)
+    return _squared_distance(point, [start[i] + t * along[i] for i in range(3)]) <= limit
 
 
 # --------------------------------------------------------------------------- a shape along a line
@@ -447,12 +548,11 @@ def _in_planes(
     their bounds ``room / rate`` would be round-off divided by round-off, anything at all.
     """
     rate, room = normals @ u, offsets - q @ normals.T  # (m,), (k, m)
-    with np.errstate(divide="ignore", invalid="ignore"):  # 0 * inf for a halfspace, x / 0 for parallel planes: never read
-        parallel = (rate == 0.0) | (np.abs(rate) * length <= slack)
-        bound = room / rate
-    low = np.max(np.where(~parallel & (rate < 0.0), bound, -math.inf), axis=1, initial=-math.inf)
-    high = np.min(np.where(~parallel & (rate > 0.0), bound, math.inf), axis=1, initial=math.inf)
-    outside = np.any(parallel & (room < -slack), axis=1)  # along a plane, outside it
+    parallel = np.abs(rate) <= slack / length  # rate 0 included (length may be inf: a halfspace)
+    entering, leaving = (rate < 0.0) & ~parallel, (rate > 0.0) & ~parallel
+    low = (room[:, entering] / rate[entering]).max(axis=1, initial=-math.inf)
+    high = (room[:, leaving] / rate[leaving]).min(axis=1, initial=math.inf)
+    outside = (room[:, parallel] < -slack).any(axis=1)  # along a plane, outside it
     return low, high, ~outside & (low <= high + slack)
 
 
@@ -505,7 +605,7 @@ def _collide(query: _Query, ga: Any, ta: Any, gb: Any, tb: Any) -> tuple[FloatAr
 
 def _unit(vector: Any) -> FloatArray | None:
     """``vector`` as a float array if it is a finite unit vector (within :data:`NORMAL_LENGTH`), else None."""
-    x, y, z = (float(v) for v in vector)
+    x, y, z = np.asarray(vector, dtype=float).tolist()  # plain floats: three numpy scalars cost more than the test
     length = math.sqrt(x * x + y * y + z * z)  # NaN or inf stay so and fail the test below
     if not abs(length - 1.0) <= NORMAL_LENGTH:
         return None
@@ -593,6 +693,6 @@ def _support(collider: Collider, direction: FloatArray) -> float:
 
 
 def _frozen(array: FloatArray) -> FloatArray:
-    out = np.array(array, dtype=float)
-    out.setflags(write=False)
-    return out
+    """``array`` made read-only (not copied: the caller hands over an array it just computed)."""
+    array.setflags(write=False)
+    return array

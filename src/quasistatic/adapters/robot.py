@@ -30,9 +30,19 @@ from ..stdio import captured_stderr, first_lines
 from ..tolerances import MAX_MAGNITUDE
 from .shapes import Pose, Shape, shape_from_coal
 
-__all__ = ["UrdfRobot", "RobotCollider", "ROBOTS_INSTALL_HINT", "link_owner", "installed_model_folders", "resolve_package_path"]
+__all__ = [
+    "UrdfRobot",
+    "RobotCollider",
+    "JointValues",
+    "ROBOTS_INSTALL_HINT",
+    "link_owner",
+    "installed_model_folders",
+    "resolve_package_path",
+]
 
 FloatArray = npt.NDArray[np.float64]
+JointValues = Sequence[float] | Mapping[str, float] | FloatArray
+"""Joint positions or velocities: a list or array in model order, or a mapping by joint name (others at 0)."""
 
 ROBOTS_INSTALL_HINT = "install the robots extra: pip install 'quasistatic[robots]'"
 _PACKAGE = "package://"
@@ -191,7 +201,9 @@ class UrdfRobot:
         folders = [Path(d) for d in package_dirs] + installed_model_folders()
         path = resolve_package_path(str(urdf), folders, f"{field}.urdf")
         kinematics = _Kinematics(path, folders, f"{field}.urdf")
-        self._build(name, path, kinematics, base or Pose(), q, joint_velocities, field)
+        names = kinematics.joint_names
+        angles, velocities = _per_joint(q, names, f"{field}.q"), _per_joint(joint_velocities, names, f"{field}.joint_velocities")
+        self._build(name, path, kinematics, base or Pose(), angles, velocities, field)
         self.torque_limits = _limits(torque_limits, kinematics.joint_names, f"{field}.torque_limits")
 
     def _build(
@@ -200,19 +212,23 @@ class UrdfRobot:
         urdf: Path,
         kinematics: _Kinematics,
         base: Pose,
-        q: Sequence[float] | Mapping[str, float] | FloatArray | None,
-        joint_velocities: Sequence[float] | Mapping[str, float] | FloatArray | None,
+        q: FloatArray,
+        joint_velocities: FloatArray,
         field: str,
     ) -> None:
+        """Set the robot at a configuration whose arrays are already checked (one entry per joint)."""
         self.name = name
         self.urdf = urdf
         self.base = base
         self._kinematics = kinematics
         self._field = field
-        self.q = _per_joint(q, kinematics.joint_names, f"{field}.q")
-        self.joint_velocities = _per_joint(joint_velocities, kinematics.joint_names, f"{field}.joint_velocities")
+        q.setflags(write=False)  # shared by the robots at() gives, so nobody changes them behind the others' back
+        joint_velocities.setflags(write=False)
+        self.q = q
+        self.joint_velocities = joint_velocities
         self._placement = _place(kinematics, self.q, base)
         self._colliders: tuple[RobotCollider, ...] | None = None
+        self._collider_placements: tuple[FloatArray, FloatArray] | None = None
 
     def at(
         self,
@@ -221,17 +237,12 @@ class UrdfRobot:
         base: Pose | None = None,
     ) -> UrdfRobot:
         """The same robot at another configuration (what is not given is kept); the URDF is not parsed again."""
+        names, field = self.joint_names, self._field
+        angles = self.q if q is None else _per_joint(q, names, f"{field}.q")
+        velocities = self.joint_velocities if joint_velocities is None else _per_joint(joint_velocities, names, f"{field}.joint_velocities")
         robot = UrdfRobot.__new__(UrdfRobot)
         robot.torque_limits = self.torque_limits
-        robot._build(
-            self.name,
-            self.urdf,
-            self._kinematics,
-            self.base if base is None else base,
-            self.q if q is None else q,
-            self.joint_velocities if joint_velocities is None else joint_velocities,
-            self._field,
-        )
+        robot._build(self.name, self.urdf, self._kinematics, self.base if base is None else base, angles, velocities, field)
         return robot
 
     @property
@@ -249,12 +260,38 @@ class UrdfRobot:
         """The collision geometries of every link, placed in the world (built on first use)."""
         if self._colliders is None:
             kinematics = self._kinematics
-            placed = self._placement.joints[kinematics.geometry_joint] @ kinematics.geometry_in_joint
+            positions, rotations = self.collider_placements()
             self._colliders = tuple(
-                RobotCollider(link_owner(self.name, link), link, shape, _pose(matrix))
-                for link, shape, matrix in zip(kinematics.geometry_link, kinematics.shapes, placed, strict=True)
+                RobotCollider(owner, link, shape, Pose.from_trusted_arrays(position, rotation))
+                for owner, link, shape, position, rotation in zip(
+                    self.collider_owners, kinematics.geometry_link, kinematics.shapes, positions, rotations, strict=True
+                )
             )
         return self._colliders
+
+    @property
+    def collider_owners(self) -> tuple[str, ...]:
+        """Each collision geometry's link as a mover (``hand/link``), in the order of :attr:`collider_shapes`."""
+        return tuple(link_owner(self.name, link) for link in self._kinematics.geometry_link)
+
+    @property
+    def collider_shapes(self) -> tuple[Shape, ...]:
+        """Each collision geometry's shape in its own frame: the same objects at every configuration."""
+        return self._kinematics.shapes
+
+    def collider_placements(self) -> tuple[FloatArray, FloatArray]:
+        """World positions (g, 3) and rotations (g, 3, 3) of the collision geometries, in one batch (read-only).
+
+        What detection needs at each configuration, without a Pose per geometry.
+        """
+        if self._collider_placements is None:
+            kinematics = self._kinematics
+            placed = self._placement.joints[kinematics.geometry_joint] @ kinematics.geometry_in_joint
+            positions, rotations = placed[:, :3, 3].copy(), placed[:, :3, :3].copy()
+            positions.setflags(write=False)
+            rotations.setflags(write=False)
+            self._collider_placements = positions, rotations
+        return self._collider_placements
 
     def link_pose(self, link: str) -> Pose:
         """World pose of a link's frame."""
@@ -263,12 +300,26 @@ class UrdfRobot:
 
     def point_jacobian(self, link: str, point: npt.ArrayLike) -> FloatArray:
         """World velocity of the material point of ``link`` at world ``point``, per unit joint velocity: (3, joints)."""
-        joint, _ = self._kinematics.link_in_joint[self._link(link)]
-        jacobian = self._placement.jacobian * self._kinematics.chain_columns[joint]
-        local = (np.asarray(point, dtype=float) - self.base.position) @ self.base.rotation  # in the model's root frame
-        # v(p) = v(origin) + w x p: the linear rows minus p x (angular rows), then turned into the world.
-        in_model = jacobian[:3] - _cross_matrix(local) @ jacobian[3:]
-        result: FloatArray = self.base.rotation @ in_model
+        return self.point_jacobians([link], np.asarray(point, dtype=float).reshape(1, 3))[0]
+
+    def point_jacobians(self, links: Sequence[str], points: npt.ArrayLike) -> FloatArray:
+        """:meth:`point_jacobian` of ``links[k]`` at ``points[k]`` (k, 3), in one batch: (k, 3, joints).
+
+        The joint Jacobians of the configuration, shifted to each point (``v(p) = v(origin) + w x p``) and
+        kept to the columns of the joints that move its link.
+        """
+        kinematics = self._kinematics
+        chains = kinematics.chain_columns[[kinematics.link_in_joint[self._link(link)][0] for link in links]]  # (k, joints)
+        jacobian = self._placement.jacobian
+        local = (np.asarray(points, dtype=float).reshape(-1, 3) - self.base.position) @ self.base.rotation  # model root frame
+        # The linear rows minus p x (angular rows), per point (np.cross costs more than writing it out).
+        x, y, z = local[:, 0, None], local[:, 1, None], local[:, 2, None]
+        wx, wy, wz = jacobian[3], jacobian[4], jacobian[5]
+        shifted = np.empty((len(local), 3, jacobian.shape[1]))
+        shifted[:, 0], shifted[:, 1], shifted[:, 2] = y * wz - z * wy, z * wx - x * wz, x * wy - y * wx
+        np.subtract(jacobian[:3], shifted, out=shifted)
+        shifted *= chains[:, None, :]
+        result: FloatArray = self.base.rotation @ shifted  # into the world
         return result
 
     def _link(self, link: str) -> str:
@@ -282,7 +333,7 @@ def _place(kinematics: _Kinematics, angles: FloatArray, base: Pose) -> _Placemen
     pinocchio = _pinocchio()
     model, data = kinematics.model, kinematics.data
     pinocchio.computeJointJacobians(model, data, kinematics.configuration(angles))  # runs the forward kinematics too
-    joints = np.array([placement.homogeneous for placement in data.oMi])
+    joints = np.array([placement.homogeneous for placement in data.oMi.tolist()])  # a list iterates faster than Pinocchio's vector
     return _Placement(base.matrix() @ joints, np.array(data.J, dtype=float))
 
 
@@ -327,11 +378,6 @@ def _limits(values: Any, names: tuple[str, ...], field: str) -> FloatArray | Non
         missing = ", ".join(n for n in names if n not in values)
         raise SceneError(field, dict(values), f"name every joint (missing: {missing})")
     return _per_joint(values, names, field)
-
-
-def _cross_matrix(vector: FloatArray) -> FloatArray:
-    x, y, z = vector
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
 def _pinocchio() -> Any:

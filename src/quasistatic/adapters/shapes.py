@@ -218,7 +218,7 @@ class Box(_Derived):
     @property
     def extent(self) -> float:
         """Largest dimension [length]: the scale of the tolerances of its contacts."""
-        return float(np.max(self.size))
+        return max(self.size.tolist())  # plain floats: detection asks for it per pair
 
 
 @dataclass(frozen=True, init=False)
@@ -331,8 +331,8 @@ class Convex(_Derived):
 
     @property
     def extent(self) -> float:
-        """Largest edge of its bounding box [length]."""
-        return float(np.max(np.ptp(self.vertices, axis=0)))
+        """Largest edge of its bounding box [length] (computed once: detection asks for it per pair)."""
+        return self.derived("extent", lambda convex: float(np.max(np.ptp(convex.vertices, axis=0))))
 
 
 def _hull(value: Any, path: str) -> tuple[FloatArray, IntArray]:

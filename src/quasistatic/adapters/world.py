@@ -14,9 +14,9 @@ the body frame is the world frame, as in an explicit scene.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, field
-from typing import TypeVar
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any, TypeVar, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -24,13 +24,15 @@ import numpy.typing as npt
 from ..errors import SceneError
 from ..model import Body, Contact, FrictionModel, Mover, Robot, Scene, Stiffness
 from ..tolerances import DETECTION_MARGIN
-from .detect import Collider, ContactPoint, detect, nearest_gaps
-from .robot import UrdfRobot, link_owner
+from .detect import Collider, ContactPoint, Layout, nearest_gaps
+from .robot import JointValues, UrdfRobot, link_owner
 from .shapes import Pose, Shape
 
 __all__ = ["SolidBody", "ShapedMover", "FrictionPair", "ContactDetection", "Detection", "World"]
 
 FloatArray = npt.NDArray[np.float64]
+T = TypeVar("T")
+P = TypeVar("P", "SolidBody", "ShapedMover")
 
 
 @dataclass(frozen=True)
@@ -117,7 +119,12 @@ class Detection:
 
 @dataclass(frozen=True)
 class World:
-    """Shapes, robots and explicit contacts: a scene before its contacts are found."""
+    """Shapes, robots and explicit contacts: a scene before its contacts are found.
+
+    :meth:`moved` gives the same world with bodies, movers and robots elsewhere, keeping everything
+    that does not depend on where they are (parsed URDFs, shapes, coal geometries, the detection
+    layout): what a simulation calls at every step.
+    """
 
     bodies: tuple[SolidBody, ...]
     movers: tuple[ShapedMover, ...] = ()
@@ -129,6 +136,7 @@ class World:
     friction: FrictionModel | str = "exact"
     stiffness: Stiffness | None = None  # the Scene's default: every contact without a stiffness of its own
     closing_time: float | None = None  # the Scene's: how long the movers advance against the springs
+    _fixed: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         parts: list[SolidBody | ShapedMover] = [*self.bodies, *self.movers]
@@ -143,22 +151,61 @@ class World:
                     field = f"contact_detection.{key}[{index}].between"
                     raise SceneError(field, name, "names no body, mover, robot or robot link (robot/link) of the scene")
 
+    def __getstate__(self) -> dict[str, Any]:
+        # The kept layout holds coal objects: rebuilt where it is needed, not pickled.
+        return {key: value for key, value in self.__dict__.items() if key != "_fixed"}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state, _fixed={})
+
+    def moved(
+        self,
+        body_poses: Mapping[str, Pose] | None = None,
+        robot_q: Mapping[str, JointValues] | None = None,
+        *,
+        mover_poses: Mapping[str, Pose] | None = None,
+        joint_velocities: Mapping[str, JointValues] | None = None,
+        mover_twists: Mapping[str, npt.ArrayLike] | None = None,
+    ) -> World:
+        """The same world with some parts elsewhere: a simulation's next step.
+
+        Parameters
+        ----------
+        body_poses : mapping body name -> Pose, optional
+            New poses of free bodies (the others stay).
+        robot_q : mapping robot name -> joint positions, optional
+            New joint positions (a list or array in model order, or a mapping by joint name), through
+            :meth:`UrdfRobot.at`: the URDF is not parsed again.
+        mover_poses : mapping mover name -> Pose, optional
+            New poses of movers (a pusher that has moved along its twist).
+        joint_velocities : mapping robot name -> joint velocities, optional
+            New joint velocities, in the forms of ``robot_q``.
+        mover_twists : mapping mover name -> twist, optional
+            New twists of movers ([v of the pose origin, w], world frame; checked when the Scene is built).
+
+        Everything that does not depend on where the parts are is kept and shared with this world:
+        the parsed robots, the shapes and their coal geometries, the detection layout, the margin, the
+        friction of each pair. Names are checked; poses must be :class:`Pose` values (validated when built).
+        """
+        bodies = _moved_parts(self.bodies, body_poses, "body_poses")
+        movers = _moved_parts(self.movers, mover_poses, "mover_poses")
+        if mover_twists:
+            _check_names(mover_twists, {m.name for m in movers}, "mover_twists", "mover")
+            movers = tuple(replace(m, twist=mover_twists[m.name]) if m.name in mover_twists else m for m in movers)
+        robots = _moved_robots(self.robots, robot_q or {}, joint_velocities or {})
+        world = object.__new__(World)
+        world.__dict__.update(self.__dict__, bodies=bodies, movers=movers, robots=robots)  # the names are unchanged
+        return world
+
     def detect(self) -> Detection:
         """The contacts within the margin, as solver contacts (normals into the free body, Jacobians for robot links)."""
-        colliders = self._colliders()
-        margin = self._margin()
-        free = frozenset(b.name for b in self.bodies)
-
-        def may_touch(first: str, second: str) -> bool:
-            """Only pairs with a free body constrain its motion; two links of one robot, or two movers, never do."""
-            return first in free or second in free
-
-        points = detect(colliders, may_touch, margin)
-        links = self._robot_links()
-        contacts = tuple(self._contact(point, free, links) for point in points)
+        layout, margin = self._layout(), self._margin()
+        positions, rotations = self._placements()
+        points = layout.detect(positions, rotations, margin)
+        contacts = self._contacts(points)
         touched = {c.body for c in contacts} | {c.other for c in contacts} | {c.body for c in self.contacts}
         lonely = [b.name for b in self.bodies if b.name not in touched and b.shape is not None]
-        isolated = nearest_gaps(colliders, lonely, may_touch) if lonely else {}
+        isolated = nearest_gaps(self._colliders(), lonely, self._may_touch) if lonely else {}
         return Detection(contacts, tuple(p.gap for p in points), margin, isolated)
 
     def scene(self, detection: Detection | None = None) -> Scene:
@@ -191,13 +238,46 @@ class World:
 
     # ----------------------------------------------------------------- parts
 
+    def _kept(self, key: str, build: Callable[[], T]) -> T:
+        """``build()`` once for this world and every world :meth:`moved` gives from it (it must not depend on poses)."""
+        if key not in self._fixed:
+            self._fixed[key] = build()
+        return cast(T, self._fixed[key])
+
     def _robot_links(self) -> dict[str, tuple[UrdfRobot, str]]:
-        """Each robot link's name as a mover (``hand/link``): its robot and link."""
+        """Each robot link's name as a mover (``hand/link``): its robot and link (this world's robots, at this configuration)."""
         return {link_owner(r.name, link): (r, link) for r in self.robots for link in r.link_names}
 
-    def _colliders(self) -> list[Collider]:
+    def _shaped(self) -> list[SolidBody | ShapedMover]:
         parts: list[SolidBody | ShapedMover] = [*self.bodies, *self.movers]
-        shaped = [Collider(p.name, p.shape, p.pose) for p in parts if p.shape is not None]
+        return [p for p in parts if p.shape is not None]
+
+    def _layout(self) -> Layout:
+        """The colliders' owners and shapes (shaped bodies, shaped movers, then each robot's geometries)."""
+
+        def build() -> Layout:
+            shaped = self._shaped()
+            owners = [p.name for p in shaped] + [owner for r in self.robots for owner in r.collider_owners]
+            shapes = [cast(Shape, p.shape) for p in shaped] + [shape for r in self.robots for shape in r.collider_shapes]
+            return Layout(owners, shapes, self._may_touch)
+
+        return self._kept("layout", build)
+
+    def _may_touch(self, first: str, second: str) -> bool:
+        """Only pairs with a free body constrain its motion; two links of one robot, or two movers, never do."""
+        free = self._kept("free", lambda: frozenset(b.name for b in self.bodies))
+        return first in free or second in free
+
+    def _placements(self) -> tuple[FloatArray, FloatArray]:
+        """Every collider's world position (n, 3) and rotation (n, 3, 3), in the layout's order."""
+        poses = [p.pose for p in self._shaped()]
+        robots = [r.collider_placements() for r in self.robots]
+        positions = np.concatenate([np.array([p.position for p in poses]).reshape(-1, 3)] + [r[0] for r in robots])
+        rotations = np.concatenate([np.array([p.rotation for p in poses]).reshape(-1, 3, 3)] + [r[1] for r in robots])
+        return positions, rotations
+
+    def _colliders(self) -> list[Collider]:
+        shaped = [Collider(p.name, p.shape, p.pose) for p in self._shaped()]
         return shaped + [Collider(c.owner, c.shape, c.pose) for r in self.robots for c in r.colliders]
 
     def _margin(self) -> float:
@@ -205,27 +285,54 @@ class World:
             return self.detection.margin
         return DETECTION_MARGIN * self.size
 
-    def _contact(self, point: ContactPoint, free: frozenset[str], links: dict[str, tuple[UrdfRobot, str]]) -> Contact:
-        """A solver contact: the free body first, its normal into it; a robot link's Jacobian at the point."""
-        body, other, normal = point.first, point.second, point.normal
-        if body not in free:
-            body, other, normal = other, body, -normal
-        robot_link = links.get(other)
-        jacobian = None if robot_link is None else robot_link[0].point_jacobian(robot_link[1], point.point)
-        # A friction pair may name a robot link's whole robot.
-        others = {other} if robot_link is None else {other, robot_link[0].name}
-        stiffness = self._stiffness(body, others)
-        return Contact(body, other, point.point, normal, mu=self._mu(body, others), jacobian=jacobian, stiffness=stiffness)
+    def _contacts(self, points: Sequence[ContactPoint]) -> tuple[Contact, ...]:
+        """Solver contacts: the free body first, its normal into it; a robot link's Jacobian at each of its points."""
+        free = self._kept("free", lambda: frozenset(b.name for b in self.bodies))
+        oriented = [(p.first, p.second, p.normal) if p.first in free else (p.second, p.first, -p.normal) for p in points]
+        jacobians = self._jacobians([other for _, other, _ in oriented], [p.point for p in points])
+        return tuple(
+            Contact.from_trusted_arrays(body, other, point.point, normal, self._mu(body, other), jacobian, self._stiffness(body, other))
+            for (body, other, normal), point, jacobian in zip(oriented, points, jacobians, strict=True)
+        )
 
-    def _mu(self, body: str, others: set[str]) -> float:
-        """The first friction pair naming ``body`` and one of ``others``, else the default."""
-        pair = _first_pair(self.detection.pairs, body, others)
-        return self.detection.mu if pair is None else pair.mu
+    def _link_index(self) -> dict[str, tuple[int, str]]:
+        """Each robot link's name as a mover (``hand/link``): the index of its robot, and the link."""
+        return self._kept(
+            "links", lambda: {link_owner(r.name, link): (k, link) for k, r in enumerate(self.robots) for link in r.link_names}
+        )
 
-    def _stiffness(self, body: str, others: set[str]) -> Stiffness | None:
-        """The first stiffness pair naming ``body`` and one of ``others``, else the detection's default."""
-        pair = _first_pair(self.detection.stiffness_pairs, body, others)
-        return self.detection.stiffness if pair is None else pair.stiffness
+    def _jacobians(self, others: list[str], points: list[FloatArray]) -> list[FloatArray | None]:
+        """The point Jacobian of each contact with a robot link (one batch per robot), None for the others."""
+        links = self._link_index()
+        result: list[FloatArray | None] = [None] * len(others)
+        for index, robot in enumerate(self.robots):
+            where = [k for k, other in enumerate(others) if other in links and links[other][0] == index]
+            if where:
+                batch = robot.point_jacobians([links[others[k]][1] for k in where], np.array([points[k] for k in where]))
+                for k, jacobian in zip(where, batch, strict=True):
+                    result[k] = jacobian
+        return result
+
+    def _others(self, other: str) -> set[str]:
+        """``other``, and for a robot link its whole robot too: a friction or stiffness pair may name either."""
+        robot_link = self._link_index().get(other)
+        return {other} if robot_link is None else {other, self.robots[robot_link[0]].name}
+
+    def _mu(self, body: str, other: str) -> float:
+        """The first friction pair naming ``body`` and ``other`` (or a robot link's whole robot), else the default."""
+        table: dict[tuple[str, str], float] = self._kept("mu", dict)
+        if (body, other) not in table:
+            pair = _first_pair(self.detection.pairs, body, self._others(other))
+            table[body, other] = self.detection.mu if pair is None else pair.mu
+        return table[body, other]
+
+    def _stiffness(self, body: str, other: str) -> Stiffness | None:
+        """The first stiffness pair naming ``body`` and ``other`` (or a robot link's whole robot), else the detection's default."""
+        table: dict[tuple[str, str], Stiffness | None] = self._kept("stiffness", dict)
+        if (body, other) not in table:
+            pair = _first_pair(self.detection.stiffness_pairs, body, self._others(other))
+            table[body, other] = self.detection.stiffness if pair is None else pair.stiffness
+        return table[body, other]
 
 
 _Pair = TypeVar("_Pair", FrictionPair, StiffnessPair)
@@ -237,6 +344,36 @@ def _first_pair(pairs: tuple[_Pair, ...], body: str, others: set[str]) -> _Pair 
         if (a == body and b in others) or (b == body and a in others):
             return pair
     return None
+
+
+def _moved_parts(parts: tuple[P, ...], poses: Mapping[str, Pose] | None, field: str) -> tuple[P, ...]:
+    """``parts`` with the poses named in ``poses`` replaced (an unknown name or a non-Pose is a SceneError)."""
+    if not poses:
+        return parts
+    _check_names(poses, {p.name for p in parts}, field, "part")
+    for name, pose in poses.items():
+        if not isinstance(pose, Pose):
+            raise SceneError(f"{field}.{name}", pose, "expected a Pose")
+    return tuple(replace(p, pose=poses[p.name]) if p.name in poses else p for p in parts)
+
+
+def _check_names(given: Mapping[str, object], known: set[str], field: str, kind: str) -> None:
+    """Every name in ``given`` is one of ``known`` (else a SceneError naming ``field.name``)."""
+    for name in given:
+        if name not in known:
+            raise SceneError(f"{field}.{name}", name, f"no such {kind}; the known ones are {', '.join(sorted(known)) or 'none'}")
+
+
+def _moved_robots(
+    robots: tuple[UrdfRobot, ...], positions: Mapping[str, JointValues], velocities: Mapping[str, JointValues]
+) -> tuple[UrdfRobot, ...]:
+    """Each robot at its new joint positions and velocities (what is not given is kept)."""
+    for argument, given in (("robot_q", positions), ("joint_velocities", velocities)):
+        _check_names(given, {r.name for r in robots}, argument, "robot")
+    return tuple(
+        r.at(q=positions.get(r.name), joint_velocities=velocities.get(r.name)) if r.name in positions or r.name in velocities else r
+        for r in robots
+    )
 
 
 def _robot(robot: UrdfRobot) -> Robot:

@@ -328,6 +328,29 @@ class Contact:
             stiffness=stiffness,
         )
 
+    @classmethod
+    def from_trusted_arrays(
+        cls,
+        body: str,
+        other: str,
+        point: FloatArray,
+        normal: FloatArray,
+        mu: float,
+        jacobian: FloatArray | None = None,
+        stiffness: Stiffness | None = None,
+    ) -> Contact:
+        """A contact from values this package computed from validated ones (contact detection, point Jacobians).
+
+        For inner loops (a simulation finds its contacts at every step): the names, numbers and arrays are
+        not checked again here; the :class:`Scene` they go into still checks the whole. The arrays are made
+        read-only, not copied: the caller hands them over.
+        """
+        contact = cls.__new__(cls)
+        for array in (point, normal) if jacobian is None else (point, normal, jacobian):
+            array.setflags(write=False)
+        _assign(contact, body=body, other=other, point=point, normal=normal, mu=float(mu), jacobian=jacobian, stiffness=stiffness)
+        return contact
+
 
 @dataclass(frozen=True, init=False)
 class Scene:
