@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from types import MappingProxyType
 from typing import TypeAlias
 
@@ -50,13 +50,8 @@ class State:
         )
 
     def applied(self, world: World) -> World:
-        """``world`` at this state: the same shapes and models, placed here."""
-        return replace(
-            world,
-            bodies=tuple(replace(b, pose=self.bodies[b.name]) for b in world.bodies),
-            movers=tuple(replace(m, pose=self.movers[m.name]) for m in world.movers),
-            robots=tuple(r.at(q=self.robots[r.name]) for r in world.robots),
-        )
+        """``world`` at this state: the same shapes and parsed models (and detection layout), placed here."""
+        return world.moved(self.bodies, self.robots, mover_poses=self.movers)
 
 
 @dataclass(frozen=True)
@@ -103,13 +98,7 @@ class Inputs:
 
     def applied(self, world: World) -> World:
         """``world`` with these velocities; what is not named keeps the scene's."""
-        return replace(
-            world,
-            movers=tuple(replace(m, twist=self.mover_twists.get(m.name, m.twist)) for m in world.movers),
-            robots=tuple(
-                r.at(joint_velocities=self.joint_velocities[r.name]) if r.name in self.joint_velocities else r for r in world.robots
-            ),
-        )
+        return world.moved(joint_velocities=self.joint_velocities, mover_twists=self.mover_twists)
 
 
 @dataclass(frozen=True)

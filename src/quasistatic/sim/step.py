@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -62,6 +63,17 @@ class SimModel:
     world: World
     options: StepOptions = field(default_factory=StepOptions)
 
+    @cached_property
+    def margin(self) -> float:
+        """Gaps up to this count as contacts [length] (the World's own margin)."""
+        return self.world.contact_margin
+
+    @cached_property
+    def detecting(self) -> World:
+        """The World searching the look-ahead band too: built once, so every step reuses its detection layout."""
+        band = self.margin + SIM_LOOKAHEAD * self.world.size
+        return replace(self.world, detection=replace(self.world.detection, margin=band))
+
     def __post_init__(self) -> None:
         if self.world.contacts or self.world.explicit_robots:
             raise SceneError(
@@ -90,7 +102,8 @@ class Evaluation:
 
     state: State  # after any penetration was corrected
     inputs: Inputs
-    world: World
+    world: World  # at this state, detecting over the look-ahead band
+    margin: float  # the contact margin [length]
     detection: Detection
     near: tuple[tuple[Contact, float], ...]  # surfaces within the look-ahead band, not yet touching, and their gaps
     solution: Solution
@@ -181,11 +194,10 @@ class Event:
 def evaluate(model: SimModel, state: State, inputs: Inputs) -> Evaluation:
     """Contacts found at ``state`` (penetration corrected first), the certified answer, and the motion to follow."""
     inputs.check(model.world)
-    world = inputs.applied(state.applied(model.world))
-    margin = world.contact_margin
-    band = margin + SIM_LOOKAHEAD * world.size
-    found = _lookahead(world, band).detect()
-    state, world, found, penetration = _corrected(model, state, inputs, world, found, band, margin)
+    world = inputs.applied(state.applied(model.detecting))
+    margin = model.margin
+    found = world.detect()
+    state, world, found, penetration = _corrected(model, state, inputs, world, found)
     touching = [i for i, g in enumerate(found.gaps) if g <= margin]
     near = tuple((found.contacts[i], found.gaps[i]) for i, g in enumerate(found.gaps) if g > margin)
     detection = Detection(
@@ -194,11 +206,7 @@ def evaluate(model: SimModel, state: State, inputs: Inputs) -> Evaluation:
     options = model.options
     solution = solve(world.scene(detection), options.method, certify=options.certify, time_limit=options.time_limit)
     motion, choice = _chosen(solution, options.ambiguous)
-    return Evaluation(state, inputs, world, detection, near, solution, motion, choice, penetration)
-
-
-def _lookahead(world: World, band: float) -> World:
-    return replace(world, detection=replace(world.detection, margin=band))
+    return Evaluation(state, inputs, world, margin, detection, near, solution, motion, choice, penetration)
 
 
 def _isolated(world: World, found: Detection, touching: list[int]) -> Mapping[str, tuple[str, float]]:
@@ -225,19 +233,17 @@ def _chosen(solution: Solution, policy: AmbiguityPolicy) -> tuple[Motion | None,
 # --------------------------------------------------------------------------- penetration
 
 
-def _corrected(
-    model: SimModel, state: State, inputs: Inputs, world: World, found: Detection, band: float, margin: float
-) -> tuple[State, World, Detection, float]:
+def _corrected(model: SimModel, state: State, inputs: Inputs, world: World, found: Detection) -> tuple[State, World, Detection, float]:
     """Move the free bodies out of any penetration deeper than the tolerance, by the least motion (twice at most)."""
     depth = max((-g for g in found.gaps), default=0.0)
     first_depth = max(depth, 0.0)
     for _ in range(2):
-        deep = [(c, g) for c, g in zip(found.contacts, found.gaps, strict=True) if g < -SIM_PENETRATION * margin]
+        deep = [(c, g) for c, g in zip(found.contacts, found.gaps, strict=True) if g < -SIM_PENETRATION * model.margin]
         if not deep:
             break
         state = _pushed_out(state, world, deep)
-        world = inputs.applied(state.applied(model.world))
-        found = _lookahead(world, band).detect()
+        world = inputs.applied(state.applied(model.detecting))
+        found = world.detect()
     return state, world, found, first_depth
 
 
@@ -304,7 +310,7 @@ def safe_step(evaluation: Evaluation, h: float) -> float:
     speed = _fastest_point(evaluation)
     if speed > 0:
         h = min(h, band / speed)
-    margin = world.contact_margin
+    margin = evaluation.margin
     for contact, gap in evaluation.near:
         closing = -float(contact.normal @ (_velocity(evaluation, contact.body, contact) - _velocity(evaluation, contact.other, contact)))
         if closing > 0:
