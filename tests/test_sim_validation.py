@@ -18,7 +18,7 @@ from quasistatic.sim import Evaluation, Inputs, SimModel, State, StepOptions, ev
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "sim"
 GRAVITY = 9.81
-PUSH = (0.01 / math.sqrt(2), 0.01 / math.sqrt(2))  # the examples push along (1, 1)/sqrt 2 at 1 cm/s, see their headers
+PUSH = (0.01 / math.sqrt(2), 0.01 / math.sqrt(2))  # push_puck_centre.yaml pushes along (1, 1)/sqrt 2 at 1 cm/s
 
 
 def _evaluation(name: str) -> Evaluation:
@@ -66,10 +66,38 @@ def test_centre_push_translates_with_the_pusher() -> None:
 
 @pytest.mark.slow
 def test_centre_push_run_keeps_the_puck_with_the_pusher() -> None:
-    trajectory = simulate(EXAMPLES / "push_puck_centre.yaml", duration=0.5, dt=0.25, ambiguous="min_power")
+    trajectory = simulate(EXAMPLES / "push_puck_centre.yaml", duration=0.5, dt=0.25)  # every step solved: no choice made
     assert trajectory.status == "completed" and trajectory.certified
     np.testing.assert_allclose(trajectory.positions("puck")[-1], [*(0.5 * np.array(PUSH)), 0.01], atol=1e-6)
     assert abs(_yaw(trajectory.rotations("puck")[-1])) < 1e-9
+
+
+ALIGN_PUSH = (0.01 * math.cos(math.radians(11.25)), 0.01 * math.sin(math.radians(11.25)))  # push_align.yaml's pusher
+ALIGN_FRAME = 11.25  # the pusher's direction on the table [deg]
+
+
+@pytest.mark.slow
+def test_misaligned_box_starts_turning_toward_the_flat_pusher() -> None:
+    """Only the upper fingertip touches; every certified motion turns the box's face toward the pusher (yaw down)."""
+    evaluation = _evaluation("push_align.yaml")
+    assert {c.other for c in evaluation.detection.contacts} == {"table", "upper"}
+    motions = evaluation.solution.solutions or (evaluation.solution.motion,)
+    assert all(m.twists["box"][5] < 0 for m in motions)
+
+
+@pytest.mark.slow
+def test_flat_pusher_aligns_the_box_monotonically() -> None:
+    """From 10 degrees the yaw falls monotonically to 0; then both fingertips carry the box along, aligned."""
+    trajectory = simulate(EXAMPLES / "push_align.yaml", duration=2.5, dt=0.5, ambiguous="min_power")
+    assert trajectory.status == "completed" and trajectory.certified
+    yaw = np.degrees([_yaw(r) for r in trajectory.rotations("box")]) - ALIGN_FRAME
+    assert yaw[0] == pytest.approx(10.0, abs=0.05)
+    assert np.all(np.diff(yaw) <= 1e-6), yaw
+    assert abs(yaw[-1]) < 0.05
+    last = trajectory.steps[-1]
+    assert {(c.other, c.mode) for c in last.contacts if c.other != "table"} == {("upper", "rolling"), ("lower", "rolling")}
+    np.testing.assert_allclose(last.twists["box"], [*ALIGN_PUSH, 0, 0, 0, 0], atol=1e-9)  # carried along
+    assert any(e.kind == "contact made" and e.pair == ("box", "lower") for e in trajectory.events)
 
 
 # --------------------------------------------------------------------------- rolling
