@@ -129,3 +129,27 @@ def test_an_unknown_link_is_named() -> None:
     robot = qs.UrdfRobot("hand", HAND)
     with pytest.raises(qs.SceneError, match="no link of that name"):
         robot.point_jacobian("thumb", [0.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("scale", [1.0, 0.3])
+def test_visual_meshes_sit_on_their_links_collision_shapes(scale: float) -> None:
+    """The URDF's visual meshes (what a viewer draws), placed at a configuration, lie where each link's collision shape is."""
+    if not installed_model_folders():
+        pytest.skip("example-robot-data is not installed")
+    hand = qs.UrdfRobot("hand", ALLEGRO)
+    hand = hand.at(q=scale * np.linspace(0.1, 0.8, len(hand.joint_names)))
+    colliders = {c.link: c for c in hand.colliders}
+    visuals = hand.visuals
+    assert len(visuals) == 21 and {v.link for v in visuals} == set(colliders)
+    for visual in visuals:
+        assert visual.vertices is not None and visual.faces is not None
+        assert visual.faces.min() >= 0 and visual.faces.max() < len(visual.vertices) and len(visual.faces) > 100
+        placed = visual.vertices @ visual.pose.rotation.T + visual.pose.position
+        centre = 0.5 * (placed.min(axis=0) + placed.max(axis=0))
+        collider = colliders[visual.link]
+        assert np.linalg.norm(centre - collider.pose.position) < 0.5 * collider.shape.extent, visual.link
+
+
+def test_a_urdf_without_visual_geometry_has_no_visuals() -> None:
+    hand = qs.load_world(Path(__file__).resolve().parents[1] / "examples" / "robots" / "planar_hand.yaml").robots[0]
+    assert hand.visuals == ()

@@ -20,7 +20,7 @@ Rules:
 """
 
 from .detect import Collider, ContactPoint, Layout, candidate_pairs, detect
-from .robot import ROBOTS_INSTALL_HINT, UrdfRobot
+from .robot import ROBOTS_INSTALL_HINT, RobotVisual, UrdfRobot
 from .shapes import Box, Capsule, Convex, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere, shape_from_coal
 from .world import ContactDetection, Detection, FrictionPair, ShapedMover, SolidBody, StiffnessPair, World
 from .world_file import world_from_file
@@ -45,6 +45,7 @@ __all__ = [
     "ShapedMover",
     "SolidBody",
     "Sphere",
+    "RobotVisual",
     "UrdfRobot",
     "World",
     "candidate_pairs",

@@ -33,6 +33,7 @@ from .shapes import Pose, Shape, shape_from_coal
 __all__ = [
     "UrdfRobot",
     "RobotCollider",
+    "RobotVisual",
     "JointValues",
     "ROBOTS_INSTALL_HINT",
     "link_owner",
@@ -83,6 +84,35 @@ class RobotCollider:
     pose: Pose
 
 
+@dataclass(frozen=True)
+class RobotVisual:
+    """One visual geometry of a robot link at the robot's configuration: a triangle mesh in the link's frame, placed.
+
+    ``vertices`` (n, 3) are in the geometry's own frame, scaled [length]; ``faces`` (f, 3) index them;
+    ``colour`` is the URDF's RGBA. A primitive visual (box, sphere...) has no mesh: ``shape`` holds it.
+    """
+
+    link: str
+    pose: Pose
+    colour: tuple[float, float, float, float]
+    vertices: FloatArray | None = None
+    faces: npt.NDArray[np.int64] | None = None
+    shape: Shape | None = None
+
+
+@dataclass(frozen=True)
+class _VisualPart:
+    """A visual geometry as parsed once: its joint, its placement in the joint's frame, and what to draw."""
+
+    joint: int
+    in_joint: FloatArray
+    link: str
+    colour: tuple[float, float, float, float]
+    vertices: FloatArray | None
+    faces: npt.NDArray[np.int64] | None
+    shape: Shape | None
+
+
 class _Kinematics:
     """Pinocchio's model and collision model of one URDF, parsed once and shared by every configuration."""
 
@@ -104,6 +134,8 @@ class _Kinematics:
                 raise SceneError(field, str(urdf), f"{reason} (package:// paths are resolved in package_dirs)") from None
         self.data = self.model.createData()
         self.geometry_data = pinocchio.GeometryData(self.geometry)
+        self.urdf, self.package_dirs = urdf, tuple(package_dirs)
+        self._visuals: tuple[_VisualPart, ...] | None = None
         self.joint_names = self._joint_names(field, urdf)
         links = [frame for frame in self.model.frames if frame.type == pinocchio.FrameType.BODY]
         self.link_names = tuple(frame.name for frame in links)
@@ -122,6 +154,12 @@ class _Kinematics:
         self.plain_q = np.array([j.idx_q for j in joints if j.nq == 1], dtype=int)
         self.circle_dof = np.array([i for i, j in enumerate(joints) if j.nq == 2], dtype=int)  # continuous: cos, sin
         self.circle_q = np.array([j.idx_q for j in joints if j.nq == 2], dtype=int)
+
+    def visual_parts(self) -> tuple[_VisualPart, ...]:
+        """The URDF's visual geometries, parsed on first use (only a viewer needs them); () if they cannot be loaded."""
+        if self._visuals is None:
+            self._visuals = _visual_parts(self)
+        return self._visuals
 
     def _joint_names(self, field: str, urdf: Path) -> tuple[str, ...]:
         """One name per degree of freedom; a joint with other than one (revolute, prismatic, continuous) is rejected."""
@@ -270,6 +308,18 @@ class UrdfRobot:
         return self._colliders
 
     @property
+    def visuals(self) -> tuple[RobotVisual, ...]:
+        """The URDF's visual meshes (or primitives) of every link, placed at this configuration.
+
+        Empty when the URDF has no visual geometry or its files cannot be read: a viewer then draws the
+        collision shapes. Parsed once per URDF, on first use.
+        """
+        parts = self._kinematics.visual_parts()
+        return tuple(
+            RobotVisual(p.link, _pose(self._placement.joints[p.joint] @ p.in_joint), p.colour, p.vertices, p.faces, p.shape) for p in parts
+        )
+
+    @property
     def collider_owners(self) -> tuple[str, ...]:
         """Each collision geometry's link as a mover (``hand/link``), in the order of :attr:`collider_shapes`."""
         return tuple(link_owner(self.name, link) for link in self._kinematics.geometry_link)
@@ -386,3 +436,41 @@ def _pinocchio() -> Any:
     except ImportError:
         raise BackendUnavailableError("Pinocchio", ROBOTS_INSTALL_HINT, needed_for="URDF robots") from None
     return pinocchio
+
+
+def _visual_parts(kinematics: _Kinematics) -> tuple[_VisualPart, ...]:
+    pinocchio = _pinocchio()
+    with captured_stderr():
+        try:
+            visual = pinocchio.buildGeomFromUrdf(
+                kinematics.model,
+                str(kinematics.urdf),
+                pinocchio.GeometryType.VISUAL,
+                package_dirs=[str(d) for d in kinematics.package_dirs] or None,
+            )
+        except (ValueError, RuntimeError):
+            return ()
+    parts = []
+    for item in visual.geometryObjects:
+        link = kinematics.model.frames[item.parentFrame].name
+        colour = tuple(float(c) for c in np.asarray(item.meshColor, dtype=float)[:4])
+        mesh, shape = _triangles(item.geometry), None
+        if mesh is None:
+            try:
+                shape = shape_from_coal(item.geometry, f"visual geometry {item.name!r}")
+            except SceneError:
+                continue  # a kind nobody draws (cone, ellipsoid): the collision shapes still show the link
+        vertices, faces = (None, None) if mesh is None else mesh
+        parts.append(_VisualPart(int(item.parentJoint), _matrix(item.placement), link, colour, vertices, faces, shape))  # type: ignore[arg-type]
+    return tuple(parts)
+
+
+def _triangles(geometry: Any) -> tuple[FloatArray, npt.NDArray[np.int64]] | None:
+    """Vertices and triangles of a coal BVH mesh (pinocchio has applied the URDF's scale); None for other kinds."""
+    if not hasattr(geometry, "tri_indices"):
+        return None
+    vertices = np.array(geometry.vertices(), dtype=float).reshape(-1, 3)
+    faces = np.array([[t[0], t[1], t[2]] for t in (geometry.tri_indices(i) for i in range(geometry.num_tris))], dtype=np.int64).reshape(
+        -1, 3
+    )
+    return vertices, faces
