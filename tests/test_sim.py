@@ -271,3 +271,14 @@ def test_uncertified_steps_are_marked_in_the_trajectory_and_the_output(tmp_path:
     assert "NOT certified" in result.stdout
     trajectory = Trajectory.load(out)
     assert not trajectory.certified and not any(s.certified for s in trajectory.steps)
+
+
+def test_a_push_into_a_wall_jams_when_the_fingertip_arrives_and_names_the_blocking_contacts() -> None:
+    world = qs.load_world(PUSH)
+    wall = qs.ShapedMover("wall", qs.Box([0.02, 0.3, 0.3]), qs.Pose([0.06, 0.0, 0.15]))  # touching the box's +x face
+    trajectory = qs.simulate(replace(world, movers=(*world.movers, wall)), duration=3.0, dt=0.5, ambiguous="min_power")
+    assert trajectory.status == "jammed" and trajectory.certified
+    assert trajectory.final.time == pytest.approx(2.0, abs=1e-3)  # when the 2 cm gap has closed
+    jam = [e for e in trajectory.events if e.kind == "jammed"]
+    assert len(jam) == 1 and jam[0].detail.endswith("blocking contacts: box/finger, box/wall")
+    np.testing.assert_array_equal(trajectory.positions("box")[-1], [0.0, 0.0, 0.05])  # the box never moved

@@ -14,7 +14,8 @@ from ..adapters import World
 from ..errors import SceneError
 from ..loading import load_world
 from ..model import Scene
-from ..tolerances import SIM_EVENT_TIME
+from ..solution import CertificateKind
+from ..tolerances import SIM_EVENT_TIME, ZERO
 from .state import InputSource, InputTable, State, inputs_at
 from .step import AmbiguityPolicy, Evaluation, Event, SimModel, StepOptions, StepResult, advance, evaluate, moving, safe_step
 from .trajectory import RunStatus, Trajectory
@@ -158,7 +159,7 @@ def events_between(before: Evaluation, after: Evaluation, window: tuple[float, f
     time = window[1]
     old, new = dict(signature(before)[1]), dict(signature(after)[1])
     events = [
-        Event(time, "contact made", pair, f"{pair[0]} touches {pair[1]} ({', '.join(new[pair])})", window)
+        Event(time, "contact made", pair, f"{pair[0]} touches {pair[1]}" + _modes_text(new[pair]), window)
         for pair in new
         if pair not in old
     ]
@@ -179,6 +180,8 @@ def _status_events(before: Evaluation | None, after: Evaluation, window: tuple[f
     detail = after.choice or after.solution.message
     if after.status == "unstable" and before is not None:
         detail += _fall(before)
+    if after.status == "jammed":
+        detail += _blocking(after)
     return (Event(window[1], after.status, ("", ""), detail, window),)
 
 
@@ -191,6 +194,24 @@ def _fall(before: Evaluation) -> str:
             v, w = twist[:3], twist[3:]
             parts.append(f"{body.name!r} (its centre of mass was moving along {_unit(v)}, turning about {_unit(w)})")
     return "; it falls as it last moved: " + ", ".join(parts) if parts else ""
+
+
+def _modes_text(modes: tuple[str, ...]) -> str:
+    shown = [m for m in modes if m]  # "" marks an answer without a motion: no modes
+    return f" ({', '.join(shown)})" if shown else ""
+
+
+def _blocking(evaluation: Evaluation) -> str:
+    """The contacts a kinematic jam's certificate (Farkas multipliers, one per contact) puts weight on."""
+    certificate = evaluation.solution.certificate
+    contacts = evaluation.detection.contacts
+    if certificate is None or certificate.kind is not CertificateKind.FARKAS or len(certificate.data) != len(contacts):
+        return ""
+    weights = np.asarray(certificate.data)
+    blocking = sorted(
+        {f"{contacts[i].body}/{contacts[i].other}" for i in np.flatnonzero(weights > ZERO * max(float(weights.max()), 1e-300))}
+    )
+    return f"; blocking contacts: {', '.join(blocking)}" if blocking else ""
 
 
 def _unit(vector: np.ndarray) -> str:
