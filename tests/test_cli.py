@@ -322,3 +322,24 @@ def test_two_finger_lift_walls_have_unbounded_range() -> None:
     assert ranges[0] == pytest.approx((2.4525, 2.4525)) and ranges[1] == pytest.approx((2.4525, 2.4525))
     assert ranges[2] is not None and ranges[2][1] is None
     assert ranges[3] is not None and ranges[3][1] is None
+
+
+def test_every_documented_command_is_registered_and_answers_help() -> None:
+    """The module's list of commands, the registered commands and the console script agree (a merge once dropped one)."""
+    import re
+    import subprocess
+    import sys
+
+    import quasistatic.cli as cli
+
+    listed = re.search(r"``quasistatic ([a-z |]+)``", cli.__doc__ or "")
+    assert listed is not None
+    documented = {word.strip() for word in listed.group(1).split("|")}
+    registered = {command.name or command.callback.__name__ for command in cli.app.registered_commands if command.callback}
+    assert documented == registered
+    result = subprocess.run(
+        [sys.executable, "-c", "from quasistatic.cli import main; main()", "--help"], capture_output=True, text=True, timeout=120
+    )
+    assert result.returncode == 0
+    shown = set(re.findall(r"^\W*([a-z]+)\s", result.stdout, re.M))
+    assert documented <= shown, documented - shown

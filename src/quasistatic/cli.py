@@ -374,6 +374,7 @@ def _progress_bar(console: Console, duration: float) -> Iterator[Callable[[float
         yield lambda time, _: progress.update(task, completed=time)
 
 
+@app.command()
 def view(
     scene_file: SceneArgument,
     method: Annotated[str, typer.Option(help=f"Solver: {', '.join(METHODS)} (also for the live re-solves).")] = "auto",
