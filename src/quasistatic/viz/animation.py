@@ -25,7 +25,7 @@ from .style import BODY_FILL, EDGE_COLOUR, FORCE_COLOUR, MODE_COLOURS, MOVER_FIL
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-__all__ = ["animate", "ANIMATION_FORMATS", "MAX_FRAMES"]
+__all__ = ["animate", "ANIMATION_FORMATS", "MAX_FRAMES", "check_run_names", "frame_indices"]
 
 FloatArray = npt.NDArray[np.float64]
 ANIMATION_FORMATS = (".gif", ".mp4")
@@ -51,14 +51,15 @@ def animate(trajectory: Trajectory, world: World, output: str | Path, *, view: s
         raise SceneError("output", str(output), f"an animation is written as {' or '.join(ANIMATION_FORMATS)}")
     if suffix == ".mp4" and shutil.which("ffmpeg") is None:
         raise SceneError("output", str(output), "an .mp4 needs ffmpeg on the PATH (apt-get install ffmpeg); write a .gif instead")
-    _check_names(trajectory, world)
-    frames = _frame_indices(trajectory)
+    check_run_names(trajectory, world)
+    frames = frame_indices(trajectory, MAX_FRAMES)
     camera = _camera(trajectory, world, Projection.of(3, view))
     _write(trajectory, world, frames, camera, output, fps)
     return output
 
 
-def _check_names(trajectory: Trajectory, world: World) -> None:
+def check_run_names(trajectory: Trajectory, world: World) -> None:
+    """Raise :class:`SceneError` unless ``world`` has the trajectory's bodies, movers and robots: the scene it was run on."""
     state = trajectory.states[0]
     for kind, names, known in (
         ("bodies", set(state.bodies), {b.name for b in world.bodies}),
@@ -71,13 +72,13 @@ def _check_names(trajectory: Trajectory, world: World) -> None:
             )
 
 
-def _frame_indices(trajectory: Trajectory) -> list[int]:
-    """Every state, or for a long run the last state at or before each of MAX_FRAMES even times (ends included)."""
+def frame_indices(trajectory: Trajectory, limit: int) -> list[int]:
+    """Every state, or for a long run the last state at or before each of ``limit`` even times (ends included)."""
     count = len(trajectory.states)
-    if count <= MAX_FRAMES:
+    if count <= limit:
         return list(range(count))
     times = trajectory.times
-    wanted = np.linspace(times[0], times[-1], MAX_FRAMES)
+    wanted = np.linspace(times[0], times[-1], limit)
     return [int(i) for i in np.searchsorted(times, wanted, side="right") - 1]
 
 
