@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import base64
 import dataclasses
+import io
 import re
 import subprocess
 import sys
@@ -187,3 +188,30 @@ def test_the_command_exports_a_run_and_needs_its_scene(tmp_path: Path) -> None:
         [str(COMMAND), "view", str(TIP), "--scene", str(TIP), "--export", str(target)], capture_output=True, text=True, timeout=300
     )
     assert scene_only.returncode == 2 and "--scene" in scene_only.stderr and len(scene_only.stderr.strip().splitlines()) == 1
+
+
+# --------------------------------------------------------------------------- in a notebook
+
+
+def test_a_notebook_shows_the_verdict_the_events_and_the_run_as_a_gif(run: qs.Trajectory) -> None:
+    Image = pytest.importorskip("PIL.Image")
+    pytest.importorskip("matplotlib")
+    page = dataclasses.replace(run, scene_file=str(TIP))._repr_html_()
+    assert "<p><b>completed</b>: ran the whole 1 s</p>" in page and "6 states to t = 1 s; every step proven" in page
+    rows = re.findall(r"<tr><td>([^<]+)</td><td>([^<]+)</td><td>([^<]+)</td><td>([^<]+)</td></tr>", page)
+    event = run.events[0]
+    assert rows == [(f"{event.time:.6g}", "mode change", "box / table", "box on table: rolling, separating -&gt; rolling")]
+    gif = re.search(r'src="data:image/gif;base64,([^"]+)"', page)
+    assert gif, page[:500]
+    with Image.open(io.BytesIO(base64.b64decode(gif.group(1)))) as image:
+        assert image.format == "GIF" and image.n_frames == len(run.states)
+
+
+def test_a_notebook_says_why_the_run_is_not_drawn_and_what_is_unproven(run: qs.Trajectory, monkeypatch: pytest.MonkeyPatch) -> None:
+    steps = tuple(dataclasses.replace(s, certified=False) if i == 2 else s for i, s in enumerate(run.steps))
+    page = dataclasses.replace(run, steps=steps)._repr_html_()  # run on a World built in Python: no scene file
+    assert "NOT proven: 1 of 6 steps uncertified" in page and "<img" not in page
+    assert "no animation" in page and "names no scene file" in page
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if the figures extra were not installed
+    page = dataclasses.replace(run, scene_file=str(TIP))._repr_html_()
+    assert "<img" not in page and "pip install &quot;quasistatic[figures]&quot;" in page and "<table>" in page

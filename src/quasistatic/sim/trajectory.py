@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..adapters import Pose, World
-from ..errors import SceneError
+from ..errors import QuasistaticError, SceneError
 from ..loading import load_world
 from ..solution import Status
 from .state import State
@@ -83,6 +83,17 @@ class Trajectory:
         if not isinstance(world, World):
             raise SceneError("scene", self.scene_file, "lists its contacts: a trajectory is run on a scene of shapes")
         return world
+
+    def _repr_html_(self) -> str:
+        """Jupyter's view of the run: how it ended, whether every step is proven, its events, and a small GIF of it
+        on the scene file it names (when that file is there and matplotlib is installed)."""
+        from ..viz.run_summary import trajectory_html  # the one way from a run to the pictures (it imports no Trajectory)
+
+        try:
+            world, why = self.scene_world(), ""
+        except (QuasistaticError, OSError) as error:
+            world, why = None, str(error)
+        return trajectory_html(self, world, why)
 
     def joint_positions(self, robot: str) -> FloatArray:
         """A URDF robot's joint positions at every state, (n, joints)."""
