@@ -78,6 +78,11 @@ class ArrowScales:
         motions = list(solution.solutions) or ([solution.motion] if solution.motion is not None else [])
         force = max((float(np.linalg.norm(c.force)) for m in motions for c in m.contacts), default=0.0)
         speed = max((_speed(m, scene.dimension) for m in motions), default=0.0)
+        return cls.sized(size, centre, force, speed)
+
+    @classmethod
+    def sized(cls, size: float, centre: FloatArray, force: float, speed: float) -> ArrowScales:
+        """Scales on which the largest ``force`` and fastest ``speed`` are 30 % of ``size`` (0: nothing to draw)."""
         return cls(size, centre, _ARROW_SHARE * size / force if force > 0 else 0.0, _ARROW_SHARE * size / speed if speed > 0 else 0.0)
 
     @classmethod
@@ -96,9 +101,7 @@ class ArrowScales:
         size = float(np.linalg.norm(high - low)) or 1.0
         force = max((float(np.linalg.norm(c.force)) for s in steps for c in s.contacts), default=0.0)
         speed = max((float(np.linalg.norm(np.asarray(t, dtype=float)[:3])) for s in steps for t in s.twists.values()), default=0.0)
-        return cls(
-            size, (low + high) / 2, _ARROW_SHARE * size / force if force > 0 else 0.0, _ARROW_SHARE * size / speed if speed > 0 else 0.0
-        )
+        return cls.sized(size, (low + high) / 2, force, speed)
 
 
 def scene_extent(scene: Scene, world: World | None = None) -> tuple[FloatArray, float]:
