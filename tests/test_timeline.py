@@ -118,7 +118,10 @@ def test_an_uncertified_run_is_marked_not_proven(run: qs.Trajectory, world: qs.W
         shown.go_to(2)
         assert "NOT proven" in shown._step_text.content
         label = shown.server.scene.get_handle_by_name("/frame/label")
-        assert label is not None
+        assert label.text == f"t = {steps[2].time:.4g} s: solved, not proven"  # the export keeps the label, not the panel
+        shown.go_to(3)
+        label = shown.server.scene.get_handle_by_name("/frame/label")  # each state draws its own
+        assert "NOT proven" not in shown._step_text.content and label.text.endswith(": solved")
     finally:
         shown.stop()
 
@@ -171,6 +174,26 @@ def test_the_export_records_every_state_in_simulated_time(viewer: Any, run: qs.T
     assert [t for t, _ in labels] == pytest.approx(list(run.times))
     boxes = [m for _, m in recording["messages"] if m.get("type") == "MeshMessage" and m.get("name") == "/frame/bodies/box"]
     assert len(boxes) == len(run.states)
+
+
+def test_a_long_run_is_exported_at_even_times(run: qs.Trajectory, world: qs.World, tmp_path: Path) -> None:
+    """300 states (the six recorded ones repeated over 3 s) are exported as 240 frames, the last state included."""
+    pytest.importorskip("viser")
+    from quasistatic.viz.timeline import MAX_EXPORT_FRAMES
+
+    count = 300
+    times = np.linspace(0.0, 3.0, count)
+    states = tuple(dataclasses.replace(run.states[i % 6], time=float(t)) for i, t in enumerate(times))
+    steps = tuple(dataclasses.replace(run.steps[i % 6], time=float(t)) for i, t in enumerate(times))
+    shown = qs.view(dataclasses.replace(run, states=states, steps=steps), world, port=0)
+    try:
+        recording = _recording(shown.export_html(tmp_path / "long.html").read_text())
+    finally:
+        shown.stop()
+    labels = [(t, m["props"]["text"]) for t, m in recording["messages"] if m.get("type") == "LabelMessage"]
+    assert len(labels) == MAX_EXPORT_FRAMES == 240
+    assert labels[0] == (0.0, "t = 0 s: solved") and labels[-1][0] == pytest.approx(3.0) and labels[-1][1] == "t = 3 s: solved"
+    assert recording["durationSeconds"] == pytest.approx(3.3)
 
 
 def test_the_command_exports_a_run_and_needs_its_scene(tmp_path: Path) -> None:
