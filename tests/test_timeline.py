@@ -207,6 +207,8 @@ def test_the_command_exports_a_run_and_needs_its_scene(tmp_path: Path) -> None:
     orphan = subprocess.run([str(COMMAND), "view", str(RUN), "--export", str(target)], capture_output=True, text=True, timeout=300)
     lines = orphan.stderr.strip().splitlines()
     assert orphan.returncode == 2 and len(lines) == 1 and lines[0].startswith("error: ") and "give --scene" in lines[0]
+    solved = subprocess.run([str(COMMAND), "view", str(RUN), "--method", "fast"], capture_output=True, text=True, timeout=300)
+    assert solved.returncode == 2 and solved.stderr.startswith("error: --method 'fast': a trajectory is drawn")
     scene_only = subprocess.run(
         [str(COMMAND), "view", str(TIP), "--scene", str(TIP), "--export", str(target)], capture_output=True, text=True, timeout=300
     )

@@ -302,6 +302,8 @@ def view(
         _fail(f"--port {port}: not a port number (0 to 65535)")
     _guarded(require_viser)
     if scene_file.suffix.lower() in _TRAJECTORY_FORMATS:
+        if method != "auto":
+            _fail(f"--method {method!r}: a trajectory is drawn from what it recorded, never solved again")
         _view_trajectory(scene_file, scene, host, port, export, view)
         return
     if scene is not None:
