@@ -30,8 +30,13 @@ ALLOWED = {
 }
 # The ways into viz/ from outside it, besides the CLI: the package root re-exports ``plot`` (matplotlib is
 # loaded only when drawing), and ``Solution._repr_png_`` (a notebook's picture) calls ``viz.chart``, which
-# imports no value type, so the leaf stays free of cycles.
-PICTURE_ENTRIES = {("quasistatic", "quasistatic.viz"), ("quasistatic.solution", "quasistatic.viz.chart")}
+# imports no value type, so the leaf stays free of cycles; ``Trajectory._repr_html_`` calls ``viz.run_summary``,
+# which imports no Trajectory.
+PICTURE_ENTRIES = {
+    ("quasistatic", "quasistatic.viz"),
+    ("quasistatic.solution", "quasistatic.viz.chart"),
+    ("quasistatic.sim.trajectory", "quasistatic.viz.run_summary"),
+}
 FRONT_DOORS = {"quasistatic.solvers.lp", "quasistatic.solvers.fast", "quasistatic.solvers.scip", "quasistatic.solvers.paper"}
 
 
@@ -90,7 +95,11 @@ def test_each_stage_imports_only_what_it_may(stage: str) -> None:
     bad = [
         f"{name} imports {target}"
         for name, target, _ in _edges()
-        if _stage(name) == stage and target not in LEAVES and target != "quasistatic" and _stage(target) not in allowed
+        if _stage(name) == stage
+        and target not in LEAVES
+        and target != "quasistatic"
+        and _stage(target) not in allowed
+        and (name, target) not in PICTURE_ENTRIES
     ]
     assert not bad, bad
 

@@ -43,6 +43,7 @@ _SLIDING = (0.0, 30.0)
 _SATURATED = 0.45  # saturation above which a pixel is coloured (grey parts, white background, text stay out)
 _PRESENT = 30  # pixels of a band that show a contact of that mode is drawn (a contact's ball is about 100)
 _ABSENT = 15  # at most this many stray pixels of a band that no contact has
+_SEEN_THROUGH = 0.3  # saturation of a contact's colour seen through a translucent part (it keeps its hue)
 _NOTICE_ROWS = 170  # Chromium's "software WebGL" notice covers the top left: its orange bar is no contact
 
 
@@ -63,9 +64,9 @@ def _hues(screenshot: bytes) -> tuple[np.ndarray, np.ndarray]:
     return hue, (high - low) / np.maximum(high, 1e-9)
 
 
-def _band(visit: PageVisit, band: tuple[float, float]) -> int:
+def _band(visit: PageVisit, band: tuple[float, float], saturated: float = _SATURATED) -> int:
     hue, saturation = _hues(visit.screenshot)
-    return int(np.count_nonzero((saturation > _SATURATED) & (hue >= band[0]) & (hue <= band[1])))
+    return int(np.count_nonzero((saturation > saturated) & (hue >= band[0]) & (hue <= band[1])))
 
 
 def _assert_shows_the_modes(visit: PageVisit, modes: set[str]) -> None:
@@ -189,7 +190,17 @@ def test_the_export_opens_without_a_server(chromium: Chromium, tmp_path: Path) -
     )
     assert run.returncode == 0 and run.stdout.strip() == f"wrote {target}: solved", (run.stdout, run.stderr)
     assert target.stat().st_size > 100_000 and "__VISER_EMBED_DATA__" in target.read_text()
-    _assert_shows_the_modes(chromium.visit(target.as_uri()), {"rolling", "sliding"})
+    _assert_shows_the_tipping_box(chromium.visit(target.as_uri()))
+
+
+def _assert_shows_the_tipping_box(visit: PageVisit) -> None:
+    """No console error, not blank, and the rolling (table) and sliding (fingertip) contacts in their colours: the
+    fingertip's contact is seen through the translucent fingertip, so its colour keeps its hue at a lower saturation."""
+    assert not visit.errors, visit.errors
+    pixels = np.asarray(Image.open(io.BytesIO(visit.screenshot)).convert("RGB"))
+    assert len(np.unique(pixels.reshape(-1, 3), axis=0)) > 50, "the page is blank"
+    for band in (_ROLLING, _SLIDING):
+        assert _band(visit, band, _SEEN_THROUGH) >= _PRESENT, band
 
 
 @pytest.mark.parametrize(
@@ -220,3 +231,59 @@ def _assert_one_error(run: subprocess.CompletedProcess[str], needle: str) -> Non
     assert run.returncode == 2, (run.stdout, run.stderr)
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], run.stderr
+
+
+# --------------------------------------------------------------------------- a simulated run on the timeline
+
+RUN = DATA / "tip_box_run.npz"  # examples/sim/tip_box.yaml simulated for 1 s with dt 0.25 (tests/test_timeline.py)
+TIP = EXAMPLES / "sim" / "tip_box.yaml"
+
+
+def test_the_timeline_moves_the_run_in_the_browser(chromium: Chromium) -> None:
+    """The first and last states of the tipping box: both show the step's rolling (table) and sliding (fingertip)
+    contacts, without a console error; the box's pose in the scene tree and the picture change between them."""
+    pytest.importorskip("coal")
+    trajectory = qs.Trajectory.load(RUN)
+    world = qs.load_world(TIP)
+    assert isinstance(world, qs.World)
+    viewer = qs.view(trajectory, world, port=0, camera="xz")  # the push is in the xz plane: the fingertip is in sight
+    try:
+        box = viewer.server.scene.get_handle_by_name("/frame/bodies/box")
+        start = (np.array(box.position), np.array(box.wxyz))
+        first = chromium.visit(viewer.url)
+        viewer.timeline.value = len(trajectory.states) - 1  # as dragging the slider to the end does
+        box = viewer.server.scene.get_handle_by_name("/frame/bodies/box")
+        end = (np.array(box.position), np.array(box.wxyz))
+        last = chromium.visit(viewer.url)
+    finally:
+        viewer.stop()
+    assert not np.allclose(start[0], end[0]) and not np.allclose(start[1], end[1])
+    for visit, step in ((first, trajectory.steps[0]), (last, trajectory.steps[-1])):
+        assert {c.mode for c in step.contacts} >= {"rolling", "sliding"}
+        _assert_shows_the_tipping_box(visit)
+    before = np.asarray(Image.open(io.BytesIO(first.screenshot)).convert("RGB"), dtype=int)
+    after = np.asarray(Image.open(io.BytesIO(last.screenshot)).convert("RGB"), dtype=int)
+    assert np.count_nonzero(np.abs(before - after).sum(axis=2) > 30) > 200, "the picture did not change along the timeline"
+
+
+def test_the_exported_run_plays_without_a_server(chromium: Chromium, tmp_path: Path) -> None:
+    pytest.importorskip("coal")
+    target = tmp_path / "run.html"
+    run = subprocess.run(
+        [str(COMMAND), "view", str(RUN), "--scene", str(TIP), "--view", "xz", "--export", str(target)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert run.returncode == 0 and run.stdout.strip() == f"wrote {target}: 6 states, completed", (run.stdout, run.stderr)
+    _assert_shows_the_tipping_box(chromium.visit(target.as_uri()))
+
+
+def _assert_shows_the_tipping_box(visit: PageVisit) -> None:
+    """No console error, not blank, and the rolling (table) and sliding (fingertip) contacts in their colours: the
+    fingertip's contact is seen through the translucent fingertip, so its colour keeps its hue at a lower saturation."""
+    assert not visit.errors, visit.errors
+    pixels = np.asarray(Image.open(io.BytesIO(visit.screenshot)).convert("RGB"))
+    assert len(np.unique(pixels.reshape(-1, 3), axis=0)) > 50, "the page is blank"
+    for band in (_ROLLING, _SLIDING):
+        assert _band(visit, band, _SEEN_THROUGH) >= _PRESENT, band

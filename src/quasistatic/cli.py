@@ -376,26 +376,47 @@ def _progress_bar(console: Console, duration: float) -> Iterator[Callable[[float
 
 @app.command()
 def view(
-    scene_file: SceneArgument,
+    scene_file: Annotated[
+        Path,
+        typer.Argument(
+            metavar="SCENE", help="Scene file (.yaml, .yml or .json), or a trajectory saved by `simulate --out` (.npz, .jsonl)."
+        ),
+    ],
     method: Annotated[str, typer.Option(help=f"Solver: {', '.join(METHODS)} (also for the live re-solves).")] = "auto",
     host: Annotated[str, typer.Option(help="Address the viewer's server listens on.")] = "127.0.0.1",
     port: Annotated[int, typer.Option(help="Port of the viewer's server (the next free one when taken; 0: any free one).")] = 8080,
     export: Annotated[Path | None, typer.Option(help="Write the view as one .html file that opens without a server, and exit.")] = None,
+    scene: Annotated[Path | None, typer.Option(help="For a trajectory: the scene file it was run on (default: the one it names).")] = None,
+    view: Annotated[str, typer.Option("--view", help="Where the camera starts (3-D): iso, xy, xz or yz.")] = "iso",
 ) -> None:
-    """Show the answer in an interactive 3-D viewer in the browser (viser; docs/pictures.md), until Ctrl-C."""
-    from .viz import require_viser
+    """Show the answer in an interactive 3-D viewer in the browser (viser; docs/pictures.md), until Ctrl-C.
+
+    Given a trajectory, a timeline (with play/pause) scrubs its states: nothing is solved, everything drawn was recorded.
+    """
+    from .viz import VIEWS, require_viser
     from .viz import view as show
 
+    if view not in VIEWS:
+        _fail(f"--view {view!r} is not one of {', '.join(VIEWS)}")
     if export is not None and export.suffix.lower() != ".html":
         _fail(f"--export {str(export)!r}: the file must end in .html")
     if not 0 <= port <= 65535:
         _fail(f"--port {port}: not a port number (0 to 65535)")
     _guarded(require_viser)
-    scene, detection, world = _loaded_world(scene_file)
-    solution = _guarded(lambda: solve(scene, method=method))
+    if scene_file.suffix.lower() in _TRAJECTORY_FORMATS:
+        if method != "auto":
+            _fail(f"--method {method!r}: a trajectory is drawn from what it recorded, never solved again")
+        _view_trajectory(scene_file, scene, host, port, export, view)
+        return
+    if scene is not None:
+        _fail(f"--scene {str(scene)!r}: only a trajectory (.npz, .jsonl) is drawn on another scene file")
+    answered, detection, world = _loaded_world(scene_file)
+    solution = _guarded(lambda: solve(answered, method=method))
     if detection is not None:
         solution = with_detection(solution, detection)
-    viewer = _guarded(lambda: show(solution, world or scene, host=host, port=0 if export is not None else port, method=method))
+    viewer = _guarded(
+        lambda: show(solution, world or answered, host=host, port=0 if export is not None else port, method=method, camera=view)
+    )
     if export is not None:
         try:
             viewer.export_html(export)
@@ -408,6 +429,39 @@ def view(
     typer.echo(
         f"viewer at {viewer.url} ({solution.status}); press Ctrl-C to stop",
     )
+    viewer.wait()
+
+
+_TRAJECTORY_FORMATS = (".npz", ".jsonl")
+
+
+def _view_trajectory(trajectory_file: Path, scene: Path | None, host: str, port: int, export: Path | None, camera: str) -> None:
+    """`view` of a trajectory: its states on the scene file it names (or --scene), with a timeline."""
+    from .sim import Trajectory
+    from .viz import view_trajectory
+
+    trajectory = _guarded(lambda: Trajectory.load(trajectory_file))
+    if scene is not None:
+        loaded = _guarded(lambda: load_world(scene))
+        if not isinstance(loaded, World):
+            _fail(f"--scene {str(scene)!r} lists its contacts: a trajectory is run on a scene of shapes")
+        world = loaded
+    elif not trajectory.scene_file:
+        _fail(f"{str(trajectory_file)!r} names no scene file (it was run on a World built in Python): give --scene")
+    else:
+        world = _guarded(trajectory.scene_world)
+    viewer = _guarded(lambda: view_trajectory(trajectory, world, host=host, port=0 if export is not None else port, camera=camera))
+    summary = f"{len(trajectory.states)} states, {trajectory.status}" + ("" if trajectory.certified else ", NOT proven")
+    if export is not None:
+        try:
+            viewer.export_html(export)
+        except OSError as exc:
+            _fail(f"cannot write {str(export)!r}: {exc.strerror or exc}")
+        finally:
+            viewer.stop()
+        typer.echo(f"wrote {export}: {summary}")
+        return
+    typer.echo(f"viewer at {viewer.url} ({summary}); press Ctrl-C to stop")
     viewer.wait()
 
 

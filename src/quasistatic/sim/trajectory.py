@@ -10,8 +10,9 @@ from typing import Any, Literal, cast
 import numpy as np
 import numpy.typing as npt
 
-from ..adapters import Pose
-from ..errors import SceneError
+from ..adapters import Pose, World
+from ..errors import QuasistaticError, SceneError
+from ..loading import load_world
 from ..solution import Status
 from .state import State
 from .step import ContactRecord, Event, StepResult
@@ -69,6 +70,30 @@ class Trajectory:
     def rotations(self, body: str) -> FloatArray:
         """The body's (or mover's) rotation matrix at every state, (n, 3, 3)."""
         return np.array([_pose(s, body).rotation for s in self.states])
+
+    def scene_world(self) -> World:
+        """The World of :attr:`scene_file`, read again (to draw the run on: the states place it).
+
+        Raises :class:`SceneError` when the trajectory names no scene file (it was run on a World built in
+        Python), or the file lists its contacts instead of shapes.
+        """
+        if not self.scene_file:
+            raise SceneError("scene", "", "the trajectory names no scene file (it was run on a World built in Python): give the World")
+        world = load_world(self.scene_file)
+        if not isinstance(world, World):
+            raise SceneError("scene", self.scene_file, "lists its contacts: a trajectory is run on a scene of shapes")
+        return world
+
+    def _repr_html_(self) -> str:
+        """Jupyter's view of the run: how it ended, whether every step is proven, its events, and a small GIF of it
+        on the scene file it names (when that file is there and matplotlib is installed)."""
+        from ..viz.run_summary import trajectory_html  # the one way from a run to the pictures (it imports no Trajectory)
+
+        try:
+            world, why = self.scene_world(), ""
+        except (QuasistaticError, OSError) as error:
+            world, why = None, str(error)
+        return trajectory_html(self, world, why)
 
     def joint_positions(self, robot: str) -> FloatArray:
         """A URDF robot's joint positions at every state, (n, joints)."""

@@ -3,7 +3,8 @@
 - :func:`plot`: a Solution drawn on its Scene (or World of shapes), one panel per motion.
 - :func:`animate`: a Trajectory drawn on its World, frame by frame (GIF, or MP4 with ffmpeg).
 - :func:`view`: the viewer, a viser server with live re-solves (:mod:`.viewer`); one frame is drawn by
-  :func:`.scene3d.draw_frame`.
+  :func:`.scene3d.draw_frame`. Given a Trajectory, a timeline scrubbing its states (:mod:`.timeline`,
+  each drawn by :func:`.scene3d.draw_state`).
 - :func:`phase_diagram`: a sweep's phase regions over one or two parameters, boundaries refined.
 - :data:`MODE_COLOURS` and the other colours: fixed, colour-blind safe (see ``style``).
 
@@ -23,8 +24,9 @@ from .chart import summary_png
 from .figures import MAX_PANELS, plot
 from .geometry import VIEWS
 from .phase import STATUS_COLOURS, phase_diagram
-from .scene3d import ArrowScales, DrawnFrame, draw_frame
+from .scene3d import ArrowScales, DrawnFrame, draw_frame, draw_state
 from .style import FORCE_COLOUR, MODE_COLOURS, NO_MOTION_COLOUR, SLIP_COLOUR, TWIST_COLOUR, require_matplotlib, save
+from .timeline import TrajectoryViewer, view_trajectory
 from .viewer import VIEWER_INSTALL_HINT, Velocities, Viewer, require_viser, view
 
 __all__ = [
@@ -43,12 +45,15 @@ __all__ = [
     "animate",
     "Velocities",
     "Viewer",
+    "TrajectoryViewer",
     "draw_frame",
     "phase_diagram",
+    "draw_state",
     "plot",
     "require_matplotlib",
     "require_viser",
     "save",
     "summary_png",
     "view",
+    "view_trajectory",
 ]

@@ -11,26 +11,41 @@ import math
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from ..adapters import Halfspace, World
 from ..errors import SceneError
-from ..sim import StepResult, Trajectory
+from ..sim.state import State
+from ..sim.step import StepResult
 from .geometry import Projection, plane_patch, shape_outline
 from .style import BODY_FILL, EDGE_COLOUR, FORCE_COLOUR, MODE_COLOURS, MOVER_FILL, NO_MOTION_COLOUR, ROBOT_FILL, require_matplotlib, styled
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-__all__ = ["animate", "ANIMATION_FORMATS", "MAX_FRAMES"]
+__all__ = ["animate", "ANIMATION_FORMATS", "MAX_FRAMES", "Run", "check_run_names", "frame_indices"]
 
 FloatArray = npt.NDArray[np.float64]
 ANIMATION_FORMATS = (".gif", ".mp4")
 MAX_FRAMES = 240  # a longer run is sampled at even times: a picture, not a record (the file holds every step)
 FORCE_LENGTH = 0.3  # the largest force of the run is drawn this fraction of the largest body's size
+
+
+class Run(Protocol):
+    """What the pictures read from a run: a :class:`quasistatic.sim.Trajectory`, named here by what it holds so
+    that ``Trajectory._repr_html_`` may draw itself through this module without an import cycle."""
+
+    @property
+    def states(self) -> tuple[State, ...]: ...
+
+    @property
+    def steps(self) -> tuple[StepResult, ...]: ...
+
+    @property
+    def times(self) -> FloatArray: ...
 
 
 @dataclass(frozen=True)
@@ -42,8 +57,9 @@ class _Camera:
     size: float
 
 
-def animate(trajectory: Trajectory, world: World, output: str | Path, *, view: str = "iso", fps: int = 20) -> Path:
-    """Write ``trajectory`` (run on ``world``) as an animation; ``.gif`` always, ``.mp4`` with ffmpeg on the PATH."""
+def animate(trajectory: Run, world: World, output: str | Path, *, view: str = "iso", fps: int = 20, max_frames: int = MAX_FRAMES) -> Path:
+    """Write ``trajectory`` (a Trajectory run on ``world``) as an animation; ``.gif`` always, ``.mp4`` with ffmpeg on
+    the PATH. A run of more than ``max_frames`` states is drawn at that many even times."""
     require_matplotlib()
     output = Path(output)
     suffix = output.suffix.lower()
@@ -51,14 +67,15 @@ def animate(trajectory: Trajectory, world: World, output: str | Path, *, view: s
         raise SceneError("output", str(output), f"an animation is written as {' or '.join(ANIMATION_FORMATS)}")
     if suffix == ".mp4" and shutil.which("ffmpeg") is None:
         raise SceneError("output", str(output), "an .mp4 needs ffmpeg on the PATH (apt-get install ffmpeg); write a .gif instead")
-    _check_names(trajectory, world)
-    frames = _frame_indices(trajectory)
+    check_run_names(trajectory, world)
+    frames = frame_indices(trajectory, max_frames)
     camera = _camera(trajectory, world, Projection.of(3, view))
     _write(trajectory, world, frames, camera, output, fps)
     return output
 
 
-def _check_names(trajectory: Trajectory, world: World) -> None:
+def check_run_names(trajectory: Run, world: World) -> None:
+    """Raise :class:`SceneError` unless ``world`` has the trajectory's bodies, movers and robots: the scene it was run on."""
     state = trajectory.states[0]
     for kind, names, known in (
         ("bodies", set(state.bodies), {b.name for b in world.bodies}),
@@ -71,17 +88,17 @@ def _check_names(trajectory: Trajectory, world: World) -> None:
             )
 
 
-def _frame_indices(trajectory: Trajectory) -> list[int]:
-    """Every state, or for a long run the last state at or before each of MAX_FRAMES even times (ends included)."""
+def frame_indices(trajectory: Run, limit: int) -> list[int]:
+    """Every state, or for a long run the last state at or before each of ``limit`` even times (ends included)."""
     count = len(trajectory.states)
-    if count <= MAX_FRAMES:
+    if count <= limit:
         return list(range(count))
     times = trajectory.times
-    wanted = np.linspace(times[0], times[-1], MAX_FRAMES)
+    wanted = np.linspace(times[0], times[-1], limit)
     return [int(i) for i in np.searchsorted(times, wanted, side="right") - 1]
 
 
-def _camera(trajectory: Trajectory, world: World, projection: Projection) -> _Camera:
+def _camera(trajectory: Run, world: World, projection: Projection) -> _Camera:
     """Bounds that hold every body and mover over the run, and one force scale for every frame."""
     size = world.size
     points = [
@@ -93,7 +110,7 @@ def _camera(trajectory: Trajectory, world: World, projection: Projection) -> _Ca
     return _Camera(projection, low, high, FORCE_LENGTH * size / largest if largest > 0 else 0.0, size)
 
 
-def _write(trajectory: Trajectory, world: World, frames: list[int], camera: _Camera, output: Path, fps: int) -> None:
+def _write(trajectory: Run, world: World, frames: list[int], camera: _Camera, output: Path, fps: int) -> None:
     import matplotlib
 
     matplotlib.use("Agg")

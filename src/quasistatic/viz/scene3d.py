@@ -16,6 +16,7 @@ hull, as contact detection sees it). No physics is computed here.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,11 +24,13 @@ import numpy as np
 
 from ..adapters import Box, Capsule, Convex, Cylinder, Halfspace, Mesh, Pose, Shape, ShapedMover, SolidBody, Sphere, World
 from ..model import Scene
+from ..sim.state import State
+from ..sim.step import StepResult
 from ..solution import Motion, Solution
 from .geometry import FloatArray, convex_hull, lifted
 from .style import BODY_FILL, FORCE_COLOUR, MODE_COLOURS, MOVER_FILL, NO_MOTION_COLOUR, ROBOT_FILL, SLIP_COLOUR, TWIST_COLOUR
 
-__all__ = ["ArrowScales", "DrawnFrame", "draw_frame", "rgb", "scene_extent"]
+__all__ = ["ArrowScales", "DrawnFrame", "draw_frame", "draw_state", "rgb", "scene_extent"]
 
 _ARROW_SHARE = 0.3  # the longest force (and velocity) arrow is this share of the scene's size, as in the pictures
 _DOT_SHARE = 0.025  # radius of a contact's ball per scene size
@@ -75,7 +78,30 @@ class ArrowScales:
         motions = list(solution.solutions) or ([solution.motion] if solution.motion is not None else [])
         force = max((float(np.linalg.norm(c.force)) for m in motions for c in m.contacts), default=0.0)
         speed = max((_speed(m, scene.dimension) for m in motions), default=0.0)
+        return cls.sized(size, centre, force, speed)
+
+    @classmethod
+    def sized(cls, size: float, centre: FloatArray, force: float, speed: float) -> ArrowScales:
+        """Scales on which the largest ``force`` and fastest ``speed`` are 30 % of ``size`` (0: nothing to draw)."""
         return cls(size, centre, _ARROW_SHARE * size / force if force > 0 else 0.0, _ARROW_SHARE * size / speed if speed > 0 else 0.0)
+
+    @classmethod
+    def of_run(cls, world: World, states: Sequence[State], steps: Sequence[StepResult]) -> ArrowScales:
+        """One set of scales for every state of a run (on ``world``): the box around every recorded contact and
+        every bounded shape at each state; the largest recorded force and com speed get 30 % of its size."""
+        points = [c.point for s in steps for c in s.contacts]
+        parts: list[SolidBody | ShapedMover] = [*world.bodies, *world.movers]
+        for part in parts:
+            if part.shape is not None and not isinstance(part.shape, Halfspace):
+                local = _local_mesh(part.shape)[0]
+                poses = (s.bodies.get(part.name) or s.movers.get(part.name) for s in states)
+                points.extend(p for pose in poses if pose is not None for p in pose.apply(local))
+        cloud = np.array(points) if points else np.zeros((1, 3))
+        low, high = cloud.min(axis=0), cloud.max(axis=0)
+        size = float(np.linalg.norm(high - low)) or 1.0
+        force = max((float(np.linalg.norm(c.force)) for s in steps for c in s.contacts), default=0.0)
+        speed = max((float(np.linalg.norm(np.asarray(t, dtype=float)[:3])) for s in steps for t in s.twists.values()), default=0.0)
+        return cls.sized(size, (low + high) / 2, force, speed)
 
 
 def scene_extent(scene: Scene, world: World | None = None) -> tuple[FloatArray, float]:
@@ -157,7 +183,55 @@ def draw_frame(
     return DrawnFrame(root, bodies, movers, links, contacts, forces, slips, twists)
 
 
+def draw_state(api: Any, world: World, step: StepResult, scales: ArrowScales, label: str = "", root: str = "/frame") -> DrawnFrame:
+    """Draw one state of a run into a viser scene, replacing what was drawn under ``root``.
+
+    Parameters
+    ----------
+    world : World
+        The World placed at the state (``State.applied``): its shapes, movers and robot links are drawn there.
+    step : StepResult
+        What the trajectory recorded at that state: each contact (its ball in the colour of its mode, grey
+        without a motion, and the force on the body as an arrow) and each body's twist (its com velocity).
+    scales : ArrowScales
+        One set for the whole run (:meth:`ArrowScales.of_run`).
+    label : str
+        Text shown above the scene (the time and status): a scene node, so an exported recording keeps it.
+    """
+    api.remove_by_name(root)
+    bodies = _draw_world_bodies(api, world, step, scales, root)
+    movers = _draw_movers(api, world, scales, root)
+    links = _draw_robot_links(api, world, root)
+    contacts = _contact_balls(api, [(c.point, c.body, c.other, c.mode) for c in step.contacts], scales, root)
+    forces = [(f"{root}/forces/{i}", c.point, c.force * scales.force) for i, c in enumerate(step.contacts)]
+    coms = {b.name: b.body().com for b in world.bodies}
+    twists = [
+        (f"{root}/twists/{n}", coms[n], np.asarray(t, dtype=float)[:3] * scales.velocity) for n, t in step.twists.items() if n in coms
+    ]
+    if label:
+        above = scales.centre + np.array([0.0, 0.0, 0.5 * scales.size])
+        api.add_label(f"{root}/label", label, position=tuple(above))
+    return DrawnFrame(
+        root, bodies, movers, links, contacts, _arrows(api, forces, FORCE_COLOUR, scales), (), _arrows(api, twists, TWIST_COLOUR, scales)
+    )
+
+
 # --------------------------------------------------------------------------- parts
+
+
+def _draw_world_bodies(api: Any, world: World, step: StepResult, scales: ArrowScales, root: str) -> tuple[str, ...]:
+    """Each free body of a run: its shape where placed, or the hull of its recorded contact points and com."""
+    names = []
+    for body in world.bodies:
+        name = f"{root}/bodies/{body.name}"
+        if body.shape is not None:
+            _draw_shape(api, name, body.shape, body.pose, BODY_FILL, scales)
+        else:
+            points = np.array([c.point for c in step.contacts if body.name in (c.body, c.other)] + [body.body().com])
+            vertices, faces = _hull_mesh(_thickened(points, scales))
+            api.add_mesh_simple(name, vertices, faces, color=rgb(BODY_FILL), opacity=_PART_OPACITY, **_NO_SHADOW, flat_shading=True)
+        names.append(name)
+    return tuple(names)
 
 
 def _draw_bodies(api: Any, scene: Scene, world: World | None, scales: ArrowScales, shaped: set[str], root: str) -> tuple[str, ...]:
@@ -287,9 +361,17 @@ def _outline_mesh(scene: Scene, body: str, scales: ArrowScales) -> tuple[FloatAr
     if scene.dimension == 2:
         polygon = convex_hull(points[:, :2])
         points = np.vstack([np.column_stack([polygon, np.full(len(polygon), z)]) for z in (-thickness, thickness)])
-    elif len(points) < 4:  # a point, a segment or a triangle: thickened along the axes so that it shows
-        points = np.vstack([points + offset for offset in thickness * np.vstack([np.eye(3), -np.eye(3)])])
+    else:
+        points = _thickened(points, scales)
     return _hull_mesh(points)
+
+
+def _thickened(points: FloatArray, scales: ArrowScales) -> FloatArray:
+    """A point, a segment or a triangle thickened along the axes so that its hull exists and shows."""
+    if len(points) >= 4:
+        return points
+    thickness = _PLANE_SHARE * scales.size
+    return np.vstack([points + offset for offset in thickness * np.vstack([np.eye(3), -np.eye(3)])])
 
 
 def _floor(halfspace: Halfspace, pose: Pose, scales: ArrowScales) -> tuple[FloatArray, np.ndarray]:
@@ -310,11 +392,17 @@ def _floor(halfspace: Halfspace, pose: Pose, scales: ArrowScales) -> tuple[Float
 
 def _draw_contacts(api: Any, scene: Scene, motion: Motion | None, scales: ArrowScales, root: str) -> tuple[str, ...]:
     modes = [None] * len(scene.contacts) if motion is None else list(motion.modes)
+    balls = [(lifted(c.point), c.body, c.other, mode) for c, mode in zip(scene.contacts, modes, strict=True)]
+    return _contact_balls(api, balls, scales, root)
+
+
+def _contact_balls(api: Any, balls: Sequence[tuple[FloatArray, str, str, str | None]], scales: ArrowScales, root: str) -> tuple[str, ...]:
+    """A ball per (point, body, other, mode) in the colour of its mode (grey: no mode)."""
     names = []
-    for index, (contact, mode) in enumerate(zip(scene.contacts, modes, strict=True)):
-        name = f"{root}/contacts/{index}_{contact.body}-{contact.other}"
+    for index, (point, body, other, mode) in enumerate(balls):
+        name = f"{root}/contacts/{index}_{body}-{other}"
         colour = NO_MOTION_COLOUR if mode is None else MODE_COLOURS[mode]
-        api.add_icosphere(name, radius=_DOT_SHARE * scales.size, color=rgb(colour), position=tuple(lifted(contact.point)), **_NO_SHADOW)
+        api.add_icosphere(name, radius=_DOT_SHARE * scales.size, color=rgb(colour), position=tuple(point), **_NO_SHADOW)
         names.append(name)
     return tuple(names)
 

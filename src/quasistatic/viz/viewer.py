@@ -14,41 +14,30 @@ client with the scene embedded), which opens without a server.
 from __future__ import annotations
 
 import dataclasses
-import io
 import os
-import socket
 import threading
-from collections.abc import Iterator, Mapping
-from contextlib import contextmanager, redirect_stdout
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 
 from ..adapters import World
-from ..errors import BackendUnavailableError, QuasistaticError
+from ..errors import QuasistaticError, SceneError
 from ..model import Mover, Robot, Scene
+from ..sim import Trajectory
 from ..solution import Motion, Solution
 from ..solve import solve, with_detection
+from .geometry import VIEWS
 from .scene3d import ArrowScales, DrawnFrame, draw_frame
+from .server import VIEWER_INSTALL_HINT, place_camera, require_viser, start_server, stop_server, url_of
 from .style import headline
+from .timeline import TrajectoryViewer, view_trajectory
 
 __all__ = ["VIEWER_INSTALL_HINT", "Velocities", "Viewer", "require_viser", "view"]
 
-VIEWER_INSTALL_HINT = 'install viser with pip install "quasistatic[viewer]"'
 _SLIDER_STEPS = 200  # steps across a slider's range
-_AMBIENT = 1.0  # ambient light: alone, it shows every colour flat
-_KEY = 0.5  # a directional light from above the camera: it shades the faces of a shape apart
-_CAMERA_DISTANCE = 1.2  # the camera starts this many scene sizes from the scene's centre
-
-
-def require_viser() -> None:
-    """Raise :class:`BackendUnavailableError` with the install line when viser is missing."""
-    try:
-        import viser  # noqa: F401
-    except ImportError as exc:
-        raise BackendUnavailableError("viser", VIEWER_INSTALL_HINT, needed_for="the viewer") from exc
 
 
 @dataclass(frozen=True)
@@ -115,7 +104,7 @@ class Viewer:
         The scene-tree names of the frame on show.
     """
 
-    def __init__(self, server: Any, solution: Solution, scene: Scene | World, method: str) -> None:
+    def __init__(self, server: Any, solution: Solution, scene: Scene | World, method: str, camera: str = "iso") -> None:
         self.server = server
         self.method = method
         self.world = scene if isinstance(scene, World) else None
@@ -129,14 +118,13 @@ class Viewer:
         self._motion_choice.on_update(lambda _: self._redraw())
         joints = {r.name: r.joint_labels() for r in self.scene.robots}
         self._sliders = _add_sliders(server, self.velocities, joints, self._on_slider)
-        self._place_camera()
+        self._place_camera(camera)
         self.drawn = self._show(solution)
 
     @property
     def url(self) -> str:
         """The address to open in a browser."""
-        host = self.server.get_host()
-        return f"http://{'localhost' if host in ('0.0.0.0', '::') else host}:{self.server.get_port()}"
+        return url_of(self.server)
 
     @property
     def motions(self) -> list[Motion]:
@@ -190,8 +178,7 @@ class Viewer:
             self.stop()
 
     def stop(self) -> None:
-        with _quiet(True):  # viser says "Server stopped" on stdout
-            self.server.stop()
+        stop_server(self.server)
 
     # ----------------------------------------------------------------- drawing
 
@@ -214,16 +201,9 @@ class Viewer:
             self.drawn = draw_frame(self.server.scene, self.scene, motion, self._scales, self.world)
             return self.drawn
 
-    def _place_camera(self) -> None:
+    def _place_camera(self, view: str) -> None:
         scales = ArrowScales.of(self.solution, self.scene, self.world)
-        camera = self.server.initial_camera
-        if self.scene.dimension == 2:  # looking down on the plane, y up
-            camera.position = tuple(scales.centre + [0.0, 0.0, 2 * _CAMERA_DISTANCE * scales.size])
-            camera.up = (0.0, 1.0, 0.0)
-        else:  # the pictures' isometric view: from (1, -1, 1), z up
-            camera.position = tuple(scales.centre + _CAMERA_DISTANCE * scales.size * np.array([1.0, -1.0, 1.0]))
-            camera.up = (0.0, 0.0, 1.0)
-        camera.look_at = tuple(scales.centre)
+        place_camera(self.server, scales.centre, scales.size, self.scene.dimension, view)
 
     def _on_slider(self) -> None:
         """A slider moved: re-solve; a failure is shown in the status text (the server keeps running)."""
@@ -281,51 +261,54 @@ def _status_text(solution: Solution, scales: ArrowScales) -> str:
     return "\n\n".join(lines)
 
 
-@contextmanager
-def _quiet(enabled: bool) -> Iterator[None]:
-    """What viser prints to stdout, dropped (the command prints its own line with the address)."""
-    if not enabled:
-        yield
-        return
-    with redirect_stdout(io.StringIO()):
-        yield
-
-
-def _light(api: Any) -> None:
-    """Even light, no environment reflections: a part's colour on screen stays near its colour in the pictures."""
-    api.configure_environment_map(hdri=None)
-    api.configure_default_lights(enabled=False)
-    api.add_light_ambient("/lights/ambient", intensity=_AMBIENT)
-    api.add_light_directional("/lights/key", intensity=_KEY, position=(1.0, -1.0, 2.0))
-
-
-def _check_listen(host: str, port: int) -> None:
-    """Fail early, with the field named, where the server could not listen (viser would retry other ports forever)."""
-    if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
-        raise ValueError(f"port: {port!r} is not a port number (0 to 65535; 0 picks a free one)")
-    try:
-        family, kind, _, _, address = socket.getaddrinfo(host, None, type=socket.SOCK_STREAM)[0]
-        with socket.socket(family, kind) as probe:
-            probe.bind((address[0], 0))
-    except (OSError, UnicodeError) as exc:
-        raise ValueError(f"host: cannot listen on {host!r}: {exc}") from exc
-
-
+@overload
 def view(
-    solution: Solution, scene: Scene | World, *, host: str = "127.0.0.1", port: int = 8080, method: str = "auto", verbose: bool = False
-) -> Viewer:
-    """Show a solution on its scene in a viser server (returns at once; ``.wait()`` blocks, ``.stop()`` ends it).
+    answer: Solution,
+    scene: Scene | World,
+    *,
+    host: str = ...,
+    port: int = ...,
+    method: str = ...,
+    camera: str = ...,
+    verbose: bool = ...,
+) -> Viewer: ...
+@overload
+def view(
+    answer: Trajectory,
+    scene: World | None = None,
+    *,
+    host: str = ...,
+    port: int = ...,
+    method: str = ...,
+    camera: str = ...,
+    verbose: bool = ...,
+) -> TrajectoryViewer: ...
+def view(
+    answer: Solution | Trajectory,
+    scene: Scene | World | None = None,
+    *,
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    method: str = "auto",
+    camera: str = "iso",
+    verbose: bool = False,
+) -> Viewer | TrajectoryViewer:
+    """Show a solution on its scene, or a simulated run with a timeline, in a viser server (returns at once;
+    ``.wait()`` blocks, ``.stop()`` ends it).
 
     Parameters
     ----------
-    solution : Solution
-        The answer to show.
+    answer : Solution or Trajectory
+        The answer to show, or a run (:func:`quasistatic.viz.timeline.view_trajectory`: a timeline of its states).
     scene : Scene or World
-        The scene it answers; a World's shapes and URDF robot links are drawn too.
+        The scene it answers; a World's shapes and URDF robot links are drawn too. For a Trajectory: the World
+        it was run on (by default the scene file it names, read again).
     host, port : str, int
         Where the server listens (viser takes the next free port when ``port`` is taken: see :attr:`Viewer.url`).
     method : str
-        The solver used when a slider re-solves.
+        The solver used when a slider re-solves (a Trajectory is drawn, never solved).
+    camera : str
+        Where the camera starts, for a 3-D scene: one of the pictures' views (``iso``, ``xy``, ``xz``, ``yz``).
     verbose : bool
         Let viser print its own banner.
 
@@ -334,12 +317,12 @@ def view(
     BackendUnavailableError
         When viser (the ``viewer`` extra) is not installed.
     """
-    require_viser()
-    import viser
-
-    _check_listen(host, port)
-    with _quiet(not verbose):  # viser prints a banner whatever its own verbose says
-        server = viser.ViserServer(host=host, port=port, verbose=verbose)
-    server.gui.configure_theme(control_width="large")
-    _light(server.scene)
-    return Viewer(server, solution, scene, method)
+    if isinstance(answer, Trajectory):
+        if scene is not None and not isinstance(scene, World):
+            raise SceneError("scene", type(scene).__name__, "a trajectory is drawn on the World of shapes it was run on")
+        return view_trajectory(answer, scene, host=host, port=port, camera=camera, verbose=verbose)
+    if scene is None:
+        raise SceneError("scene", "None", "a Solution is drawn on the Scene or World it answers")
+    if camera not in VIEWS:
+        raise ValueError(f"view: {camera!r} is not one of {', '.join(VIEWS)}")
+    return Viewer(start_server(host, port, verbose), answer, scene, method, camera)
