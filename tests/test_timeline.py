@@ -240,3 +240,35 @@ def test_a_notebook_says_why_the_run_is_not_drawn_and_what_is_unproven(run: qs.T
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if the figures extra were not installed
     page = dataclasses.replace(run, scene_file=str(TIP))._repr_html_()
     assert "<img" not in page and "pip install &quot;quasistatic[figures]&quot;" in page and "<table>" in page
+
+
+def test_scene_frames_draw_the_urdf_visual_meshes_and_runs_draw_collision_shapes() -> None:
+    """A robot in a single answer is drawn with its URDF's visual meshes; a run's states with its collision shapes (small recordings)."""
+    from quasistatic.adapters.robot import installed_model_folders
+    from quasistatic.viz.scene3d import ArrowScales, draw_frame
+
+    if not installed_model_folders():
+        pytest.skip("example-robot-data is not installed")
+    from quasistatic.tools.bench.pipeline import allegro_grasp
+
+    class Recorder:
+        """Stands in for viser's scene API: keeps the meshes drawn."""
+
+        def __init__(self) -> None:
+            self.meshes: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+        def add_mesh_simple(self, name: str, vertices: np.ndarray, faces: np.ndarray, **_: object) -> None:
+            self.meshes[name] = (np.asarray(vertices), np.asarray(faces))
+
+        def __getattr__(self, _: str) -> object:
+            return lambda *args, **kwargs: None
+
+    world, _ = allegro_grasp()
+    scene = world.scene()
+    solution = qs.solve(scene)
+    recorder = Recorder()
+    drawn = draw_frame(recorder, scene, solution.motion, ArrowScales.of(solution, scene, world), world)
+    hand = world.robots[0]
+    assert len(drawn.robot_links) == len(hand.visuals) == 21
+    triangles = sum(len(recorder.meshes[name][1]) for name in drawn.robot_links)
+    assert triangles == sum(len(v.faces) for v in hand.visuals if v.faces is not None) > 20_000

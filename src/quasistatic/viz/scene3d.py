@@ -9,8 +9,11 @@ frames of one answer share them.
 
 Everything drawn is the Solution's own numbers or the Scene's geometry: the
 outline of a body known only by its contact points is their convex hull, and a
-robot link is its collision shape at the configuration (a mesh: its convex
-hull, as contact detection sees it). No physics is computed here.
+robot link is drawn with the URDF's visual meshes at the configuration (in their
+colours), or its collision shapes when the URDF has none. A run's states
+(:func:`draw_state`) draw the collision shapes: a recording keeps every frame,
+and the visual meshes (tens of thousands of triangles per hand) would make it
+hundreds of megabytes. No physics is computed here.
 """
 
 from __future__ import annotations
@@ -177,7 +180,7 @@ def draw_frame(
     shaped = {p.name for p in parts if p.shape is not None}
     bodies = _draw_bodies(api, scene, world, scales, shaped, root)
     movers = _draw_movers(api, world, scales, root)
-    links = _draw_robot_links(api, world, root)
+    links = _draw_robot_links(api, world, root, visual=True)
     contacts = _draw_contacts(api, scene, motion, scales, root)
     forces, slips, twists = _draw_arrows(api, scene, motion, scales, root) if motion is not None else ((), (), ())
     return DrawnFrame(root, bodies, movers, links, contacts, forces, slips, twists)
@@ -260,11 +263,23 @@ def _draw_movers(api: Any, world: World | None, scales: ArrowScales, root: str) 
     return tuple(names)
 
 
-def _draw_robot_links(api: Any, world: World | None, root: str) -> tuple[str, ...]:
-    """Every collision shape of every URDF robot's links at its configuration, translucent."""
+def _draw_robot_links(api: Any, world: World | None, root: str, visual: bool = False) -> tuple[str, ...]:
+    """Every URDF robot's links at its configuration, translucent: its visual meshes (``visual``) if any, else its collision shapes."""
     names = []
     for robot in [] if world is None else world.robots:
-        for index, collider in enumerate(robot.colliders):
+        visuals = robot.visuals if visual else ()
+        for index, part in enumerate(visuals):
+            name = f"{root}/robots/{robot.name}/{part.link}_{index}"
+            if part.vertices is not None and part.faces is not None:
+                vertices, faces = part.vertices, part.faces
+            elif part.shape is not None:
+                vertices, faces = _local_mesh(part.shape)
+            else:
+                continue
+            colour = tuple(int(round(255 * c)) for c in part.colour[:3])
+            api.add_mesh_simple(name, vertices, faces, color=colour, opacity=0.6, **_NO_SHADOW, **_placement(part.pose))
+            names.append(name)
+        for index, collider in enumerate(() if visuals else robot.colliders):
             name = f"{root}/robots/{robot.name}/{collider.link}_{index}"
             vertices, faces = _local_mesh(collider.shape)
             api.add_mesh_simple(name, vertices, faces, color=rgb(ROBOT_FILL), opacity=0.6, **_NO_SHADOW, **_placement(collider.pose))
