@@ -101,6 +101,10 @@ def test_tipping_box_turns_at_the_hand_derived_rate(tipping: Trajectory) -> None
     first = tipping.steps[1]
     modes = {(c.other, c.mode) for c in first.contacts}
     assert modes == {("finger", "sliding"), ("table", "rolling")}  # it pivots on its front edge; the tip slides up the face
+    for contact in first.contacts:  # the fingertip slides up the face (tangent to it); the edge does not slip
+        speed = float(np.linalg.norm(contact.slip))
+        assert (speed > 1e-3) if contact.other == "finger" else (speed == 0.0)
+        assert abs(float(contact.slip @ contact.normal)) < 1e-9
 
 
 def test_penetration_is_corrected_and_does_not_accumulate(tipping: Trajectory) -> None:
@@ -217,6 +221,7 @@ def test_trajectory_files_read_back_the_same(tipping: Trajectory, tmp_path: Path
     for a, b in zip(again.steps, tipping.steps, strict=True):
         assert (a.status, a.dt, [c.mode for c in a.contacts]) == (b.status, b.dt, [c.mode for c in b.contacts])
         np.testing.assert_array_equal(a.twists["box"], b.twists["box"])
+        np.testing.assert_array_equal([c.slip for c in a.contacts], [c.slip for c in b.contacts])
 
 
 def test_a_file_that_is_not_a_trajectory_is_refused(tmp_path: Path) -> None:

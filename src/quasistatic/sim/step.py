@@ -85,7 +85,11 @@ class SimModel:
 
 @dataclass(frozen=True)
 class ContactRecord:
-    """One contact at one instant: where, its normal (into ``body``), gap, force on ``body`` and mode."""
+    """One contact at one instant: where, its normal (into ``body``), gap, force on ``body``, mode, and slip.
+
+    ``slip``: the velocity of ``body``'s material point relative to ``other``'s, in the tangent plane
+    (zero unless sliding; zero where there is no motion) [length/time].
+    """
 
     body: str
     other: str
@@ -94,6 +98,7 @@ class ContactRecord:
     gap: float
     force: FloatArray
     mode: Mode | None  # None where the answer has no motion (jammed, unstable, failed)
+    slip: FloatArray = field(default_factory=lambda: np.zeros(3))
 
 
 @dataclass(frozen=True)
@@ -135,7 +140,7 @@ class Evaluation:
             )
         results = self.motion.contacts
         return tuple(
-            ContactRecord(c.body, c.other, c.point, c.normal, g, np.asarray(r.force, dtype=float), r.mode)
+            ContactRecord(c.body, c.other, c.point, c.normal, g, np.asarray(r.force, dtype=float), r.mode, np.asarray(r.slip, dtype=float))
             for c, g, r in zip(contacts, self.detection.gaps, results, strict=True)
         )
 

@@ -244,6 +244,7 @@ def _step_dict(step: StepResult) -> dict[str, Any]:
                 "gap": c.gap,
                 "force": _floats(c.force),
                 "mode": c.mode,
+                "slip": _floats(c.slip),
             }
             for c in step.contacts
         ],
@@ -257,7 +258,16 @@ def _step_dict(step: StepResult) -> dict[str, Any]:
 
 def _step_from(data: dict[str, Any]) -> StepResult:
     contacts = tuple(
-        ContactRecord(c["body"], c["other"], np.array(c["point"]), np.array(c["normal"]), float(c["gap"]), np.array(c["force"]), c["mode"])
+        ContactRecord(
+            c["body"],
+            c["other"],
+            np.array(c["point"]),
+            np.array(c["normal"]),
+            float(c["gap"]),
+            np.array(c["force"]),
+            c["mode"],
+            np.array(c.get("slip", (0.0, 0.0, 0.0)), dtype=float),  # files written before slips were kept
+        )  # fmt: skip
         for c in data["contacts"]
     )
     events = tuple(

@@ -207,6 +207,7 @@ def draw_state(api: Any, world: World, step: StepResult, scales: ArrowScales, la
     links = _draw_robot_links(api, world, root)
     contacts = _contact_balls(api, [(c.point, c.body, c.other, c.mode) for c in step.contacts], scales, root)
     forces = [(f"{root}/forces/{i}", c.point, c.force * scales.force) for i, c in enumerate(step.contacts)]
+    slips = [(f"{root}/slips/{i}", c.point, c.slip * scales.velocity) for i, c in enumerate(step.contacts)]
     coms = {b.name: b.body().com for b in world.bodies}
     twists = [
         (f"{root}/twists/{n}", coms[n], np.asarray(t, dtype=float)[:3] * scales.velocity) for n, t in step.twists.items() if n in coms
@@ -215,8 +216,9 @@ def draw_state(api: Any, world: World, step: StepResult, scales: ArrowScales, la
         above = scales.centre + np.array([0.0, 0.0, 0.5 * scales.size])
         api.add_label(f"{root}/label", label, position=tuple(above))
     return DrawnFrame(
-        root, bodies, movers, links, contacts, _arrows(api, forces, FORCE_COLOUR, scales), (), _arrows(api, twists, TWIST_COLOUR, scales)
-    )
+        root, bodies, movers, links, contacts, _arrows(api, forces, FORCE_COLOUR, scales), _arrows(api, slips, SLIP_COLOUR, scales),
+        _arrows(api, twists, TWIST_COLOUR, scales),
+    )  # fmt: skip
 
 
 # --------------------------------------------------------------------------- parts
