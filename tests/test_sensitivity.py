@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import quasistatic as qs
-from quasistatic.laws.inputs import Inputs
+from quasistatic.laws.inputs import InputVector
 from random_scenes import random_scene
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -22,7 +22,7 @@ def _stacked(solution: qs.Solution) -> tuple[np.ndarray, np.ndarray]:
 
 def _central_difference(scene: qs.Scene, j: int, h: float) -> tuple[np.ndarray, np.ndarray] | None:
     """(d twist, d forces) per unit of input j by central differences of the forward solve; None if a side is not solved."""
-    inputs = Inputs.of(scene)
+    inputs = InputVector.of(scene)
     values = inputs.values(scene)
     sides = []
     for sign in (1.0, -1.0):
@@ -101,7 +101,7 @@ def test_the_margin_is_exact_in_2d() -> None:
     mode boundary: the sensitivity then refuses with the reason."""
     checked = 0
     for scene, solution, result in _differentiable(2):
-        inputs = Inputs.of(scene)
+        inputs = InputVector.of(scene)
         values = inputs.values(scene)
         for j, margin in enumerate(result.margins):
             if not np.isfinite(margin.above) or margin.above > 1.0:

@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion
 from .laws import assemble
-from .laws.inputs import Inputs
+from .laws.inputs import InputVector
 from .model import FloatArray, Scene
 from .solution import Mode, Motion, Solution
 from .solve import solve
@@ -135,7 +135,7 @@ def plan(
         Audit threshold on every scene-relative residual [-].
     """
     wanted_modes = _checked_modes(scene, modes)
-    selection = Inputs.of(scene, _checked_free(scene, free))
+    selection = InputVector.of(scene, _checked_free(scene, free))
     base = selection.apply(scene, np.zeros(selection.size))
     problem = assemble(base)
     if scene.dimension == 3 and scene.friction.kind == "pyramid":

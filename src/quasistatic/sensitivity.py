@@ -1,7 +1,7 @@
 """``sensitivity(scene)``: the exact derivative of a solved motion with respect to the commanded inputs.
 
 The inputs are the robots' joint velocities and the rigid movers' twists
-(:class:`~quasistatic.laws.inputs.Inputs`). Within the motion's contact modes
+(:class:`~quasistatic.laws.inputs.InputVector`). Within the motion's contact modes
 the laws are smooth equations (:mod:`quasistatic.laws.fixed_modes`); their
 implicit-function derivative (:mod:`quasistatic.laws.sensitivity`) gives every
 body twist's and contact force's rate per unit of each input, and the mode
@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from .laws import Problem, assemble
-from .laws.inputs import Inputs
+from .laws.inputs import InputVector
 from .laws.modes import ModeMasks
 from .laws.sensitivity import Boundary, FixedModeDerivative, Singular, ball_radius, boundaries, crossing, fixed_mode_derivative
 from .model import FloatArray, Scene
@@ -178,7 +178,7 @@ def sensitivity(scene: Scene, solution: Solution | None = None, *, inputs: Colle
     -------
     Sensitivity, or NoSensitivity with the reason there is none.
     """
-    selection = Inputs.of(scene, _checked_owners(scene, inputs))
+    selection = InputVector.of(scene, _checked_owners(scene, inputs))
     if scene.friction.kind == "pyramid":
         reason = "pyramid friction in 3-D slides along the pyramid's faces, not the fixed-mode laws' circle; use friction 'exact'"
         return NoSensitivity(NoSensitivityReason.UNSUPPORTED_FRICTION, reason)
@@ -243,7 +243,7 @@ def _relative_motion(problem: Problem, solution: Solution) -> tuple[FloatArray, 
     return q, np.einsum("mst,mt->ms", problem.frames, forces) / problem.scales.force
 
 
-def _input_map(problem: Problem, selection: Inputs) -> FloatArray:
+def _input_map(problem: Problem, selection: InputVector) -> FloatArray:
     """d b / d p: the movers' scene-relative point velocities in contact frames per physical input unit, (m, d, P)."""
     W = selection.point_velocity_map(problem.scene)
     return np.einsum("mst,mtP->msP", problem.frames, W) / problem.scales.velocity
@@ -251,7 +251,7 @@ def _input_map(problem: Problem, selection: Inputs) -> FloatArray:
 
 def _physical(
     problem: Problem,
-    selection: Inputs,
+    selection: InputVector,
     derivative: FixedModeDerivative,
     limits: list[Boundary],
     masks: ModeMasks,

@@ -2,7 +2,7 @@
 
 Sensitivities differentiate with respect to this vector and the planner solves
 for part of it. Each contact's mover point velocity is linear in it
-(:meth:`Inputs.point_velocity_map`), which is all the contact laws see of it.
+(:meth:`InputVector.point_velocity_map`), which is all the contact laws see of it.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 from ..model import FloatArray, Mover, Robot, Scene
 from ..model.kinematics import cross
 
-__all__ = ["Input", "Inputs", "twist_components"]
+__all__ = ["Input", "InputVector", "twist_components"]
 
 
 def twist_components(dimension: int) -> tuple[str, ...]:
@@ -38,13 +38,13 @@ class Input:
 
 
 @dataclass(frozen=True)
-class Inputs:
+class InputVector:
     """An ordered selection of a scene's inputs [joint: rad/time or length/time; twist: length/time, rad/time]."""
 
     entries: tuple[Input, ...]
 
     @classmethod
-    def of(cls, scene: Scene, owners: Collection[str] | None = None) -> Inputs:
+    def of(cls, scene: Scene, owners: Collection[str] | None = None) -> InputVector:
         """Every robot's joints (scene order), then every rigid mover's twist; only ``owners`` (names) when given."""
         entries: list[Input] = []
         for robot in scene.robots:
