@@ -19,7 +19,7 @@ from contextlib import contextmanager
 from dataclasses import replace
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, NoReturn, TypeVar
+from typing import TYPE_CHECKING, Annotated, Any, NoReturn, TypeVar
 
 import typer
 from rich.console import Console
@@ -36,6 +36,9 @@ from .solution import Mode, Solution
 from .solve import METHODS, solve, with_detection
 from .solvers import SearchProgress
 from .sweeps import SweepResult
+
+if TYPE_CHECKING:
+    from .sim import Trajectory
 
 __all__ = ["app", "main"]
 
@@ -304,7 +307,6 @@ def simulate(
     ] = True,
 ) -> None:
     """Follow a scene of shapes or URDF robots over time: contacts found again and a certified solve at every step (docs/simulation.md)."""
-    from .sim import Trajectory
     from .sim import simulate as run
 
     policies = {"stop": "stop", "min-power": "min_power", "min_power": "min_power"}
@@ -345,12 +347,7 @@ def animate(
         _fail(f"--view {view!r} is not one of {', '.join(VIEWS)}")
     _guarded(require_matplotlib)
     trajectory = _guarded(lambda: Trajectory.load(trajectory_file))
-    source = scene or (Path(trajectory.scene_file) if trajectory.scene_file else None)
-    if source is None:
-        _fail(f"{str(trajectory_file)!r} names no scene file (it was run on a World built in Python): give --scene")
-    world = _guarded(lambda: load_world(source))
-    if not isinstance(world, World):
-        _fail(f"--scene {str(source)!r} lists its contacts: a trajectory is run on a scene of shapes")
+    world = _run_world(trajectory_file, trajectory, scene)
     try:
         _guarded(lambda: draw(trajectory, world, output, view=view, fps=fps))
     except OSError as exc:
@@ -417,19 +414,9 @@ def view(
     viewer = _guarded(
         lambda: show(solution, world or answered, host=host, port=0 if export is not None else port, method=method, camera=view)
     )
+    _serve_or_export(viewer, export, solution.status)
     if export is not None:
-        try:
-            viewer.export_html(export)
-        except OSError as exc:
-            _fail(f"cannot write {str(export)!r}: {exc.strerror or exc}")
-        finally:
-            viewer.stop()
-        typer.echo(f"wrote {export}: {solution.status}")
         raise typer.Exit(1 if solution.status == "failed" else 0)
-    typer.echo(
-        f"viewer at {viewer.url} ({solution.status}); press Ctrl-C to stop",
-    )
-    viewer.wait()
 
 
 _TRAJECTORY_FORMATS = (".npz", ".jsonl")
@@ -441,28 +428,37 @@ def _view_trajectory(trajectory_file: Path, scene: Path | None, host: str, port:
     from .viz import view_trajectory
 
     trajectory = _guarded(lambda: Trajectory.load(trajectory_file))
-    if scene is not None:
-        loaded = _guarded(lambda: load_world(scene))
-        if not isinstance(loaded, World):
-            _fail(f"--scene {str(scene)!r} lists its contacts: a trajectory is run on a scene of shapes")
-        world = loaded
-    elif not trajectory.scene_file:
-        _fail(f"{str(trajectory_file)!r} names no scene file (it was run on a World built in Python): give --scene")
-    else:
-        world = _guarded(trajectory.scene_world)
+    world = _run_world(trajectory_file, trajectory, scene)
     viewer = _guarded(lambda: view_trajectory(trajectory, world, host=host, port=0 if export is not None else port, camera=camera))
     summary = f"{len(trajectory.states)} states, {trajectory.status}" + ("" if trajectory.certified else ", NOT proven")
-    if export is not None:
-        try:
-            viewer.export_html(export)
-        except OSError as exc:
-            _fail(f"cannot write {str(export)!r}: {exc.strerror or exc}")
-        finally:
-            viewer.stop()
-        typer.echo(f"wrote {export}: {summary}")
+    _serve_or_export(viewer, export, summary)
+
+
+def _run_world(trajectory_file: Path, trajectory: Trajectory, scene: Path | None) -> World:
+    """The World a run is drawn on: ``--scene``, or the scene file the trajectory names."""
+    if scene is None:
+        if not trajectory.scene_file:
+            _fail(f"{str(trajectory_file)!r} names no scene file (it was run on a World built in Python): give --scene")
+        return _guarded(trajectory.scene_world)
+    loaded = _guarded(lambda: load_world(scene))
+    if not isinstance(loaded, World):
+        _fail(f"--scene {str(scene)!r} lists its contacts: a trajectory is run on a scene of shapes")
+    return loaded
+
+
+def _serve_or_export(viewer: Any, export: Path | None, summary: str) -> None:
+    """Write the view to ``export`` and stop the server, or print the address and serve until Ctrl-C."""
+    if export is None:
+        typer.echo(f"viewer at {viewer.url} ({summary}); press Ctrl-C to stop")
+        viewer.wait()
         return
-    typer.echo(f"viewer at {viewer.url} ({summary}); press Ctrl-C to stop")
-    viewer.wait()
+    try:
+        viewer.export_html(export)
+    except OSError as exc:
+        _fail(f"cannot write {str(export)!r}: {exc.strerror or exc}")
+    finally:
+        viewer.stop()
+    typer.echo(f"wrote {export}: {summary}")
 
 
 @app.command()

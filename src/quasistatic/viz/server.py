@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import io
 import socket
-from collections.abc import Iterator
+import threading
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager, redirect_stdout
 from typing import Any
 
@@ -17,7 +18,16 @@ import numpy as np
 from ..errors import BackendUnavailableError
 from .geometry import VIEWS, FloatArray
 
-__all__ = ["VIEWER_INSTALL_HINT", "place_camera", "quiet", "require_viser", "start_server", "stop_server", "url_of"]
+__all__ = [
+    "VIEWER_INSTALL_HINT",
+    "place_camera",
+    "quiet",
+    "require_viser",
+    "serve_until_interrupted",
+    "start_server",
+    "stop_server",
+    "url_of",
+]
 
 VIEWER_INSTALL_HINT = 'install viser with pip install "quasistatic[viewer]"'
 _AMBIENT = 1.0  # ambient light: alone, it shows every colour flat
@@ -49,6 +59,16 @@ def start_server(host: str, port: int, verbose: bool) -> Any:
 def stop_server(server: Any) -> None:
     with quiet(True):  # viser says "Server stopped" on stdout
         server.stop()
+
+
+def serve_until_interrupted(stop: Callable[[], None]) -> None:
+    """Block until Ctrl-C (the server runs in its own threads), then ``stop``."""
+    try:
+        threading.Event().wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        stop()
 
 
 def url_of(server: Any) -> str:

@@ -26,7 +26,7 @@ from ..sim import State, StepResult, Trajectory
 from .animation import check_run_names, frame_indices
 from .geometry import VIEWS
 from .scene3d import ArrowScales, DrawnFrame, draw_state
-from .server import place_camera, start_server, stop_server, url_of
+from .server import place_camera, serve_until_interrupted, start_server, stop_server, url_of
 
 __all__ = ["MAX_EXPORT_FRAMES", "TrajectoryViewer", "view_trajectory"]
 
@@ -151,12 +151,7 @@ class TrajectoryViewer:
 
     def wait(self) -> None:
         """Block until Ctrl-C, then stop the server."""
-        try:
-            threading.Event().wait()
-        except KeyboardInterrupt:
-            pass
-        finally:
-            self.stop()
+        serve_until_interrupted(self.stop)
 
     def stop(self) -> None:
         self.pause()

@@ -31,7 +31,7 @@ from ..solution import Motion, Solution
 from ..solve import solve, with_detection
 from .geometry import VIEWS
 from .scene3d import ArrowScales, DrawnFrame, draw_frame
-from .server import VIEWER_INSTALL_HINT, place_camera, require_viser, start_server, stop_server, url_of
+from .server import VIEWER_INSTALL_HINT, place_camera, require_viser, serve_until_interrupted, start_server, stop_server, url_of
 from .style import headline
 from .timeline import TrajectoryViewer, view_trajectory
 
@@ -170,12 +170,7 @@ class Viewer:
 
     def wait(self) -> None:
         """Block until Ctrl-C, then stop the server."""
-        try:
-            threading.Event().wait()
-        except KeyboardInterrupt:
-            pass
-        finally:
-            self.stop()
+        serve_until_interrupted(self.stop)
 
     def stop(self) -> None:
         stop_server(self.server)
