@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import importlib
 import json
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -12,6 +15,9 @@ from typer.testing import CliRunner
 
 import quasistatic as qs
 from quasistatic import cli
+
+# the module (the package's attribute `solve` is the function): the CLI imports `solve` from it when a command solves
+solve_module = importlib.import_module("quasistatic.solve")
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
@@ -155,7 +161,7 @@ def test_modes_and_options_are_passed_to_solve(monkeypatch: pytest.MonkeyPatch) 
         seen.update(kwargs)
         return real_solve(scene, method=kwargs["method"], max_solutions=kwargs["max_solutions"])
 
-    monkeypatch.setattr(cli, "solve", spy)
+    monkeypatch.setattr(solve_module, "solve", spy)
     args = ("--modes", "rolling, rolling,free,SLIDING", "--method", "lp", "--max-solutions", "3", "--time-limit", "7.5")
     result = invoke("solve", DEMO, *args)
     assert result.exit_code == 0, result.output
@@ -177,7 +183,7 @@ def test_modes_and_options_are_passed_to_solve(monkeypatch: pytest.MonkeyPatch) 
 
 def test_failed_status_exits_1(monkeypatch: pytest.MonkeyPatch) -> None:
     failed = qs.Solution("failed", "failed: the backend gave up", "lp", "exact")
-    monkeypatch.setattr(cli, "solve", lambda scene, **kwargs: failed)
+    monkeypatch.setattr(solve_module, "solve", lambda scene, **kwargs: failed)
     result = invoke("solve", DEMO)
     assert result.exit_code == 1
     assert "status: failed" in result.stdout
@@ -343,3 +349,27 @@ def test_every_documented_command_is_registered_and_answers_help() -> None:
     assert result.returncode == 0
     shown = set(re.findall(r"^\W*([a-z]+)\s", result.stdout, re.M))
     assert documented <= shown, documented - shown
+
+
+def test_the_command_line_names_the_library_methods() -> None:
+    assert cli.METHODS == qs.METHODS
+
+
+def test_importing_the_package_and_its_cli_loads_no_solver() -> None:
+    """A bad scene file or ``--help`` answers without SciPy, HiGHS, SCIP or numba (the package root is lazy)."""
+    heavy = ("scipy", "highspy", "pyscipopt", "numba", "pinocchio", "coal", "matplotlib")
+    code = f"import sys, quasistatic, quasistatic.cli; print(' '.join(m for m in {heavy!r} if m in sys.modules))"
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert loaded == []
+
+
+def test_submodules_named_like_functions_leave_the_functions_in_place() -> None:
+    code = (
+        "import importlib, quasistatic as qs\n"
+        "for name in ('solve', 'plan', 'sensitivity'):\n"
+        "    importlib.import_module('quasistatic.' + name)\n"
+        "    assert callable(getattr(qs, name)) and not isinstance(getattr(qs, name), type(qs)), name\n"
+        "assert all(hasattr(qs, name) for name in qs.__all__) and set(qs.__all__) <= set(dir(qs))\n"
+        "print('ok')"
+    )
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip() == "ok"

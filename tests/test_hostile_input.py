@@ -11,6 +11,7 @@ checks that loading returns a Scene or raises SceneError, quickly.
 
 from __future__ import annotations
 
+import importlib
 import json
 import math
 import subprocess
@@ -29,6 +30,9 @@ from typer.testing import CliRunner
 import quasistatic as qs
 from quasistatic import cli
 from quasistatic.tolerances import MAX_DEPTH, MAX_FILE_BYTES, MAX_FRICTION, MAX_MAGNITUDE, MAX_VALUES
+
+# the module (the package's attribute `solve` is the function): the CLI imports `solve` from it when a command solves
+solve_module = importlib.import_module("quasistatic.solve")
 
 QUASISTATIC = Path(sys.executable).parent / "quasistatic"
 HANG = 10.0  # [s] a subprocess still running after this has hung: the test fails
@@ -266,7 +270,7 @@ def test_solver_crash_is_one_error_line_and_exit_1(tmp_path: Path, monkeypatch: 
     def crash(scene: qs.Scene, **kwargs: Any) -> qs.Solution:
         raise qs.SolverError("scip", "SCIP failed: error in input data!")
 
-    monkeypatch.setattr(cli, "solve", crash)
+    monkeypatch.setattr(solve_module, "solve", crash)
     result = _runner().invoke(cli.app, ["solve", str(_write(tmp_path / "scene.yaml", GOOD_YAML))])
     assert result.exit_code == 1
     assert result.stderr.splitlines() == ["error: scip: SCIP failed: error in input data!"]
@@ -290,7 +294,7 @@ def test_unexpected_exception_in_main_is_one_line(
     def bug(scene: qs.Scene, **kwargs: Any) -> qs.Solution:
         raise ZeroDivisionError("division by zero")
 
-    monkeypatch.setattr(cli, "solve", bug)
+    monkeypatch.setattr(solve_module, "solve", bug)
     monkeypatch.setattr(sys, "argv", ["quasistatic", "solve", str(_write(tmp_path / "scene.yaml", GOOD_YAML))])
     with pytest.raises(SystemExit) as info:
         cli.main()

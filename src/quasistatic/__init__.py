@@ -2,37 +2,198 @@
 
 Given the motion of a robot and the contacts, predict how grasped or pushed
 objects move, the contact forces and each contact's mode (Trinkle & Hunter).
+
+The root imports its public names lazily (PEP 562): each is imported from its
+module the first time it is read, so the command line answers a bad scene
+file or ``--help`` without first loading SciPy, HiGHS, SCIP and numba.
 """
 
-from .adapters import (
-    Box,
-    Capsule,
-    ContactDetection,
-    Cylinder,
-    FrictionPair,
-    Halfspace,
-    Mesh,
-    Pose,
-    ShapedMover,
-    SolidBody,
-    Sphere,
-    UrdfRobot,
-    World,
-)
-from .batch import solve_many
-from .errors import BackendUnavailableError, QuasistaticError, SceneError, SolverError
-from .laws import Problem, assemble
-from .loading import load_scene, load_world
-from .model import Body, Contact, FrictionModel, Mover, Robot, Scene, Stiffness
-from .plan import PlanResult, QuadraticCost, plan
-from .sensitivity import InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, sensitivity
-from .sim import Inputs, InputTable, Trajectory, simulate
-from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
-from .solve import METHODS, solve
-from .sweeps import SweepResult, sweep
-from .viz import plot, view
+from __future__ import annotations
 
+import importlib
+import sys
+import types
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .adapters import (
+        Box,
+        Capsule,
+        ContactDetection,
+        Cylinder,
+        FrictionPair,
+        Halfspace,
+        Mesh,
+        Pose,
+        ShapedMover,
+        SolidBody,
+        Sphere,
+        UrdfRobot,
+        World,
+    )
+    from .batch import solve_many
+    from .errors import BackendUnavailableError, QuasistaticError, SceneError, SolverError
+    from .laws import Problem, assemble
+    from .loading import load_scene, load_world
+    from .model import Body, Contact, FrictionModel, Mover, Robot, Scene, Stiffness
+    from .plan import PlanResult, QuadraticCost, plan
+    from .sensitivity import InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, sensitivity
+    from .sim import Inputs, InputTable, Trajectory, simulate
+    from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
+    from .solve import METHODS, solve
+    from .sweeps import SweepResult, sweep
+    from .viz import plot, view
 __version__ = "0.1.0"
+
+# public name -> the module (relative to this package) that defines it
+_EXPORTS: dict[str, str] = {
+    **dict.fromkeys(
+        (
+            "Box",
+            "Capsule",
+            "ContactDetection",
+            "Cylinder",
+            "FrictionPair",
+            "Halfspace",
+            "Mesh",
+            "Pose",
+            "ShapedMover",
+            "SolidBody",
+            "Sphere",
+            "UrdfRobot",
+            "World",
+        ),
+        "adapters",
+    ),
+    **dict.fromkeys(("solve_many",), "batch"),
+    **dict.fromkeys(
+        (
+            "BackendUnavailableError",
+            "QuasistaticError",
+            "SceneError",
+            "SolverError",
+        ),
+        "errors",
+    ),
+    **dict.fromkeys(
+        (
+            "Problem",
+            "assemble",
+        ),
+        "laws",
+    ),
+    **dict.fromkeys(
+        (
+            "load_scene",
+            "load_world",
+        ),
+        "loading",
+    ),
+    **dict.fromkeys(
+        (
+            "Body",
+            "Contact",
+            "FrictionModel",
+            "Mover",
+            "Robot",
+            "Scene",
+            "Stiffness",
+        ),
+        "model",
+    ),
+    **dict.fromkeys(
+        (
+            "PlanResult",
+            "QuadraticCost",
+            "plan",
+        ),
+        "plan",
+    ),
+    **dict.fromkeys(
+        (
+            "InputMargin",
+            "ModeChange",
+            "NoSensitivity",
+            "NoSensitivityReason",
+            "Sensitivity",
+            "sensitivity",
+        ),
+        "sensitivity",
+    ),
+    **dict.fromkeys(
+        (
+            "Inputs",
+            "InputTable",
+            "Trajectory",
+            "simulate",
+        ),
+        "sim",
+    ),
+    **dict.fromkeys(
+        (
+            "Attempt",
+            "Audit",
+            "Certificate",
+            "CertificateKind",
+            "ContactResult",
+            "Diagnosis",
+            "Motion",
+            "PowerBalance",
+            "Solution",
+        ),
+        "solution",
+    ),
+    **dict.fromkeys(
+        (
+            "METHODS",
+            "solve",
+        ),
+        "solve",
+    ),
+    **dict.fromkeys(
+        (
+            "SweepResult",
+            "sweep",
+        ),
+        "sweeps",
+    ),
+    **dict.fromkeys(
+        (
+            "plot",
+            "view",
+        ),
+        "viz",
+    ),
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value  # imported once; later reads are plain attribute reads
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))
+
+
+class _Package(types.ModuleType):
+    """The package module, keeping ``solve``, ``plan`` and ``sensitivity`` the functions.
+
+    Each of those names is also a submodule; importing a submodule binds it on
+    its package, which would replace the function the package exports.
+    """
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if isinstance(value, types.ModuleType) and name in _EXPORTS:
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 __all__ = [
     "sensitivity",

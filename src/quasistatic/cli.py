@@ -33,12 +33,11 @@ from .model import Scene
 from .model.io import scene_to_dict
 from .report import make_console, render_contacts, render_solution, render_trajectory
 from .solution import Mode, Solution
-from .solve import METHODS, solve, with_detection
-from .solvers import SearchProgress
-from .sweeps import SweepResult
 
 if TYPE_CHECKING:
     from .sim import Trajectory
+    from .solvers import SearchProgress
+    from .sweeps import SweepResult
 
 __all__ = ["app", "main"]
 
@@ -50,6 +49,9 @@ _MODE_WORDS: dict[str, Mode | None] = {
     "free": None,
 }
 _T = TypeVar("_T")
+# `quasistatic.METHODS`, spelled out so that `--help` and a bad scene file answer without importing the
+# solvers (SciPy, HiGHS, SCIP, numba); tests/test_cli.py checks that the two agree.
+METHODS = ("auto", "lp", "scip", "certified", "paper", "fast")
 
 app = typer.Typer(
     name="quasistatic",
@@ -68,7 +70,7 @@ def demo(as_json: JsonOption = False) -> None:
     """Solve the built-in example (two fingertips lifting a box) and print the result."""
     with resources.as_file(resources.files("quasistatic") / "examples" / DEMO_SCENE) as path:
         scene = _guarded(lambda: load_scene(path))
-    _report(_guarded(lambda: solve(scene, all_solutions=True)), as_json)
+    _report(_solved(scene, None, all_solutions=True), as_json)
 
 
 @app.command("solve")
@@ -99,18 +101,25 @@ def solve_command(
     prescribed = _guarded(lambda: _parse_modes(modes)) if modes is not None else None
     certify = all_solutions and method in ("auto", "scip", "certified")
     with _StatusLine(enabled=not as_json) as status:
-        solution = _guarded(
-            lambda: solve(
-                scene,
-                method=method,
-                modes=prescribed,
-                all_solutions=certify,
-                max_solutions=max_solutions,
-                time_limit=time_limit,
-                progress=status.update,
-            )
+        solution = _solved(
+            scene,
+            detection,
+            method=method,
+            modes=prescribed,
+            all_solutions=certify,
+            max_solutions=max_solutions,
+            time_limit=time_limit,
+            progress=status.update,
         )
-    _report(solution if detection is None else with_detection(solution, detection), as_json)
+    _report(solution, as_json)
+
+
+def _solved(scene: Scene, detection: Detection | None, **options: Any) -> Solution:
+    """The audited ``solve`` of ``scene``, with what detection found; the solvers are imported only here, when needed."""
+    from .solve import solve, with_detection
+
+    solution = _guarded(lambda: solve(scene, **options))
+    return solution if detection is None else with_detection(solution, detection)
 
 
 def _loaded(scene_file: Path) -> tuple[Scene, Detection | None]:
@@ -176,9 +185,7 @@ def plot(
         _fail(f"--view {view!r} is not one of {', '.join(VIEWS)}")
     _guarded(require_matplotlib)
     scene, detection, world = _loaded_world(scene_file)
-    solution = _guarded(lambda: solve(scene, method=method))
-    if detection is not None:
-        solution = with_detection(solution, detection)
+    solution = _solved(scene, detection, method=method)
     figure = _guarded(lambda: draw(solution, world or scene, view=view))
     try:
         save(figure, output)
@@ -408,9 +415,7 @@ def view(
     if scene is not None:
         _fail(f"--scene {str(scene)!r}: only a trajectory (.npz, .jsonl) is drawn on another scene file")
     answered, detection, world = _loaded_world(scene_file)
-    solution = _guarded(lambda: solve(answered, method=method))
-    if detection is not None:
-        solution = with_detection(solution, detection)
+    solution = _solved(answered, detection, method=method)
     viewer = _guarded(
         lambda: show(solution, world or answered, host=host, port=0 if export is not None else port, method=method, camera=view)
     )
