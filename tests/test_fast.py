@@ -492,3 +492,43 @@ def test_sparse_full_column_rank_matches_lapack() -> None:
             if not 0.5 < smallest / tol < 2.0:
                 assert full_column_rank(A, tol) is bool(smallest > tol), (trial, smallest, tol)
     assert not full_column_rank(np.zeros((DENSE_MAX + 5, DENSE_MAX + 1)), 1e-9)  # exactly singular: the LU stops
+
+
+def test_plain_python_twins_equal_the_compiled_kernels() -> None:
+    """Each kernel's whole-array twin (what runs without numba) gives the compiled loops' results to round-off."""
+    pytest.importorskip("numba")
+    from quasistatic.laws import fixed_modes
+    from quasistatic.solvers.numerics import lcp
+    from quasistatic.tools.bench.families import grasp_2d, grasp_3d
+
+    rng = np.random.default_rng(11)
+    for size in (1, 5, 17):
+        A, r = rng.normal(size=(size, size)), rng.normal(size=size)
+        (ok, x), (ok_twin, x_twin) = lcp._linear_solve(A, r), lcp._linear_solve_numpy(A, r)
+        assert ok and ok_twin
+        np.testing.assert_allclose(x_twin, x, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(lcp._newton_step_numpy(A, r), lcp._newton_step(A, r), rtol=1e-8, atol=1e-12)
+    singular = rng.normal(size=(4, 4))
+    singular[3] = singular[0] - 2.0 * singular[1]
+    assert not lcp._linear_solve(singular, r[:4])[0] and not lcp._linear_solve_numpy(singular, r[:4])[0]
+    for scene in (grasp_2d(4, 1), grasp_3d(6, 1), grasp_3d(8, 0)):
+        data = qs.assemble(scene).derived("fast", lcp.LemkeInputs)
+        blocks = lcp._split_rows(data.J, data.b, data.mu, data.frictional)
+        edges = lcp._edges(data.base, rng.uniform(-1, 1, data.frictional.shape[0]), scene.dimension - 1)
+        (Jn, bn, Jt, bt, mu_f), fr = blocks, data.frictional
+        for got, want in zip(
+            lcp._assemble_numpy(Jn, Jt, bn, bt, mu_f, data.g, edges, fr),
+            lcp._assemble(Jn, Jt, bn, bt, mu_f, data.g, edges, fr),
+            strict=True,
+        ):
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-15)
+        m, _, n = data.J.shape
+        kind = rng.integers(0, 3, m).astype(np.int64)  # separating, rolling and sliding contacts mixed
+        column, size = fixed_modes.columns(kind, n, scene.dimension - 1)
+        x = rng.normal(size=size)
+        for got, want in zip(
+            fixed_modes._system_numpy(data.J, data.b, data.mu, data.g, x, kind, column, n),
+            fixed_modes.system(data.J, data.b, data.mu, data.g, x, kind, column, n),
+            strict=True,
+        ):
+            np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-14)

@@ -10,8 +10,9 @@ in 3-D, the two edges in 2-D):
 
 Unknowns ``x``: the twist ``q`` (n), then per closed contact its normal force
 and, when it rolls, its tangential force. The system is square. This module is
-the one place these laws are written: the fast path's Newton iteration (compiled
-with numba), the exact-cone refinement and the paper method's polish all
+the one place these laws are written (once as loops for numba, once as
+whole-array numpy for plain Python; tests keep the two equal): the fast path's
+Newton iteration, the exact-cone refinement and the paper method's polish all
 solve it.
 
 Encoding: ``kind[i]`` is 0 (separating), 1 (rolling, frictional) or 2
@@ -47,7 +48,57 @@ def columns(kind: IntArray, n: int, t: int) -> tuple[IntArray, int]:
     return column, size
 
 
-@njit
+def _system_numpy(
+    J: FloatArray, b: FloatArray, mu: FloatArray, g: FloatArray, x: FloatArray, kind: IntArray, column: IntArray, n: int
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Whole-array twin of :func:`system` for plain Python (numba compiles the loops)."""
+    m, d = J.shape[0], J.shape[1]
+    t = d - 1
+    size = x.shape[0]
+    residual = np.zeros(size)
+    jacobian = np.zeros((size, size))
+    forces = np.zeros((m, d))
+    residual[:n] = g
+    q = x[:n]
+    for i in range(m):
+        if kind[i] == SEPARATING:
+            continue
+        rows = J[i]  # (d, n): the contact's tangent rows, then its normal row
+        velocity = rows @ q - b[i]
+        col = column[i]
+        cn = x[col]
+        forces[i, t] = cn
+        # Closed: no normal velocity; the normal force enters equilibrium.
+        residual[col] = velocity[t]
+        jacobian[col, :n] = rows[t]
+        jacobian[:n, col] += rows[t]
+        if kind[i] == ROLLING:
+            forces[i, :t] = x[col + 1 : col + 1 + t]
+            residual[col + 1 : col + 1 + t] = velocity[:t]
+            jacobian[col + 1 : col + 1 + t, :n] = rows[:t]
+            jacobian[:n, col + 1 : col + 1 + t] += rows[:t].T
+        elif mu[i] > 0.0:
+            _sliding_friction_numpy(rows[:t], mu[i], cn, col, velocity[:t], forces[i], jacobian)
+        residual[:n] += rows.T @ forces[i]
+    return residual, jacobian, forces
+
+
+def _sliding_friction_numpy(
+    tangent: FloatArray, mu: float, cn: float, col: int, slip: FloatArray, force: FloatArray, jacobian: FloatArray
+) -> None:
+    """Whole-array twin of :func:`_sliding_friction` for plain Python (numba compiles the loops)."""
+    t, n = tangent.shape
+    speed = np.sqrt(np.sum(slip * slip))
+    if speed <= 0.0:
+        return
+    e = slip / speed
+    force[:t] = -mu * cn * e
+    jacobian[:n, col] += -mu * (tangent.T @ e)
+    projector = (-mu * cn / speed) * (np.eye(t) - np.outer(e, e))
+    jacobian[:n, :n] += tangent.T @ projector @ tangent
+
+
+@njit(python=_system_numpy)
 def system(
     J: FloatArray, b: FloatArray, mu: FloatArray, g: FloatArray, x: FloatArray, kind: IntArray, column: IntArray, n: int
 ) -> tuple[FloatArray, FloatArray, FloatArray]:

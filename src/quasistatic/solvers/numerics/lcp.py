@@ -305,7 +305,17 @@ def _gauss_newton(
     return x, norm, forces
 
 
-@njit
+def _newton_step_numpy(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
+    """Whole-array twin of :func:`_newton_step` for plain Python (numba compiles the loops)."""
+    normal = jacobian.T @ jacobian
+    gradient = -(jacobian.T @ residual)
+    largest = max(0.0, np.max(np.diag(normal))) if residual.shape[0] else 0.0
+    normal += NEWTON_DAMPING * (1.0 + largest) * np.eye(residual.shape[0])
+    _, step = _linear_solve(normal, gradient)
+    return step
+
+
+@njit(python=_newton_step_numpy)
 def _newton_step(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
     """Newton step ``-J^-1 r``, as ``-(J^T J + lam I)^-1 J^T r`` with a tiny ``lam``.
 
@@ -394,7 +404,30 @@ def _basis_solution(M: np.ndarray, q: np.ndarray, basis: np.ndarray, tol: float)
     return True, z
 
 
-@njit
+def _linear_solve_numpy(A: np.ndarray, rhs: np.ndarray) -> tuple[bool, np.ndarray]:
+    """Whole-array twin of :func:`_linear_solve` for plain Python (numba compiles the loops)."""
+    n = rhs.shape[0]
+    U = A.copy()
+    x = rhs.copy()
+    tiny = 1e-14 * max(np.max(np.abs(U)) if n else 0.0, 1e-300)
+    for k in range(n):
+        p = k + int(np.argmax(np.abs(U[k:, k])))
+        if abs(U[p, k]) <= tiny:
+            return False, x
+        if p != k:
+            row = U[k].copy()
+            U[k] = U[p]
+            U[p] = row
+            x[k], x[p] = x[p], x[k]
+        factors = U[k + 1 :, k] / U[k, k]
+        U[k + 1 :, k:] -= np.outer(factors, U[k, k:])
+        x[k + 1 :] -= factors * x[k]
+    for k in range(n - 1, -1, -1):
+        x[k] = (x[k] - np.sum(U[k, k + 1 :] * x[k + 1 :])) / U[k, k]
+    return True, x
+
+
+@njit(python=_linear_solve_numpy)
 def _linear_solve(A: np.ndarray, rhs: np.ndarray) -> tuple[bool, np.ndarray]:
     """``A x = rhs`` by Gaussian elimination with partial pivoting; False when ``A`` is singular.
 
@@ -434,7 +467,47 @@ def _linear_solve(A: np.ndarray, rhs: np.ndarray) -> tuple[bool, np.ndarray]:
     return True, x
 
 
-@njit
+def _assemble_numpy(
+    Jn: np.ndarray,
+    Jt: np.ndarray,
+    bn: np.ndarray,
+    bt: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    edges: np.ndarray,
+    frictional: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Whole-array twin of :func:`_assemble` for plain Python (numba compiles the loops)."""
+    m, n = Jn.shape
+    f, K, t = edges.shape
+    N = 2 * n + m + f * K + f
+    cn0 = 2 * n
+    b0 = cn0 + m
+    l0 = b0 + f * K
+    M = np.zeros((N, N))
+    q = np.zeros(N)
+    q[:n] = -g
+    q[n : 2 * n] = g
+    q[cn0:b0] = -bn
+    M[cn0:b0, :n] = Jn
+    M[cn0:b0, n : 2 * n] = -Jn
+    M[:n, cn0:b0] = -Jn.T
+    M[n : 2 * n, cn0:b0] = Jn.T
+    for a in range(f):
+        rows = slice(b0 + a * K, b0 + (a + 1) * K)
+        along = edges[a] @ Jt[a]  # (K, n): each edge's slip rows
+        q[rows] = -(edges[a] @ bt[a])
+        M[rows, :n] = along
+        M[rows, n : 2 * n] = -along
+        M[:n, rows] = -along.T
+        M[n : 2 * n, rows] = along.T
+        M[rows, l0 + a] = 1.0
+        M[l0 + a, rows] = -1.0
+        M[l0 + a, cn0 + frictional[a]] = mu[a]
+    return M, q
+
+
+@njit(python=_assemble_numpy)
 def _assemble(
     Jn: np.ndarray,
     Jt: np.ndarray,
