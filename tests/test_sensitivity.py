@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -162,3 +163,28 @@ def test_a_robot_joint_turns_the_box_through_its_jacobian() -> None:
     np.testing.assert_allclose(result.twists["box"], [[0.15, 0.15], [-0.15, -0.15], [-3.0, -3.0]], atol=1e-12)
     np.testing.assert_allclose(result.forces, 0.0, atol=1e-12)  # frictionless: the forces balance gravity alone
     assert result.certified and result.margins_exact
+
+
+def test_a_solution_differentiates_itself() -> None:
+    """``solution.sensitivity()`` (issue 15's spelling): the same derivative as ``qs.sensitivity(scene, solution)``,
+    from the scene the Solution keeps; that scene is not in the JSON, nor in a pickle, and a batch attaches it again."""
+    scene = qs.load_scene(EXAMPLES / "robot_tip.yaml")
+    solution = qs.solve(scene)
+    assert solution.scene is scene
+    own = solution.sensitivity(inputs=["arm"])
+    assert isinstance(own, qs.Sensitivity)
+    np.testing.assert_allclose(own.twists["box"], [[0.15, 0.15], [-0.15, -0.15], [-3.0, -3.0]], atol=1e-12)
+    np.testing.assert_array_equal(own.twist_jacobian, qs.sensitivity(scene, solution, inputs=["arm"]).twist_jacobian)
+    assert "scene" not in solution.to_dict() and "source" not in solution.to_dict()
+    assert pickle.loads(pickle.dumps(solution)).source is None
+    for batched in qs.solve_many([scene, scene, scene], n_jobs=2):
+        assert batched.scene is scene
+        np.testing.assert_array_equal(batched.sensitivity(inputs=["arm"]).twist_jacobian, own.twist_jacobian)
+
+
+def test_a_solution_without_a_derivative_says_why() -> None:
+    refused = qs.solve(qs.load_scene(EXAMPLES / "push_into_wall.yaml")).sensitivity()
+    assert isinstance(refused, qs.NoSensitivity) and refused.reason is qs.NoSensitivityReason.NOT_SOLVED
+    by_hand = qs.Solution("failed", "made by hand", "none", "exact")
+    with pytest.raises(ValueError, match="source: this Solution was not made by solve"):
+        by_hand.sensitivity()
