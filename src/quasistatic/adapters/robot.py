@@ -218,6 +218,10 @@ class UrdfRobot:
     torque_limits : list or mapping, optional
         Largest torque magnitude of each joint, in the same forms (a mapping names every joint);
         a motion that needs more is reported as infeasible for this robot. None: no limits.
+    joint_stiffness : list or mapping, optional
+        Stiffness of each joint's servo or transmission [torque/rad, or force/length for a prismatic joint], > 0,
+        in the same forms (a mapping names every joint): the links then yield in series with the contact springs
+        when compliant forces are worked out, through the contacts' Jacobians at this configuration. None: rigid.
     field : str, optional
         Where the robot is in a scene file, for error messages (``robots.hand``).
     """
@@ -232,6 +236,7 @@ class UrdfRobot:
         q: Sequence[float] | Mapping[str, float] | None = None,
         joint_velocities: Sequence[float] | Mapping[str, float] | None = None,
         torque_limits: Sequence[float] | Mapping[str, float] | None = None,
+        joint_stiffness: Sequence[float] | Mapping[str, float] | None = None,
         field: str | None = None,
     ) -> None:
         field = field or f"robots.{name}"
@@ -243,6 +248,7 @@ class UrdfRobot:
         angles, velocities = _per_joint(q, names, f"{field}.q"), _per_joint(joint_velocities, names, f"{field}.joint_velocities")
         self._build(name, path, kinematics, base or Pose(), angles, velocities, field)
         self.torque_limits = _limits(torque_limits, kinematics.joint_names, f"{field}.torque_limits")
+        self.joint_stiffness = _stiffness(joint_stiffness, kinematics.joint_names, f"{field}.joint_stiffness")
 
     def _build(
         self,
@@ -280,6 +286,7 @@ class UrdfRobot:
         velocities = self.joint_velocities if joint_velocities is None else _per_joint(joint_velocities, names, f"{field}.joint_velocities")
         robot = UrdfRobot.__new__(UrdfRobot)
         robot.torque_limits = self.torque_limits
+        robot.joint_stiffness = self.joint_stiffness
         robot._build(self.name, self.urdf, self._kinematics, self.base if base is None else base, angles, velocities, field)
         return robot
 
@@ -428,6 +435,15 @@ def _limits(values: Any, names: tuple[str, ...], field: str) -> FloatArray | Non
         missing = ", ".join(n for n in names if n not in values)
         raise SceneError(field, dict(values), f"name every joint (missing: {missing})")
     return _per_joint(values, names, field)
+
+
+def _stiffness(values: Any, names: tuple[str, ...], field: str) -> FloatArray | None:
+    """Joint stiffness as :func:`_limits` reads it (a mapping names every joint: a missing one is not 0), each > 0."""
+    stiffness = _limits(values, names, field)
+    if stiffness is not None and not np.all(stiffness > 0.0):
+        shown = dict(values) if isinstance(values, Mapping) else stiffness.tolist()
+        raise SceneError(field, shown, "every joint stiffness must be > 0 (leave the key out for rigid joints)")
+    return stiffness
 
 
 def _pinocchio() -> Any:
