@@ -28,6 +28,7 @@ import numpy as np
 from .laws import Problem, assemble
 from .laws.inputs import InputVector
 from .laws.modes import ModeMasks
+from .laws.pyramid_modes import PyramidModes, pyramid_boundaries, pyramid_derivative
 from .laws.sensitivity import Boundary, FixedModeDerivative, Singular, ball_radius, boundaries, crossing, fixed_mode_derivative
 from .model import FloatArray, Scene
 from .solution import Mode, Solution
@@ -40,6 +41,8 @@ _CHANGES = {
     "normal_force": "the normal force reaches 0 (the contact may separate)",
     "cone": "the rolling contact's force reaches its friction cone (it may slide)",
     "slip": "the sliding contact's slip reaches 0 (it may stick)",
+    "edge": "the sliding contact's slip turns to a pyramid face's normal (its friction may leave its edge)",
+    "face": "the sliding contact's friction reaches a pyramid edge (its slip may leave the face's normal)",
 }
 
 
@@ -54,8 +57,6 @@ class NoSensitivityReason(enum.Enum):
     """The twist is not isolated within its modes (a continuum of motions)."""
     MODE_BOUNDARY = "mode_boundary"
     """A contact is on the boundary between two modes: the one-sided derivatives differ."""
-    UNSUPPORTED_FRICTION = "unsupported_friction"
-    """3-D pyramid friction: its sliding law is not the fixed-mode laws' circle (use ``friction: exact``)."""
     NO_ROOT = "no_root"
     """Newton's method on the fixed-mode laws did not return to the reported motion."""
 
@@ -128,10 +129,11 @@ class Sensitivity:
         Radius of the Euclidean ball in the inputs (mixed units, as given) within which no contact changes
         mode; ``ball_change`` names the nearest change.
     margins_exact : bool
-        True in 2-D and in 3-D without sliding frictional contacts: the laws are affine in the inputs and the
-        margins are exact. Otherwise they are first-order estimates.
+        True in 2-D, with 3-D pyramids, and on 3-D exact cones without sliding frictional contacts: the laws are
+        affine in the inputs and the margins are exact. Otherwise they are first-order estimates.
     ball_exact : bool
-        True when every mode-deciding quantity is linear in the inputs (2-D, or no frictional 3-D contact closed).
+        True when every mode-deciding quantity is linear in the inputs (2-D, 3-D pyramids, or no frictional 3-D
+        contact closed).
     certified : bool
         The differentiated motion was proven the only one (a certified ``solved``).
     """
@@ -185,21 +187,19 @@ def differentiate(scene: Scene, solution: Solution, *, inputs: Collection[str] |
     Sensitivity, or NoSensitivity with the reason there is none.
     """
     selection = InputVector.of(scene, _checked_owners(scene, inputs))
-    if scene.friction.kind == "pyramid":
-        reason = "pyramid friction in 3-D slides along the pyramid's faces, not the fixed-mode laws' circle; use friction 'exact'"
-        return NoSensitivity(NoSensitivityReason.UNSUPPORTED_FRICTION, reason)
     refused = _refusal(solution)
     if refused is not None:
         return refused
     assert solution.motion is not None  # solved
     problem = assemble(scene)
     masks = ModeMasks.of(problem, solution.modes)
-    derivative = fixed_mode_derivative(problem, masks, *_relative_motion(problem, solution), _input_map(problem, selection))
-    if isinstance(derivative, Singular):
-        return _singular(derivative)
-    if float(np.max(np.abs(derivative.q - _relative_motion(problem, solution)[0]), initial=0.0)) > SAME_TWIST:
-        return NoSensitivity(NoSensitivityReason.NO_ROOT, "Newton's method on the fixed-mode laws left the reported motion")
-    limits = boundaries(derivative, masks, problem.mu)
+    q, c = _relative_motion(problem, solution)
+    found = _derivative(problem, masks, q, c, _input_map(problem, selection))
+    if isinstance(found, Singular):
+        return _singular(found)
+    derivative, limits = found
+    if float(np.max(np.abs(derivative.q - q), initial=0.0)) > SAME_TWIST:
+        return NoSensitivity(NoSensitivityReason.NO_ROOT, "the fixed-mode laws' motion is not the reported one (no root nearby)")
     on_boundary = next((b for b in limits if b.value < MODE_BOUNDARY), None)
     if on_boundary is not None:
         change = ModeChange(on_boundary.contact, on_boundary.what)
@@ -207,11 +207,23 @@ def differentiate(scene: Scene, solution: Solution, *, inputs: Collection[str] |
     return _physical(problem, selection, derivative, limits, masks, solution)
 
 
+def _derivative(
+    problem: Problem, masks: ModeMasks, q: FloatArray, c: FloatArray, B: FloatArray
+) -> tuple[FixedModeDerivative, list[Boundary]] | Singular:
+    """The derivative and the mode boundaries: linear laws for 3-D pyramids, the exact fixed-mode laws otherwise."""
+    if problem.dimension == 3 and problem.friction.kind == "pyramid":
+        modes = PyramidModes.of(problem, masks, c)
+        linear = pyramid_derivative(problem, modes, B)
+        return linear if isinstance(linear, Singular) else (linear, pyramid_boundaries(linear, modes, problem.mu))
+    exact = fixed_mode_derivative(problem, masks, q, c, B)
+    return exact if isinstance(exact, Singular) else (exact, boundaries(exact, masks, problem.mu))
+
+
 @dataclass(frozen=True)
 class SolvedScene:
     """What a Solution keeps of its solve to differentiate itself: the Scene it was solved from.
 
-    Not part of the Solution's JSON; it travels with the Solution in memory and in pickles.
+    Not part of the Solution's JSON, nor of its pickle (``solve_many`` attaches its own scene again).
     """
 
     scene: Scene
@@ -284,7 +296,8 @@ def _physical(
     radii = [ball_radius(b) for b in limits]
     nearest = int(np.argmin(radii)) if radii else -1
     ball = radii[nearest] if radii else float("inf")
-    linear = problem.dimension == 2 or not bool(np.any(masks.closed & (problem.mu > 0)))
+    polyhedral = problem.friction.is_polyhedral(problem.dimension)
+    linear = polyhedral or not bool(np.any(masks.closed & (problem.mu > 0)))
     return Sensitivity(
         inputs=selection.names,
         twists=twists,
