@@ -189,3 +189,58 @@ def test_a_solution_without_a_derivative_says_why() -> None:
     by_hand = qs.Solution("failed", "made by hand", "none", "exact")
     with pytest.raises(ValueError, match="source: this Solution was not made by solve"):
         by_hand.sensitivity()
+
+
+def _moved_contact(scene: qs.Scene, parameter: str, h: float) -> qs.Scene:
+    """The scene with one geometry parameter moved by ``h``: a contact point's coordinate, or its normal turned about
+    a world axis (about the plane's normal in 2-D) by ``h`` rad (Rodrigues), everything else as it was."""
+    i = int(parameter.split("[")[1].split("]")[0])
+    kind, axis = parameter.split(".")[-2:]
+    contacts = list(scene.contacts)
+    c = contacts[i]
+    point, normal = np.array(c.point, dtype=float), np.array(c.normal, dtype=float)
+    if kind == "point":
+        point["xyz".index(axis)] += h
+    elif scene.dimension == 2:
+        normal = np.array([[np.cos(h), -np.sin(h)], [np.sin(h), np.cos(h)]]) @ normal
+    else:
+        a = np.eye(3)["xyz".index(axis[-1])]
+        normal = normal * np.cos(h) + np.cross(a, normal) * np.sin(h) + a * (a @ normal) * (1 - np.cos(h))
+    contacts[i] = qs.Contact(c.body, c.other, point, normal, mu=c.mu, jacobian=c.jacobian)
+    movers = [qs.Mover(m.name, None if m.robot else m.twist, m.origin, m.robot) for m in scene.movers]
+    return qs.Scene(scene.bodies, contacts, movers, scene.robots, scene.dimension, scene.gravity, scene.friction)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_geometry_derivatives_match_finite_differences_of_the_solve(dimension: int) -> None:
+    """d(twist, world forces)/d(contact point, normal turn) against central differences of qs.solve on the scene with
+    that contact moved or its normal turned; a wrong sign, a transposed arm or a frame turned the wrong way fails
+    (the tolerance is a thousandth of the largest column, plus the solves' round-off over the step)."""
+    compared = 0
+    for scene, solution, _ in _differentiable(dimension)[:6]:
+        result = solution.sensitivity(geometry=True)
+        assert isinstance(result, qs.Sensitivity) and result.geometry is not None
+        geometry = result.geometry
+        assert len(geometry.parameters) == len(scene.contacts) * (3 if dimension == 2 else 6)
+        twist, forces = _stacked(solution)
+        jacobian = np.concatenate(list(geometry.twists.values()))
+        h = 1e-6
+        for j in range(0, len(geometry.parameters), 2 if dimension == 2 else 5):  # points and normals of every contact
+            sides = [qs.solve(_moved_contact(scene, geometry.parameters[j], sign * h)) for sign in (1.0, -1.0)]
+            if any(side.status != "solved" or side.modes != solution.modes for side in sides):
+                continue
+            d_twist = (_stacked(sides[0])[0] - _stacked(sides[1])[0]) / (2 * h)
+            d_forces = (_stacked(sides[0])[1] - _stacked(sides[1])[1]) / (2 * h)
+            twist_scale = 1e-3 * float(np.max(np.abs(jacobian))) + 1e-10 * float(np.max(np.abs(twist))) / h
+            force_scale = 1e-3 * float(np.max(np.abs(geometry.forces))) + 1e-10 * float(np.max(np.abs(forces))) / h
+            name = geometry.parameters[j]
+            np.testing.assert_allclose(jacobian[:, j], d_twist, rtol=1e-3, atol=twist_scale, err_msg=name)
+            np.testing.assert_allclose(geometry.forces[:, :, j], d_forces, rtol=1e-3, atol=force_scale, err_msg=name)
+            compared += 1
+    assert compared >= 12
+
+
+def test_geometry_derivatives_are_refused_on_3d_pyramids() -> None:
+    scene = random_scene(3, 16, "pyramid:8")
+    with pytest.raises(ValueError, match="geometry: derivatives through the geometry"):
+        qs.sensitivity(scene, geometry=True)

@@ -25,7 +25,7 @@ from .laws import Problem, assemble
 from .loading import load_scene, load_world
 from .model import Body, Contact, FrictionModel, Mover, Robot, Scene, Stiffness
 from .plan import PlanResult, QuadraticCost, plan
-from .sensitivity import InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, sensitivity
+from .sensitivity import GeometrySensitivity, InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, sensitivity
 from .sim import Inputs, InputTable, Trajectory, simulate
 from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
 from .solve import METHODS, solve
@@ -36,6 +36,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "sensitivity",
+    "GeometrySensitivity",
     "plan",
     "Sensitivity",
     "QuadraticCost",

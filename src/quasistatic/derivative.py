@@ -18,6 +18,7 @@ cycle (``solution.py`` is a leaf).
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 from collections.abc import Collection
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from .laws import Problem, assemble
+from .laws.geometry_derivative import GeometryDerivative, geometry_derivative, geometry_parameters
 from .laws.inputs import InputVector
 from .laws.modes import ModeMasks
 from .laws.pyramid_modes import PyramidModes, pyramid_boundaries, pyramid_derivative
@@ -34,7 +36,16 @@ from .model import FloatArray, Scene
 from .solution import Mode, Solution
 from .tolerances import MODE_BOUNDARY, SAME_TWIST
 
-__all__ = ["differentiate", "SolvedScene", "Sensitivity", "NoSensitivity", "NoSensitivityReason", "ModeChange", "InputMargin"]
+__all__ = [
+    "differentiate",
+    "SolvedScene",
+    "Sensitivity",
+    "GeometrySensitivity",
+    "NoSensitivity",
+    "NoSensitivityReason",
+    "ModeChange",
+    "InputMargin",
+]
 
 _CHANGES = {
     "separating": "the separating contact closes (normal speed reaches 0)",
@@ -110,6 +121,38 @@ class InputMargin:
 
 
 @dataclass(frozen=True)
+class GeometrySensitivity:
+    """The derivative of one solved motion with respect to the contact geometry, in physical units and world frame.
+
+    Attributes
+    ----------
+    parameters : tuple of str
+        The G parameters, contact by contact: ``contacts[i].point.x`` (and ``.y``, ``.z``) [length], then
+        ``contacts[i].normal.turn_x`` (``_y``, ``_z``; ``normal.turn`` in 2-D) [rad]: the normal turned about
+        that world axis (a turn about the normal itself changes nothing).
+    twists : dict name -> array (k, G)
+        d(body twist)/d(parameter).
+    forces : array (m, d, G)
+        d(world contact force on the body)/d(parameter).
+
+    A contact whose other side is a robot keeps its given Jacobian as its point moves (it is data of the
+    scene); a rigid mover's point velocity follows the point. Valid while the modes hold (no margins are given
+    for the geometry).
+    """
+
+    parameters: tuple[str, ...]
+    twists: dict[str, FloatArray]
+    forces: FloatArray
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "parameters": list(self.parameters),
+            "twists": {name: d.tolist() for name, d in self.twists.items()},
+            "forces": self.forces.tolist(),
+        }
+
+
+@dataclass(frozen=True)
 class Sensitivity:
     """The derivative of one solved motion with respect to the inputs, in physical units and world frame.
 
@@ -136,6 +179,8 @@ class Sensitivity:
         contact closed).
     certified : bool
         The differentiated motion was proven the only one (a certified ``solved``).
+    geometry : GeometrySensitivity or None
+        With ``geometry=True``: the derivative with respect to the contact points and normals.
     """
 
     inputs: tuple[str, ...]
@@ -148,6 +193,7 @@ class Sensitivity:
     margins_exact: bool
     ball_exact: bool
     certified: bool
+    geometry: GeometrySensitivity | None = None
 
     @property
     def twist_jacobian(self) -> FloatArray:
@@ -167,10 +213,13 @@ class Sensitivity:
             "margins_exact": self.margins_exact,
             "ball_exact": self.ball_exact,
             "certified": self.certified,
+            "geometry": None if self.geometry is None else self.geometry.to_dict(),
         }
 
 
-def differentiate(scene: Scene, solution: Solution, *, inputs: Collection[str] | None = None) -> Sensitivity | NoSensitivity:
+def differentiate(
+    scene: Scene, solution: Solution, *, inputs: Collection[str] | None = None, geometry: bool = False
+) -> Sensitivity | NoSensitivity:
     """The derivative of ``solution``, an answer of ``scene``, with respect to the scene's inputs.
 
     Parameters
@@ -181,12 +230,17 @@ def differentiate(scene: Scene, solution: Solution, *, inputs: Collection[str] |
         Only a ``solved`` motion has a derivative.
     inputs : collection of str, optional
         Names of the robots and rigid movers whose inputs to differentiate by (all of them when omitted).
+    geometry : bool
+        Also differentiate with respect to each contact's point and normal (``Sensitivity.geometry``); exact
+        cones and 2-D only (a ValueError on 3-D pyramids, whose edges turn with the contact frame).
 
     Returns
     -------
     Sensitivity, or NoSensitivity with the reason there is none.
     """
     selection = InputVector.of(scene, _checked_owners(scene, inputs))
+    if geometry and scene.dimension == 3 and scene.friction.kind == "pyramid":
+        raise ValueError("geometry: derivatives through the geometry are given for exact cones and in 2-D, not on 3-D pyramids")
     refused = _refusal(solution)
     if refused is not None:
         return refused
@@ -204,7 +258,21 @@ def differentiate(scene: Scene, solution: Solution, *, inputs: Collection[str] |
     if on_boundary is not None:
         change = ModeChange(on_boundary.contact, on_boundary.what)
         return NoSensitivity(NoSensitivityReason.MODE_BOUNDARY, f"on a mode boundary: {change.description}", on_boundary.contact)
-    return _physical(problem, selection, derivative, limits, masks, solution)
+    result = _physical(problem, selection, derivative, limits, masks, solution)
+    if not geometry:
+        return result
+    through = geometry_derivative(problem, masks, q, c)
+    if isinstance(through, Singular):
+        return _singular(through)
+    return dataclasses.replace(result, geometry=_physical_geometry(problem, through))
+
+
+def _physical_geometry(problem: Problem, through: GeometryDerivative) -> GeometrySensitivity:
+    units = problem.scales.twist_units(problem.dimension)
+    k = units.size
+    twists = {b.name: through.dq[a * k : (a + 1) * k] * units[:, None] for a, b in enumerate(problem.scene.bodies)}
+    world = np.einsum("msdG,ms->mdG", through.dframes, through.c) + np.einsum("msd,msG->mdG", problem.frames, through.dc)
+    return GeometrySensitivity(geometry_parameters(problem.dimension, problem.n_contacts), twists, world * problem.scales.force)
 
 
 def _derivative(
@@ -228,8 +296,8 @@ class SolvedScene:
 
     scene: Scene
 
-    def sensitivity(self, solution: Solution, inputs: Collection[str] | None = None) -> Sensitivity | NoSensitivity:
-        return differentiate(self.scene, solution, inputs=inputs)
+    def sensitivity(self, solution: Solution, inputs: Collection[str] | None = None, geometry: bool = False) -> Sensitivity | NoSensitivity:
+        return differentiate(self.scene, solution, inputs=inputs, geometry=geometry)
 
 
 def _checked_owners(scene: Scene, owners: Collection[str] | None) -> Collection[str] | None:

@@ -10,15 +10,17 @@ from __future__ import annotations
 
 from collections.abc import Collection
 
-from .derivative import InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, differentiate
+from .derivative import GeometrySensitivity, InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, differentiate
 from .model import Scene
 from .solution import Solution
 from .solve import solve
 
-__all__ = ["sensitivity", "Sensitivity", "NoSensitivity", "NoSensitivityReason", "ModeChange", "InputMargin"]
+__all__ = ["sensitivity", "Sensitivity", "GeometrySensitivity", "NoSensitivity", "NoSensitivityReason", "ModeChange", "InputMargin"]
 
 
-def sensitivity(scene: Scene, solution: Solution | None = None, *, inputs: Collection[str] | None = None) -> Sensitivity | NoSensitivity:
+def sensitivity(
+    scene: Scene, solution: Solution | None = None, *, inputs: Collection[str] | None = None, geometry: bool = False
+) -> Sensitivity | NoSensitivity:
     """The derivative of the scene's solved motion with respect to its inputs.
 
     Parameters
@@ -28,9 +30,11 @@ def sensitivity(scene: Scene, solution: Solution | None = None, *, inputs: Colle
         The scene's answer (``solve(scene)`` when omitted). Only a ``solved`` motion has a derivative.
     inputs : collection of str, optional
         Names of the robots and rigid movers whose inputs to differentiate by (all of them when omitted).
+    geometry : bool
+        Also differentiate with respect to each contact's point and normal (``Sensitivity.geometry``).
 
     Returns
     -------
     Sensitivity, or NoSensitivity with the reason there is none.
     """
-    return differentiate(scene, solve(scene) if solution is None else solution, inputs=inputs)
+    return differentiate(scene, solve(scene) if solution is None else solution, inputs=inputs, geometry=geometry)

@@ -551,7 +551,7 @@ class SolveSource(Protocol):
     @property
     def scene(self) -> Any: ...
 
-    def sensitivity(self, solution: Solution, inputs: Collection[str] | None = None) -> Any: ...
+    def sensitivity(self, solution: Solution, inputs: Collection[str] | None = None, geometry: bool = False) -> Any: ...
 
 
 @dataclass(frozen=True)
@@ -633,19 +633,20 @@ class Solution:
         """The Scene this answer was solved from (None for a Solution built by hand)."""
         return None if self.source is None else self.source.scene
 
-    def sensitivity(self, inputs: Collection[str] | None = None) -> Any:
+    def sensitivity(self, inputs: Collection[str] | None = None, geometry: bool = False) -> Any:
         """The exact derivative of this answer's motion with respect to its scene's inputs (issue 15).
 
         Returns a :class:`quasistatic.Sensitivity`, or a :class:`quasistatic.NoSensitivity` saying why there is
         none (not ``solved``, forces indeterminate, a mode boundary), exactly as
-        ``quasistatic.sensitivity(solution.scene, solution, inputs=inputs)``. ``inputs`` names the robots and
-        movers to differentiate by (all by default).
+        ``quasistatic.sensitivity(solution.scene, solution, inputs=inputs, geometry=geometry)``. ``inputs`` names
+        the robots and movers to differentiate by (all by default); ``geometry`` adds the derivative with respect
+        to the contact points and normals.
         """
         if self.source is None:
             raise ValueError(
                 "source: this Solution was not made by solve(), so it has no scene to differentiate; use qs.sensitivity(scene, solution)"
             )
-        return self.source.sensitivity(self, inputs)
+        return self.source.sensitivity(self, inputs, geometry)
 
     def __getstate__(self) -> dict[str, Any]:
         # Pickled without its scene: a batch's worker would ship back the scene its parent holds, doubling the cost
