@@ -149,6 +149,7 @@ class _Kinematics:
             shape_from_coal(item.geometry, f"{field}: collision geometry {item.name!r}") for item in self.geometry.geometryObjects
         )
         self.chain_columns = self._chain_columns()
+        self.moves = self._moves()
         joints = [self.model.joints[joint_id] for joint_id in range(1, self.model.njoints)]
         self.plain_dof = np.array([i for i, j in enumerate(joints) if j.nq == 1], dtype=int)
         self.plain_q = np.array([j.idx_q for j in joints if j.nq == 1], dtype=int)
@@ -170,6 +171,16 @@ class _Kinematics:
                 raise SceneError(field, str(urdf), f"joint {name!r} has {joint.nv} degrees of freedom; only 1-DOF joints are supported")
             names.append(name)
         return tuple(names)
+
+    def _moves(self) -> FloatArray:
+        """``[j, k]`` = 1 when the joint of velocity column j is a strict ancestor of that of column k (it moves it)."""
+        moves = np.zeros((self.model.nv, self.model.nv))
+        for joint_id in range(1, self.model.njoints):
+            k = self.model.joints[joint_id].idx_v
+            for ancestor in self.model.supports[joint_id]:
+                if 0 < ancestor != joint_id:
+                    moves[self.model.joints[ancestor].idx_v, k] = 1.0
+        return moves
 
     def _chain_columns(self) -> FloatArray:
         """Per joint, a 0/1 row over the velocity columns of the joints that move it (its kinematic chain)."""
@@ -377,6 +388,26 @@ class UrdfRobot:
         np.subtract(jacobian[:3], shifted, out=shifted)
         shifted *= chains[:, None, :]
         result: FloatArray = self.base.rotation @ shifted  # into the world
+        return result
+
+    def point_jacobian_rates(self, link: str, point: npt.ArrayLike) -> FloatArray:
+        """How :meth:`point_jacobian` of ``link`` at the fixed world ``point`` changes with each joint position:
+        (3, joints, joints), entry ``[:, j, k]`` = d(column k)/d(q_j) [per rad, or per length for a prismatic joint].
+
+        Analytic, from the configuration's own spatial Jacobian: a joint's twist ``xi_k = (v_k, w_k)`` (velocity of
+        the world origin's point, angular velocity) turns with every joint ``j`` that moves it by the Lie bracket
+        ``[xi_j, xi_k] = (w_j x v_k - w_k x v_j, w_j x w_k)``; the point's column is ``v_k + w_k x p``.
+        """
+        kinematics = self._kinematics
+        chain = kinematics.chain_columns[kinematics.link_in_joint[self._link(link)][0]]
+        jacobian = self._placement.jacobian * chain  # (6, joints): only the joints that move the link
+        v, w = jacobian[:3].T, jacobian[3:].T  # (joints, 3)
+        local = (np.asarray(point, dtype=float).reshape(3) - self.base.position) @ self.base.rotation
+        moves = kinematics.moves  # moves[j, k]: joint j is a strict ancestor of joint k
+        dv = np.cross(w[:, None, :], v[None, :, :]) - np.cross(w[None, :, :], v[:, None, :])  # (j, k, 3)
+        dw = np.cross(w[:, None, :], w[None, :, :])
+        rates = (dv + np.cross(dw, local)) * moves[:, :, None]
+        result: FloatArray = np.einsum("ab,jkb->ajk", self.base.rotation, rates)
         return result
 
     def _link(self, link: str) -> str:
