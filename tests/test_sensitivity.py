@@ -244,3 +244,65 @@ def test_geometry_derivatives_are_refused_on_3d_pyramids() -> None:
     scene = random_scene(3, 16, "pyramid:8")
     with pytest.raises(ValueError, match="geometry: derivatives through the geometry"):
         qs.sensitivity(scene, geometry=True)
+
+
+def _hand_push(robot: qs.UrdfRobot, joint_velocities: np.ndarray) -> qs.Scene:
+    """A 6 cm cube of 0.2 kg on three table points (mu 0.3), pushed along +x at (-0.03, 0, 0.045) by the planar hand's
+    left fingertip (frictionless), whose contact Jacobian comes from ``robot`` (examples/robots/models/planar_hand.urdf)."""
+    point = np.array([-0.03, 0.0, 0.045])
+    supports = [[-0.03, -0.03, 0.0], [0.03, -0.03, 0.0], [0.0, 0.03, 0.0]]
+    contacts = [qs.Contact("box", "table", p, [0.0, 0.0, 1.0], mu=0.3) for p in supports]
+    contacts.append(qs.Contact("box", "hand/left_tip", point, [1.0, 0.0, 0.0], mu=0.0, jacobian=robot.point_jacobian("left_tip", point)))
+    return qs.Scene(
+        bodies=[qs.Body("box", 0.2, [0.0, 0.0, 0.03])],
+        movers=[qs.Mover("table"), qs.Mover("hand/left_tip", robot="hand")],
+        robots=[qs.Robot("hand", joint_velocities, joint_names=robot.joint_names)],
+        contacts=contacts,
+        dimension=3,
+    )
+
+
+def test_joint_position_derivatives_match_finite_differences_of_the_solve() -> None:
+    """d(twist, forces)/d(joint position) of a URDF robot, contact points and normals held: against central differences
+    of qs.solve with the fingertip's Jacobian taken at q +- h e_j (Pinocchio). The fingertip pushes the cube along +x
+    while both left joints turn, so their positions change how fast the fingertip's point moves along the normal."""
+    pytest.importorskip("pinocchio")
+    urdf = EXAMPLES / "robots" / "models" / "planar_hand.urdf"
+    q = np.array([-1.233011444981106, 1.4277306614691663, 1.233011444981106, -1.4277306614691663])
+    robot = qs.UrdfRobot("hand", urdf, base=qs.Pose([0.0, 0.0, 0.15]), q=q)
+    jacobian = robot.point_jacobian("left_tip", [-0.03, 0.0, 0.045])
+    joint_velocities = np.r_[np.linalg.lstsq(jacobian[:, :2], [0.01, 0.0, 0.0], rcond=None)[0], 0.0, 0.0]
+    scene = _hand_push(robot, joint_velocities)
+    solution = qs.solve(scene)
+    assert solution.status == "solved" and solution.modes[:3] == ("sliding",) * 3
+    plain = solution.sensitivity(geometry=True)  # a Scene's solution knows no URDF robot: points and normals only
+    assert isinstance(plain, qs.Sensitivity) and plain.geometry is not None
+    assert not any(name.startswith("robots.") for name in plain.geometry.parameters)
+    with pytest.raises(ValueError, match="robots: 'hand' is not at the configuration"):
+        qs.sensitivity(scene, solution, geometry=True, robots=[robot.at(q=q + 0.1)])
+    result = qs.sensitivity(scene, solution, geometry=True, robots=[robot])
+    assert isinstance(result, qs.Sensitivity) and result.geometry is not None
+    names = result.geometry.parameters[-4:]
+    assert names == tuple(f"robots.hand.q.{joint}" for joint in robot.joint_names)
+    jacobian_columns = np.concatenate(list(result.geometry.twists.values()))[:, -4:]
+    assert float(np.abs(jacobian_columns[:, :2]).max()) > 1e-3  # the left joints turn the push; the right ones do nothing
+    np.testing.assert_array_equal(jacobian_columns[:, 2:], 0.0)
+    # The frictionless push only sets the cube's speed along x; the forces are statics' (friction 0.3 of the weight
+    # against the slip along x): no joint position changes them.
+    np.testing.assert_allclose(result.geometry.forces[:, :, -4:], 0.0, atol=1e-12)
+    h = 1e-6
+    for j in range(2):
+        step = np.zeros(4)
+        step[j] = h
+        sides = [qs.solve(_hand_push(robot.at(q=q + sign * step), joint_velocities)) for sign in (1.0, -1.0)]
+        assert all(side.status == "solved" and side.modes == solution.modes for side in sides)
+        d_twist = (_stacked(sides[0])[0] - _stacked(sides[1])[0]) / (2 * h)
+        d_forces = (_stacked(sides[0])[1] - _stacked(sides[1])[1]) / (2 * h)
+        np.testing.assert_allclose(jacobian_columns[:, j], d_twist, rtol=1e-5, atol=1e-7, err_msg=names[j])
+        np.testing.assert_allclose(result.geometry.forces[:, :, -4 + j], d_forces, rtol=1e-5, atol=1e-6, err_msg=names[j])
+
+
+def test_a_worlds_solution_keeps_its_robots_for_joint_position_derivatives() -> None:
+    pytest.importorskip("pinocchio")
+    solution = qs.solve(qs.load_world(EXAMPLES / "robots" / "planar_hand.yaml"))
+    assert solution.source is not None and [r.name for r in solution.source.robots] == ["hand"]

@@ -20,12 +20,13 @@ from __future__ import annotations
 
 import dataclasses
 import enum
-from collections.abc import Collection
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from .adapters import UrdfRobot
 from .laws import Problem, assemble
 from .laws.geometry_derivative import GeometryDerivative, geometry_derivative, geometry_parameters
 from .laws.inputs import InputVector
@@ -34,7 +35,7 @@ from .laws.pyramid_modes import PyramidModes, pyramid_boundaries, pyramid_deriva
 from .laws.sensitivity import Boundary, FixedModeDerivative, Singular, ball_radius, boundaries, crossing, fixed_mode_derivative
 from .model import FloatArray, Scene
 from .solution import Mode, Solution
-from .tolerances import MODE_BOUNDARY, SAME_TWIST
+from .tolerances import MODE_BOUNDARY, ROUNDOFF, SAME_TWIST
 
 __all__ = [
     "differentiate",
@@ -129,7 +130,9 @@ class GeometrySensitivity:
     parameters : tuple of str
         The G parameters, contact by contact: ``contacts[i].point.x`` (and ``.y``, ``.z``) [length], then
         ``contacts[i].normal.turn_x`` (``_y``, ``_z``; ``normal.turn`` in 2-D) [rad]: the normal turned about
-        that world axis (a turn about the normal itself changes nothing).
+        that world axis (a turn about the normal itself changes nothing); then, for each URDF robot given,
+        ``robots.NAME.q.JOINT`` [rad or length]: the joint position, with the contact points and normals held
+        (the link's Jacobian at each contact point turns with the configuration, so its point velocity does).
     twists : dict name -> array (k, G)
         d(body twist)/d(parameter).
     forces : array (m, d, G)
@@ -218,7 +221,12 @@ class Sensitivity:
 
 
 def differentiate(
-    scene: Scene, solution: Solution, *, inputs: Collection[str] | None = None, geometry: bool = False
+    scene: Scene,
+    solution: Solution,
+    *,
+    inputs: Collection[str] | None = None,
+    geometry: bool = False,
+    robots: Sequence[UrdfRobot] = (),
 ) -> Sensitivity | NoSensitivity:
     """The derivative of ``solution``, an answer of ``scene``, with respect to the scene's inputs.
 
@@ -233,6 +241,9 @@ def differentiate(
     geometry : bool
         Also differentiate with respect to each contact's point and normal (``Sensitivity.geometry``); exact
         cones and 2-D only (a ValueError on 3-D pyramids, whose edges turn with the contact frame).
+    robots : sequence of UrdfRobot
+        With ``geometry``: also differentiate with respect to these robots' joint positions (each must be the
+        scene's robot of that name, at the configuration its contact Jacobians came from).
 
     Returns
     -------
@@ -261,18 +272,51 @@ def differentiate(
     result = _physical(problem, selection, derivative, limits, masks, solution)
     if not geometry:
         return result
-    through = geometry_derivative(problem, masks, q, c)
+    names, rates = _joint_position_rates(scene, robots)
+    through = geometry_derivative(problem, masks, q, c, rates)
     if isinstance(through, Singular):
         return _singular(through)
-    return dataclasses.replace(result, geometry=_physical_geometry(problem, through))
+    return dataclasses.replace(result, geometry=_physical_geometry(problem, through, names))
 
 
-def _physical_geometry(problem: Problem, through: GeometryDerivative) -> GeometrySensitivity:
+def _joint_position_rates(scene: Scene, robots: Sequence[UrdfRobot]) -> tuple[tuple[str, ...], FloatArray]:
+    """Names ``robots.NAME.q.JOINT`` and, per contact, its mover point's world velocity rate per unit of each, (m, d, R)."""
+    names: list[str] = []
+    columns: list[FloatArray] = []
+    movers = {mover.name: mover for mover in scene.movers}
+    for robot in robots:
+        given = next((r for r in scene.robots if r.name == robot.name), None)
+        if given is None:
+            raise ValueError(f"robots: {robot.name!r} is not a robot of the scene")
+        rates = np.zeros((len(scene.contacts), scene.dimension, len(robot.joint_names)))
+        for i, contact in enumerate(scene.contacts):
+            mover = movers.get(contact.other)
+            if mover is None or mover.robot != robot.name:
+                continue
+            link = contact.other.removeprefix(f"{robot.name}/")
+            _check_configuration(robot, link, contact.point, contact.jacobian, f"contacts[{i}]")
+            rates[i] = np.einsum("ajk,k->aj", robot.point_jacobian_rates(link, contact.point), given.joint_velocities)
+        names += [f"robots.{robot.name}.q.{joint}" for joint in robot.joint_names]
+        columns.append(rates)
+    if not columns:
+        return (), np.zeros((len(scene.contacts), scene.dimension, 0))
+    return tuple(names), np.concatenate(columns, axis=2)
+
+
+def _check_configuration(robot: UrdfRobot, link: str, point: FloatArray, jacobian: FloatArray | None, field: str) -> None:
+    """The robot must be where the scene's contact Jacobian was taken, or its rates would be another pose's."""
+    now = robot.point_jacobian(link, point)
+    if jacobian is None or not np.allclose(now, jacobian, rtol=0.0, atol=ROUNDOFF * max(1.0, float(np.abs(now).max()))):
+        raise ValueError(f"robots: {robot.name!r} is not at the configuration {field}'s Jacobian came from")
+
+
+def _physical_geometry(problem: Problem, through: GeometryDerivative, joints: tuple[str, ...]) -> GeometrySensitivity:
     units = problem.scales.twist_units(problem.dimension)
     k = units.size
     twists = {b.name: through.dq[a * k : (a + 1) * k] * units[:, None] for a, b in enumerate(problem.scene.bodies)}
     world = np.einsum("msdG,ms->mdG", through.dframes, through.c) + np.einsum("msd,msG->mdG", problem.frames, through.dc)
-    return GeometrySensitivity(geometry_parameters(problem.dimension, problem.n_contacts), twists, world * problem.scales.force)
+    names = geometry_parameters(problem.dimension, problem.n_contacts) + joints
+    return GeometrySensitivity(names, twists, world * problem.scales.force)
 
 
 def _derivative(
@@ -295,9 +339,10 @@ class SolvedScene:
     """
 
     scene: Scene
+    robots: tuple[UrdfRobot, ...] = ()  # a World's URDF robots, for derivatives in their joint positions
 
     def sensitivity(self, solution: Solution, inputs: Collection[str] | None = None, geometry: bool = False) -> Sensitivity | NoSensitivity:
-        return differentiate(self.scene, solution, inputs=inputs, geometry=geometry)
+        return differentiate(self.scene, solution, inputs=inputs, geometry=geometry, robots=self.robots)
 
 
 def _checked_owners(scene: Scene, owners: Collection[str] | None) -> Collection[str] | None:

@@ -98,6 +98,7 @@ def solve(
             time_limit=time_limit,
             progress=progress,
         )
+        solution = dataclasses.replace(solution, source=SolvedScene(solution.scene, scene.robots))  # joint positions too
         return with_detection(solution, detection)
     started = time.perf_counter()
     problem = scene if isinstance(scene, Problem) else assemble(scene)

@@ -68,8 +68,12 @@ def geometry_parameters(dimension: int, m: int) -> tuple[str, ...]:
     )
 
 
-def geometry_derivative(problem: Problem, masks: ModeMasks, q: FloatArray, c: FloatArray) -> GeometryDerivative | Singular:
-    """The derivative of the motion ``(q, c)`` with modes ``masks`` per unit of each of :func:`geometry_parameters`."""
+def geometry_derivative(
+    problem: Problem, masks: ModeMasks, q: FloatArray, c: FloatArray, velocity_rates: FloatArray | None = None
+) -> GeometryDerivative | Singular:
+    """The derivative of the motion ``(q, c)`` with modes ``masks`` per unit of each of :func:`geometry_parameters`,
+    then of R more parameters that only move the movers' points: ``velocity_rates`` (m, d, R), the world velocity
+    of each contact's mover point per unit of each [length/time per parameter unit] (a robot's joint positions)."""
     laws = FixedModeLaws(problem, masks)
     x = polish(laws, laws.start(q, c, nonnegative=False))
     if isinstance(x, Singular):
@@ -77,10 +81,13 @@ def geometry_derivative(problem: Problem, masks: ModeMasks, q: FloatArray, c: Fl
     changes = [change for i in range(problem.n_contacts) for change in _changes(problem, i)]
     q, forces = laws.motion(x)
     u = problem.velocities(q)
-    G, (m, d, n) = len(changes), problem.J.shape
+    (m, d, n), R = problem.J.shape, 0 if velocity_rates is None else velocity_rates.shape[2]
+    G = len(changes) + R
     dJ, db = np.zeros((m, d, n, G)), np.zeros((m, d, G))
     for g, change in enumerate(changes):
         dJ[change.contact, :, :, g], db[change.contact, :, g] = _data_change(problem, change)
+    if velocity_rates is not None:
+        db[:, :, len(changes) :] = np.einsum("mst,mtR->msR", problem.frames, velocity_rates) / problem.scales.velocity
     dF = np.stack([_residual_change(laws, q, forces, u, dJ[..., g], db[..., g]) for g in range(G)], axis=1)
     dx = -np.linalg.solve(laws.jacobian(x), dF).astype(float)
     dq = dx[:n]
