@@ -280,6 +280,8 @@ def test_joint_position_derivatives_match_finite_differences_of_the_solve() -> N
     assert not any(name.startswith("robots.") for name in plain.geometry.parameters)
     with pytest.raises(ValueError, match="robots: 'hand' is not at the configuration"):
         qs.sensitivity(scene, solution, geometry=True, robots=[robot.at(q=q + 0.1)])
+    with pytest.raises(ValueError, match="robots: joint-position derivatives come with the geometry"):
+        qs.sensitivity(scene, solution, robots=[robot])
     result = qs.sensitivity(scene, solution, geometry=True, robots=[robot])
     assert isinstance(result, qs.Sensitivity) and result.geometry is not None
     names = result.geometry.parameters[-4:]

@@ -250,6 +250,8 @@ def differentiate(
     Sensitivity, or NoSensitivity with the reason there is none.
     """
     selection = InputVector.of(scene, _checked_owners(scene, inputs))
+    if robots and not geometry:
+        raise ValueError("robots: joint-position derivatives come with the geometry's; pass geometry=True")
     if geometry and scene.dimension == 3 and scene.friction.kind == "pyramid":
         raise ValueError("geometry: derivatives through the geometry are given for exact cones and in 2-D, not on 3-D pyramids")
     refused = _refusal(solution)
