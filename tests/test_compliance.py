@@ -421,3 +421,64 @@ def test_closing_time_without_springs_says_so() -> None:
     solution = qs.solve(qs.Scene(grasp.bodies, rigid, grasp.movers, dimension=2, closing_time=0.5))
     assert solution.status == "jammed" and solution.compliant_step is None
     assert "nothing has a stiffness" in solution.details["compliance"]
+
+
+HAND = Path(__file__).resolve().parents[1] / "examples" / "robots" / "planar_hand.yaml"
+HAND_STIFFNESS = {"left_base": 2.0, "left_middle": 5.0, "right_base": 3.0, "right_middle": 7.0}  # N m/rad, all different
+
+
+def _closing_hand(tmp_path: Path, joint_stiffness: object) -> Path:
+    """examples/robots/planar_hand.yaml with its base joints closing the fingertips on the box for 0.1 s, contact
+    springs of 2000 N/m, the given joint stiffness, and no gravity (the squeeze alone: no tangential load)."""
+    import yaml
+
+    data = yaml.safe_load(HAND.read_text(encoding="utf-8"))
+    data["robots"]["hand"]["urdf"] = str(HAND.parent / data["robots"]["hand"]["urdf"])
+    data["robots"]["hand"]["joint_velocities"] = {"left_base": -0.05, "right_base": 0.05}
+    data["robots"]["hand"]["joint_stiffness"] = joint_stiffness
+    data["contact_detection"]["stiffness"] = {"default": {"normal": 2000.0}}
+    data["gravity"] = [0.0, 0.0, 0.0]
+    data["closing_time"] = 0.1
+    path = tmp_path / "closing_hand.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    return path
+
+
+def test_a_urdf_robots_joint_stiffness_yields_in_series(tmp_path: Path) -> None:
+    """A URDF robot's joint stiffness by joint name (robots.hand.joint_stiffness), mapped to the contacts through
+    Pinocchio's Jacobians. The two fingertips squeeze the box along x, collinear, so their springs act in series
+    across it: N = h (b_1 + b_2) / (c_1 + c_2), with each contact's closing speed b_i = n_i . J_i qdot and its
+    normal compliance c_i = 1/k_n + sum_j (n_i . J_i[:, j])^2 / k_j (the box's turn and lift take up the
+    fingertips' other deflections). Each joint has its own stiffness, so a joint mapped to another's value, or
+    joint stiffness ignored (N = 10.5 N), fails."""
+    pytest.importorskip("pinocchio")
+    path = _closing_hand(tmp_path, HAND_STIFFNESS)
+    scene = qs.load_scene(path)
+    robot = scene.robot("hand")
+    assert robot.joint_names == ("left_base", "left_middle", "right_base", "right_middle")
+    np.testing.assert_array_equal(robot.joint_stiffness, [2.0, 5.0, 3.0, 7.0])
+    compliance = [1 / 2000.0 + ((c.normal @ c.jacobian) ** 2) @ (1 / robot.joint_stiffness) for c in scene.contacts]
+    advance = [0.1 * c.normal @ c.jacobian @ robot.joint_velocities for c in scene.contacts]
+    squeeze = sum(advance) / sum(compliance)
+    assert squeeze == pytest.approx(0.0853684, rel=1e-5)  # the Jacobians' columns: 0.105, 0.0785 m per rad
+    out = json.loads(subprocess.run([QUASISTATIC, "solve", str(path), "--json"], capture_output=True, text=True, check=True).stdout)
+    assert out["status"] == "jammed"  # rigid fingers cannot close on a rigid box
+    step = out["compliant_step"]
+    assert step["valid"] and [c["state"] for c in step["contacts"]] == ["stuck", "stuck"]
+    np.testing.assert_allclose([c["normal_force"] for c in step["contacts"]], [squeeze, squeeze], rtol=1e-8)
+
+
+@pytest.mark.parametrize(
+    ("stiffness", "message"),
+    [
+        ({"left_base": 2.0}, "name every joint (missing: left_middle, right_base, right_middle)"),
+        ({**HAND_STIFFNESS, "left_base": -1.0}, "every joint stiffness must be > 0"),
+        ({**HAND_STIFFNESS, "elbow": 1.0}, "robots.hand.joint_stiffness.elbow"),
+    ],
+)
+def test_bad_urdf_joint_stiffness_is_one_error_line(tmp_path: Path, stiffness: object, message: str) -> None:
+    pytest.importorskip("pinocchio")
+    result = subprocess.run([QUASISTATIC, "solve", str(_closing_hand(tmp_path, stiffness))], capture_output=True, text=True)
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error:") and message in lines[0], result.stderr

@@ -206,3 +206,65 @@ def test_a_robot_plan_is_the_least_norm_joint_velocity() -> None:
     assert result.input_names == ("arm.joint[0]", "arm.joint[1]")
     np.testing.assert_allclose(result.inputs, [-0.01, -0.01], atol=1e-12)
     assert result.unique is True
+
+
+def _pushed_box_3d(friction: str) -> qs.Scene:
+    """A 0.1 m cube of 0.5 kg on a floor (four corners, mu 0.3), a frictionless fingertip at the middle of its -x face."""
+    corners = [[x, y, 0.0] for x in (-0.05, 0.05) for y in (-0.05, 0.05)]
+    return qs.Scene(
+        bodies=[qs.Body("box", 0.5, [0.0, 0.0, 0.05])],
+        movers=[qs.Mover("floor"), qs.Mover("finger", origin=[-0.05, 0.0, 0.05])],
+        contacts=[qs.Contact("box", "floor", p, [0.0, 0.0, 1.0], mu=0.3) for p in corners]
+        + [qs.Contact("box", "finger", [-0.05, 0.0, 0.05], [1.0, 0.0, 0.0])],
+        dimension=3,
+        friction=friction,
+    )
+
+
+def test_pushing_a_box_on_pyramid_friction() -> None:
+    """3-D, pyramid:4 (edges along the contact frame's tangents): the floor's friction opposes the slip along +x from
+    one edge (a vertex of the friction square), 0.3 m g in all; the frictionless finger pushes with exactly that
+    and moves with the box. The forward certified solve of the planned scene gives the same motion."""
+    scene = _pushed_box_3d("pyramid:4")
+    twist = [0.01, 0.0, 0.0, 0.0, 0.0, 0.0]
+    result = qs.plan(scene, twist, ["sliding"] * 4 + ["rolling"], free=["finger"], certify=True)
+    assert result.status == "planned", result.message
+    np.testing.assert_allclose(result.inputs, twist, atol=1e-12)
+    assert result.motion is not None and result.motion.modes == ("sliding",) * 4 + ("rolling",)
+    np.testing.assert_allclose(result.motion.contacts[4].force, [0.3 * 0.5 * G, 0.0, 0.0], atol=1e-9)
+    friction = sum(np.array(c.force) for c in result.motion.contacts[:4])
+    np.testing.assert_allclose(friction, [-0.3 * 0.5 * G, 0.0, 0.5 * G], atol=1e-9)
+    assert result.forward is not None and any(
+        np.allclose(m.twists["box"], twist, atol=1e-9) for m in (result.forward.solutions or (result.forward.motion,)) if m is not None
+    )
+
+
+def _pyramid_motions() -> list[tuple[qs.Scene, qs.Solution]]:
+    from random_scenes import random_scene
+
+    found = []
+    for seed in range(40):
+        scene = random_scene(3, seed, "pyramid:8")
+        solution = qs.solve(scene)
+        if solution.status == "solved" and "sliding" in solution.modes:
+            found.append((scene, solution))
+    return found
+
+
+def test_a_plan_on_pyramids_recovers_inputs_as_cheap_as_the_forward_ones() -> None:
+    """Random 3-D scenes on pyramid:8 with sliding contacts: planning each solved motion (its twist and modes, every
+    finger free) gives audited inputs that cost no more than the scene's own (which realise it), whose slips load
+    the pyramid's edges or faces as maximum dissipation wants, and which the forward solve says give that motion."""
+    cases = _pyramid_motions()
+    assert len(cases) >= 5
+    for scene, solution in cases:
+        fingers = [m.name for m in scene.movers if m.name != "table"]
+        speeds = [np.linalg.norm(c.slip) if c.mode == "sliding" else c.normal_velocity for c in solution.contacts if c.mode != "rolling"]
+        twist = solution.twists["box"]
+        result = qs.plan(scene, twist, solution.modes, free=fingers, min_speed=0.5 * min(speeds), certify=True)
+        assert result.status == "planned", (result.message, solution.modes)
+        own = np.concatenate([scene.mover(f).twist for f in fingers])
+        assert result.cost is not None and result.cost <= 0.5 * own @ own * (1 + 1e-9) + 1e-15
+        assert result.forward is not None
+        motions = result.forward.solutions or ((result.forward.motion,) if result.forward.motion is not None else ())
+        assert any(np.allclose(m.twists["box"], twist, atol=1e-9 * max(1.0, np.abs(twist).max())) for m in motions)

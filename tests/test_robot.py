@@ -153,3 +153,22 @@ def test_visual_meshes_sit_on_their_links_collision_shapes(scale: float) -> None
 def test_a_urdf_without_visual_geometry_has_no_visuals() -> None:
     hand = qs.load_world(Path(__file__).resolve().parents[1] / "examples" / "robots" / "planar_hand.yaml").robots[0]
     assert hand.visuals == ()
+
+
+def test_point_jacobian_rates_match_pinocchio_at_nearby_configurations() -> None:
+    """UrdfRobot.point_jacobian_rates (the Lie brackets of the joints' spatial twists) against central differences of
+    point_jacobian at q +- h e_j (Pinocchio's forward kinematics), for the Panda on a turned, shifted base, at a world
+    point held fixed: a bracket in the wrong order or a missing ancestor fails."""
+    c, s = np.cos(0.7), np.sin(0.7)
+    base = qs.Pose([0.1, 0.2, 0.3], [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+    robot = qs.UrdfRobot("panda", PANDA, q=[0.1, -0.7, 0.2, -2.3, 0.1, 1.5, 0.7, 0.02, 0.02], base=base)
+    point = np.array([0.3, 0.05, 0.5])
+    rates = robot.point_jacobian_rates("panda_leftfinger", point)
+    assert rates.shape == (3, 9, 9) and float(np.abs(rates).max()) > 0.5
+    h = 1e-6
+    for j in range(9):
+        step = np.zeros(9)
+        step[j] = h
+        ahead, behind = robot.at(q=robot.q + step), robot.at(q=robot.q - step)
+        difference = (ahead.point_jacobian("panda_leftfinger", point) - behind.point_jacobian("panda_leftfinger", point)) / (2 * h)
+        np.testing.assert_allclose(rates[:, j, :], difference, atol=1e-8, err_msg=f"q[{j}]")

@@ -37,7 +37,7 @@ if TYPE_CHECKING:
     from .loading import load_scene, load_world
     from .model import Body, Contact, FrictionModel, Mover, Robot, Scene, Stiffness
     from .plan import PlanResult, QuadraticCost, plan
-    from .sensitivity import InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, sensitivity
+    from .sensitivity import GeometrySensitivity, InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, sensitivity
     from .sim import Inputs, InputTable, Trajectory, simulate
     from .solution import Attempt, Audit, Certificate, CertificateKind, ContactResult, Diagnosis, Motion, PowerBalance, Solution
     from .solve import METHODS, solve
@@ -45,126 +45,45 @@ if TYPE_CHECKING:
     from .viz import plot, view
 __version__ = "0.1.0"
 
-# public name -> the module (relative to this package) that defines it
-_EXPORTS: dict[str, str] = {
-    **dict.fromkeys(
-        (
-            "Box",
-            "Capsule",
-            "ContactDetection",
-            "Cylinder",
-            "FrictionPair",
-            "Halfspace",
-            "Mesh",
-            "Pose",
-            "ShapedMover",
-            "SolidBody",
-            "Sphere",
-            "UrdfRobot",
-            "World",
-        ),
-        "adapters",
+# each module (relative to this package) and the public names it defines
+_MODULES: dict[str, tuple[str, ...]] = {
+    "adapters": (
+        "Box",
+        "Capsule",
+        "ContactDetection",
+        "Cylinder",
+        "FrictionPair",
+        "Halfspace",
+        "Mesh",
+        "Pose",
+        "ShapedMover",
+        "SolidBody",
+        "Sphere",
+        "UrdfRobot",
+        "World",
     ),
-    **dict.fromkeys(("solve_many",), "batch"),
-    **dict.fromkeys(
-        (
-            "BackendUnavailableError",
-            "QuasistaticError",
-            "SceneError",
-            "SolverError",
-        ),
-        "errors",
-    ),
-    **dict.fromkeys(
-        (
-            "Problem",
-            "assemble",
-        ),
-        "laws",
-    ),
-    **dict.fromkeys(
-        (
-            "load_scene",
-            "load_world",
-        ),
-        "loading",
-    ),
-    **dict.fromkeys(
-        (
-            "Body",
-            "Contact",
-            "FrictionModel",
-            "Mover",
-            "Robot",
-            "Scene",
-            "Stiffness",
-        ),
-        "model",
-    ),
-    **dict.fromkeys(
-        (
-            "PlanResult",
-            "QuadraticCost",
-            "plan",
-        ),
-        "plan",
-    ),
-    **dict.fromkeys(
-        (
-            "InputMargin",
-            "ModeChange",
-            "NoSensitivity",
-            "NoSensitivityReason",
-            "Sensitivity",
-            "sensitivity",
-        ),
+    "batch": ("solve_many",),
+    "errors": ("BackendUnavailableError", "QuasistaticError", "SceneError", "SolverError"),
+    "laws": ("Problem", "assemble"),
+    "loading": ("load_scene", "load_world"),
+    "model": ("Body", "Contact", "FrictionModel", "Mover", "Robot", "Scene", "Stiffness"),
+    "plan": ("PlanResult", "QuadraticCost", "plan"),
+    "sensitivity": (
+        "GeometrySensitivity",
+        "InputMargin",
+        "ModeChange",
+        "NoSensitivity",
+        "NoSensitivityReason",
+        "Sensitivity",
         "sensitivity",
     ),
-    **dict.fromkeys(
-        (
-            "Inputs",
-            "InputTable",
-            "Trajectory",
-            "simulate",
-        ),
-        "sim",
-    ),
-    **dict.fromkeys(
-        (
-            "Attempt",
-            "Audit",
-            "Certificate",
-            "CertificateKind",
-            "ContactResult",
-            "Diagnosis",
-            "Motion",
-            "PowerBalance",
-            "Solution",
-        ),
-        "solution",
-    ),
-    **dict.fromkeys(
-        (
-            "METHODS",
-            "solve",
-        ),
-        "solve",
-    ),
-    **dict.fromkeys(
-        (
-            "SweepResult",
-            "sweep",
-        ),
-        "sweeps",
-    ),
-    **dict.fromkeys(
-        (
-            "plot",
-            "view",
-        ),
-        "viz",
-    ),
+    "sim": ("Inputs", "InputTable", "Trajectory", "simulate"),
+    "solution": ("Attempt", "Audit", "Certificate", "CertificateKind", "ContactResult", "Diagnosis", "Motion", "PowerBalance", "Solution"),
+    "solve": ("METHODS", "solve"),
+    "sweeps": ("SweepResult", "sweep"),
+    "viz": ("plot", "view"),
 }
+_EXPORTS = {name: module for module, names in _MODULES.items() for name in names}
 
 
 def __getattr__(name: str) -> Any:
@@ -197,6 +116,7 @@ sys.modules[__name__].__class__ = _Package
 
 __all__ = [
     "sensitivity",
+    "GeometrySensitivity",
     "plan",
     "Sensitivity",
     "QuadraticCost",

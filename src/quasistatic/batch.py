@@ -9,6 +9,7 @@ blocks of item indices, and only the solutions travel back. Elsewhere joblib
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import multiprocessing
 import os
@@ -20,6 +21,7 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 from .check import DEFAULT_TOLERANCE
+from .derivative import SolvedScene
 from .errors import QuasistaticError
 from .laws import Problem, assemble
 from .model import Scene
@@ -111,7 +113,7 @@ def solve_many(
         return _solve_chunk(items, 0, method, options)
     if _can_fork():
         workers = len(os.sched_getaffinity(0)) if n_jobs == -1 else n_jobs
-        return _solve_forked(items, workers, chunks_per_job, method, options)
+        return _with_scenes(_solve_forked(items, workers, chunks_per_job, method, options), items)
     try:
         import joblib
     except ImportError as exc:  # a declared dependency; only a broken install lacks it
@@ -121,7 +123,15 @@ def solve_many(
     starts = range(0, len(items), size)
     parallel = joblib.Parallel(n_jobs=workers, backend="loky")
     results = parallel(joblib.delayed(_solve_chunk)(items[s : s + size], s, method, options) for s in starts)
-    return [solution for chunk in results for solution in chunk]
+    return _with_scenes([solution for chunk in results for solution in chunk], items)
+
+
+def _with_scenes(solutions: list[Solution], items: Sequence[Scene | Problem]) -> list[Solution]:
+    """Each solution with its scene attached again (a Solution is pickled without it), so ``sensitivity()`` works."""
+    return [
+        dataclasses.replace(solution, source=SolvedScene(item.scene if isinstance(item, Problem) else item))
+        for solution, item in zip(solutions, items, strict=True)
+    ]
 
 
 def _solve_chunk(items: Sequence[Scene | Problem], offset: int, method: str, options: dict[str, Any]) -> list[Solution]:

@@ -138,8 +138,6 @@ def plan(
     selection = InputVector.of(scene, _checked_free(scene, free))
     base = selection.apply(scene, np.zeros(selection.size))
     problem = assemble(base)
-    if scene.dimension == 3 and scene.friction.kind == "pyramid":
-        raise ValueError("friction: the planner needs 'exact' or 'none' in 3-D (its sliding law is the circle's), not pyramid")
     units = problem.scales.twist_units(scene.dimension)
     T = _checked_twists(scene, twist)
     hessian, linear = _checked_cost(cost, selection.size)

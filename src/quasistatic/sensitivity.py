@@ -1,169 +1,32 @@
 """``sensitivity(scene)``: the exact derivative of a solved motion with respect to the commanded inputs.
 
 The inputs are the robots' joint velocities and the rigid movers' twists
-(:class:`~quasistatic.laws.inputs.InputVector`). Within the motion's contact modes
-the laws are smooth equations (:mod:`quasistatic.laws.fixed_modes`); their
-implicit-function derivative (:mod:`quasistatic.laws.sensitivity`) gives every
-body twist's and contact force's rate per unit of each input, and the mode
-boundaries give how far each input can move before a contact changes mode.
-Where no derivative exists (not ``solved``, forces indeterminate, a motion on a
-mode boundary) the answer is a :class:`NoSensitivity` that says why.
+(:class:`~quasistatic.laws.inputs.InputVector`); the work is done by
+:func:`quasistatic.derivative.differentiate`, which ``solution.sensitivity()``
+also reaches. This function only solves the scene first when no answer is given.
 """
 
 from __future__ import annotations
 
-import enum
-from collections.abc import Collection
-from dataclasses import dataclass
-from typing import Any
+from collections.abc import Collection, Sequence
 
-import numpy as np
-
-from .laws import Problem, assemble
-from .laws.inputs import InputVector
-from .laws.modes import ModeMasks
-from .laws.sensitivity import Boundary, FixedModeDerivative, Singular, ball_radius, boundaries, crossing, fixed_mode_derivative
-from .model import FloatArray, Scene
-from .solution import Mode, Solution
+from .adapters import UrdfRobot
+from .derivative import GeometrySensitivity, InputMargin, ModeChange, NoSensitivity, NoSensitivityReason, Sensitivity, differentiate
+from .model import Scene
+from .solution import Solution
 from .solve import solve
-from .tolerances import MODE_BOUNDARY, SAME_TWIST
 
-__all__ = ["sensitivity", "Sensitivity", "NoSensitivity", "NoSensitivityReason", "ModeChange", "InputMargin"]
-
-_CHANGES = {
-    "separating": "the separating contact closes (normal speed reaches 0)",
-    "normal_force": "the normal force reaches 0 (the contact may separate)",
-    "cone": "the rolling contact's force reaches its friction cone (it may slide)",
-    "slip": "the sliding contact's slip reaches 0 (it may stick)",
-}
+__all__ = ["sensitivity", "Sensitivity", "GeometrySensitivity", "NoSensitivity", "NoSensitivityReason", "ModeChange", "InputMargin"]
 
 
-class NoSensitivityReason(enum.Enum):
-    """Why a motion has no derivative with respect to the inputs."""
-
-    NOT_SOLVED = "not_solved"
-    """The answer is not ``solved`` (ambiguous, jammed, unstable or failed): there is no one motion to differentiate."""
-    FORCES_INDETERMINATE = "forces_indeterminate"
-    """The motion's forces are not unique, so their derivative is not defined."""
-    CONTINUUM = "continuum"
-    """The twist is not isolated within its modes (a continuum of motions)."""
-    MODE_BOUNDARY = "mode_boundary"
-    """A contact is on the boundary between two modes: the one-sided derivatives differ."""
-    UNSUPPORTED_FRICTION = "unsupported_friction"
-    """3-D pyramid friction: its sliding law is not the fixed-mode laws' circle (use ``friction: exact``)."""
-    NO_ROOT = "no_root"
-    """Newton's method on the fixed-mode laws did not return to the reported motion."""
-
-
-@dataclass(frozen=True)
-class NoSensitivity:
-    """No derivative, and why: ``reason``, a sentence, and the contact concerned when there is one."""
-
-    reason: NoSensitivityReason
-    message: str
-    contact: int | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"available": False, "reason": self.reason.value, "message": self.message, "contact": self.contact}
-
-
-@dataclass(frozen=True)
-class ModeChange:
-    """The first mode change met: at ``contact`` (scene order), ``what`` (separating, normal_force, cone, slip)."""
-
-    contact: int
-    what: str
-
-    @property
-    def description(self) -> str:
-        return f"contacts[{self.contact}]: {_CHANGES[self.what]}"
-
-
-@dataclass(frozen=True)
-class InputMargin:
-    """How far one input may decrease (``below``) or increase (``above``) alone before a contact changes mode.
-
-    In the input's own unit; ``inf`` when no mode changes in that direction. ``below_change``/``above_change``
-    name the first change (None with ``inf``).
-    """
-
-    input: str
-    below: float
-    above: float
-    below_change: ModeChange | None
-    above_change: ModeChange | None
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "input": self.input,
-            "below": _finite(self.below),
-            "above": _finite(self.above),
-            "below_change": None if self.below_change is None else self.below_change.description,
-            "above_change": None if self.above_change is None else self.above_change.description,
-        }
-
-
-@dataclass(frozen=True)
-class Sensitivity:
-    """The derivative of one solved motion with respect to the inputs, in physical units and world frame.
-
-    Attributes
-    ----------
-    inputs : tuple of str
-        The P inputs, e.g. ``hand.joint[0]``, ``pusher.v_x`` (robots' joints, then rigid movers' twists).
-    twists : dict name -> array (k, P)
-        d(body twist)/d(input): [length/time or rad/time per input unit].
-    forces : array (m, d, P)
-        d(world contact force on the body)/d(input) [force per input unit].
-    modes : tuple of str
-        The contact modes the derivative holds in.
-    margins : tuple of InputMargin
-        Per input: how far it may move alone, either way, before a contact changes mode.
-    ball : float
-        Radius of the Euclidean ball in the inputs (mixed units, as given) within which no contact changes
-        mode; ``ball_change`` names the nearest change.
-    margins_exact : bool
-        True in 2-D and in 3-D without sliding frictional contacts: the laws are affine in the inputs and the
-        margins are exact. Otherwise they are first-order estimates.
-    ball_exact : bool
-        True when every mode-deciding quantity is linear in the inputs (2-D, or no frictional 3-D contact closed).
-    certified : bool
-        The differentiated motion was proven the only one (a certified ``solved``).
-    """
-
-    inputs: tuple[str, ...]
-    twists: dict[str, FloatArray]
-    forces: FloatArray
-    modes: tuple[Mode, ...]
-    margins: tuple[InputMargin, ...]
-    ball: float
-    ball_change: ModeChange | None
-    margins_exact: bool
-    ball_exact: bool
-    certified: bool
-
-    @property
-    def twist_jacobian(self) -> FloatArray:
-        """Every body's twist stacked in scene order, per input: (k n, P)."""
-        return np.concatenate(list(self.twists.values()), axis=0)
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "available": True,
-            "inputs": list(self.inputs),
-            "twists": {name: d.tolist() for name, d in self.twists.items()},
-            "forces": self.forces.tolist(),
-            "modes": list(self.modes),
-            "margins": [m.to_dict() for m in self.margins],
-            "ball": _finite(self.ball),
-            "ball_change": None if self.ball_change is None else self.ball_change.description,
-            "margins_exact": self.margins_exact,
-            "ball_exact": self.ball_exact,
-            "certified": self.certified,
-        }
-
-
-def sensitivity(scene: Scene, solution: Solution | None = None, *, inputs: Collection[str] | None = None) -> Sensitivity | NoSensitivity:
+def sensitivity(
+    scene: Scene,
+    solution: Solution | None = None,
+    *,
+    inputs: Collection[str] | None = None,
+    geometry: bool = False,
+    robots: Sequence[UrdfRobot] = (),
+) -> Sensitivity | NoSensitivity:
     """The derivative of the scene's solved motion with respect to its inputs.
 
     Parameters
@@ -173,129 +36,14 @@ def sensitivity(scene: Scene, solution: Solution | None = None, *, inputs: Colle
         The scene's answer (``solve(scene)`` when omitted). Only a ``solved`` motion has a derivative.
     inputs : collection of str, optional
         Names of the robots and rigid movers whose inputs to differentiate by (all of them when omitted).
+    geometry : bool
+        Also differentiate with respect to each contact's point and normal (``Sensitivity.geometry``).
+    robots : sequence of UrdfRobot
+        With ``geometry``: also with respect to these URDF robots' joint positions, contact points and normals
+        held (a Solution of a World passes its robots itself: ``solution.sensitivity(geometry=True)``).
 
     Returns
     -------
     Sensitivity, or NoSensitivity with the reason there is none.
     """
-    selection = InputVector.of(scene, _checked_owners(scene, inputs))
-    if scene.friction.kind == "pyramid":
-        reason = "pyramid friction in 3-D slides along the pyramid's faces, not the fixed-mode laws' circle; use friction 'exact'"
-        return NoSensitivity(NoSensitivityReason.UNSUPPORTED_FRICTION, reason)
-    solution = solve(scene) if solution is None else solution
-    refused = _refusal(solution)
-    if refused is not None:
-        return refused
-    assert solution.motion is not None  # solved
-    problem = assemble(scene)
-    masks = ModeMasks.of(problem, solution.modes)
-    derivative = fixed_mode_derivative(problem, masks, *_relative_motion(problem, solution), _input_map(problem, selection))
-    if isinstance(derivative, Singular):
-        return _singular(derivative)
-    if float(np.max(np.abs(derivative.q - _relative_motion(problem, solution)[0]), initial=0.0)) > SAME_TWIST:
-        return NoSensitivity(NoSensitivityReason.NO_ROOT, "Newton's method on the fixed-mode laws left the reported motion")
-    limits = boundaries(derivative, masks, problem.mu)
-    on_boundary = next((b for b in limits if b.value < MODE_BOUNDARY), None)
-    if on_boundary is not None:
-        change = ModeChange(on_boundary.contact, on_boundary.what)
-        return NoSensitivity(NoSensitivityReason.MODE_BOUNDARY, f"on a mode boundary: {change.description}", on_boundary.contact)
-    return _physical(problem, selection, derivative, limits, masks, solution)
-
-
-def _checked_owners(scene: Scene, owners: Collection[str] | None) -> Collection[str] | None:
-    if owners is None:
-        return None
-    if isinstance(owners, str):
-        owners = (owners,)
-    known = {r.name for r in scene.robots} | {m.name for m in scene.movers if m.robot is None}
-    for name in owners:
-        if name not in known:
-            raise ValueError(f"inputs: {name!r} is not a robot or a mover with a twist (known: {', '.join(sorted(known)) or 'none'})")
-    return owners
-
-
-def _refusal(solution: Solution) -> NoSensitivity | None:
-    if solution.status != "solved" or solution.motion is None:
-        return NoSensitivity(NoSensitivityReason.NOT_SOLVED, f"the answer is {solution.status}: there is no one motion to differentiate")
-    if solution.forces_indeterminate:
-        return NoSensitivity(
-            NoSensitivityReason.FORCES_INDETERMINATE, "the contact forces are indeterminate: their derivative is not defined"
-        )
-    if solution.motion.continuum:
-        return NoSensitivity(NoSensitivityReason.CONTINUUM, "the motion is a continuum: it is not isolated")
-    return None
-
-
-def _singular(singular: Singular) -> NoSensitivity:
-    if singular.why == "forces_indeterminate":
-        return NoSensitivity(NoSensitivityReason.FORCES_INDETERMINATE, "the fixed-mode laws leave the forces free: no derivative of forces")
-    if singular.why == "continuum":
-        return NoSensitivity(NoSensitivityReason.CONTINUUM, "the fixed-mode laws leave the twist free: the motion is not isolated")
-    return NoSensitivity(NoSensitivityReason.NO_ROOT, "the reported motion does not satisfy the fixed-mode laws to their tolerance")
-
-
-def _relative_motion(problem: Problem, solution: Solution) -> tuple[FloatArray, FloatArray]:
-    """The solution's twist and contact-frame forces in scene-relative units."""
-    assert solution.motion is not None
-    units = problem.scales.twist_units(problem.dimension)
-    q = np.concatenate([solution.twists[b.name] / units for b in problem.scene.bodies])
-    forces = np.array([c.force for c in solution.contacts], dtype=float).reshape(problem.n_contacts, problem.dimension)
-    return q, np.einsum("mst,mt->ms", problem.frames, forces) / problem.scales.force
-
-
-def _input_map(problem: Problem, selection: InputVector) -> FloatArray:
-    """d b / d p: the movers' scene-relative point velocities in contact frames per physical input unit, (m, d, P)."""
-    W = selection.point_velocity_map(problem.scene)
-    return np.einsum("mst,mtP->msP", problem.frames, W) / problem.scales.velocity
-
-
-def _physical(
-    problem: Problem,
-    selection: InputVector,
-    derivative: FixedModeDerivative,
-    limits: list[Boundary],
-    masks: ModeMasks,
-    solution: Solution,
-) -> Sensitivity:
-    scene, scales = problem.scene, problem.scales
-    units = scales.twist_units(problem.dimension)
-    k = units.size
-    twists = {b.name: derivative.dq[a * k : (a + 1) * k] * units[:, None] for a, b in enumerate(scene.bodies)}
-    forces = np.einsum("msd,msP->mdP", problem.frames, derivative.dc) * scales.force
-    margins = tuple(_margin(name, j, selection.size, limits, derivative.affine) for j, name in enumerate(selection.names))
-    radii = [ball_radius(b) for b in limits]
-    nearest = int(np.argmin(radii)) if radii else -1
-    ball = radii[nearest] if radii else float("inf")
-    linear = problem.dimension == 2 or not bool(np.any(masks.closed & (problem.mu > 0)))
-    return Sensitivity(
-        inputs=selection.names,
-        twists=twists,
-        forces=forces,
-        modes=solution.modes,
-        margins=margins,
-        ball=ball,
-        ball_change=ModeChange(limits[nearest].contact, limits[nearest].what) if np.isfinite(ball) else None,
-        margins_exact=derivative.affine,
-        ball_exact=linear,
-        certified=solution.certified,
-    )
-
-
-def _margin(name: str, j: int, size: int, limits: list[Boundary], affine: bool) -> InputMargin:
-    ends: list[tuple[float, ModeChange | None]] = []
-    for sign in (-1.0, 1.0):
-        direction = np.zeros(size)
-        direction[j] = sign
-        distances = [crossing(b, direction, affine) for b in limits]
-        first = int(np.argmin(distances)) if distances else -1
-        if first < 0 or not np.isfinite(distances[first]):
-            ends.append((float("inf"), None))
-        else:
-            ends.append((distances[first], ModeChange(limits[first].contact, limits[first].what)))
-    (below, below_change), (above, above_change) = ends
-    return InputMargin(name, below, above, below_change, above_change)
-
-
-def _finite(value: float) -> float | None:
-    """JSON has no infinity: an unbounded margin is null."""
-    return float(value) if np.isfinite(value) else None
+    return differentiate(scene, solve(scene) if solution is None else solution, inputs=inputs, geometry=geometry, robots=robots)

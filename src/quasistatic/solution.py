@@ -6,6 +6,7 @@ Plain value types; this module imports nothing else of the package.
 from __future__ import annotations
 
 import enum
+from collections.abc import Collection
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, Literal, Protocol
@@ -541,6 +542,18 @@ class Motion:
         return out
 
 
+class SolveSource(Protocol):
+    """What a Solution keeps of the solve that made it (:class:`quasistatic.derivative.SolvedScene`, set by ``solve``).
+
+    ``scene`` is the Scene it was solved from (typed loosely: this module imports nothing of the package).
+    """
+
+    @property
+    def scene(self) -> Any: ...
+
+    def sensitivity(self, solution: Solution, inputs: Collection[str] | None = None, geometry: bool = False) -> Any: ...
+
+
 @dataclass(frozen=True)
 class Solution:
     """The answer to one forward object motion problem.
@@ -590,6 +603,10 @@ class Solution:
         Wall time of the whole solve, audit included [s].
     notes : tuple of (name, value) pairs
         Solver-specific remarks for people (pivots, stages, formulations); ``details`` shows them as a dict.
+    source : SolveSource or None
+        The scene this answer was solved from (``solve`` and ``solve_many`` set it), so that :meth:`sensitivity`
+        needs no arguments; not compared, not printed, not in :meth:`to_dict` and not pickled. None for a
+        Solution built by hand or read back from a pickle.
     """
 
     status: Status
@@ -609,6 +626,32 @@ class Solution:
     fallback: tuple[Attempt, ...] = ()
     seconds: float = 0.0
     notes: tuple[tuple[str, Any], ...] = ()
+    source: SolveSource | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def scene(self) -> Any:
+        """The Scene this answer was solved from (None for a Solution built by hand)."""
+        return None if self.source is None else self.source.scene
+
+    def sensitivity(self, inputs: Collection[str] | None = None, geometry: bool = False) -> Any:
+        """The exact derivative of this answer's motion with respect to its scene's inputs (issue 15).
+
+        Returns a :class:`quasistatic.Sensitivity`, or a :class:`quasistatic.NoSensitivity` saying why there is
+        none (not ``solved``, forces indeterminate, a mode boundary), exactly as
+        ``quasistatic.sensitivity(solution.scene, solution, inputs=inputs, geometry=geometry)``. ``inputs`` names
+        the robots and movers to differentiate by (all by default); ``geometry`` adds the derivative with respect
+        to the contact points and normals.
+        """
+        if self.source is None:
+            raise ValueError(
+                "source: this Solution was not made by solve(), so it has no scene to differentiate; use qs.sensitivity(scene, solution)"
+            )
+        return self.source.sensitivity(self, inputs, geometry)
+
+    def __getstate__(self) -> dict[str, Any]:
+        # Pickled without its scene: a batch's worker would ship back the scene its parent holds, doubling the cost
+        # of returning a small answer; solve_many attaches the parent's own scene again.
+        return {**self.__dict__, "source": None}
 
     @property
     def twists(self) -> dict[str, np.ndarray]:

@@ -18,6 +18,7 @@ import numpy as np
 
 from .adapters import Detection, World
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion, audited_step
+from .derivative import SolvedScene
 from .errors import QuasistaticError, SolverError
 from .laws import Problem, RawMotion, WorldForceSet, assemble, free_directions, physical_twists, to_world
 from .model import FloatArray, Scene
@@ -97,6 +98,7 @@ def solve(
             time_limit=time_limit,
             progress=progress,
         )
+        solution = dataclasses.replace(solution, source=SolvedScene(solution.scene, scene.robots))  # joint positions too
         return with_detection(solution, detection)
     started = time.perf_counter()
     problem = scene if isinstance(scene, Problem) else assemble(scene)
@@ -327,6 +329,7 @@ def _audited(
         fallback=fallback,
         notes=result.notes,
         seconds=time.perf_counter() - started,
+        source=SolvedScene(problem.scene),
     )
     failed = [m for m in motions if not m.audit.passed]
     if not failed:

@@ -149,6 +149,7 @@ class _Kinematics:
             shape_from_coal(item.geometry, f"{field}: collision geometry {item.name!r}") for item in self.geometry.geometryObjects
         )
         self.chain_columns = self._chain_columns()
+        self.moves = self._moves()
         joints = [self.model.joints[joint_id] for joint_id in range(1, self.model.njoints)]
         self.plain_dof = np.array([i for i, j in enumerate(joints) if j.nq == 1], dtype=int)
         self.plain_q = np.array([j.idx_q for j in joints if j.nq == 1], dtype=int)
@@ -170,6 +171,16 @@ class _Kinematics:
                 raise SceneError(field, str(urdf), f"joint {name!r} has {joint.nv} degrees of freedom; only 1-DOF joints are supported")
             names.append(name)
         return tuple(names)
+
+    def _moves(self) -> FloatArray:
+        """``[j, k]`` = 1 when the joint of velocity column j is a strict ancestor of that of column k (it moves it)."""
+        moves = np.zeros((self.model.nv, self.model.nv))
+        for joint_id in range(1, self.model.njoints):
+            k = self.model.joints[joint_id].idx_v
+            for ancestor in self.model.supports[joint_id]:
+                if 0 < ancestor != joint_id:
+                    moves[self.model.joints[ancestor].idx_v, k] = 1.0
+        return moves
 
     def _chain_columns(self) -> FloatArray:
         """Per joint, a 0/1 row over the velocity columns of the joints that move it (its kinematic chain)."""
@@ -218,6 +229,10 @@ class UrdfRobot:
     torque_limits : list or mapping, optional
         Largest torque magnitude of each joint, in the same forms (a mapping names every joint);
         a motion that needs more is reported as infeasible for this robot. None: no limits.
+    joint_stiffness : list or mapping, optional
+        Stiffness of each joint's servo or transmission [torque/rad, or force/length for a prismatic joint], > 0,
+        in the same forms (a mapping names every joint): the links then yield in series with the contact springs
+        when compliant forces are worked out, through the contacts' Jacobians at this configuration. None: rigid.
     field : str, optional
         Where the robot is in a scene file, for error messages (``robots.hand``).
     """
@@ -232,6 +247,7 @@ class UrdfRobot:
         q: Sequence[float] | Mapping[str, float] | None = None,
         joint_velocities: Sequence[float] | Mapping[str, float] | None = None,
         torque_limits: Sequence[float] | Mapping[str, float] | None = None,
+        joint_stiffness: Sequence[float] | Mapping[str, float] | None = None,
         field: str | None = None,
     ) -> None:
         field = field or f"robots.{name}"
@@ -243,6 +259,7 @@ class UrdfRobot:
         angles, velocities = _per_joint(q, names, f"{field}.q"), _per_joint(joint_velocities, names, f"{field}.joint_velocities")
         self._build(name, path, kinematics, base or Pose(), angles, velocities, field)
         self.torque_limits = _limits(torque_limits, kinematics.joint_names, f"{field}.torque_limits")
+        self.joint_stiffness = _stiffness(joint_stiffness, kinematics.joint_names, f"{field}.joint_stiffness")
 
     def _build(
         self,
@@ -280,6 +297,7 @@ class UrdfRobot:
         velocities = self.joint_velocities if joint_velocities is None else _per_joint(joint_velocities, names, f"{field}.joint_velocities")
         robot = UrdfRobot.__new__(UrdfRobot)
         robot.torque_limits = self.torque_limits
+        robot.joint_stiffness = self.joint_stiffness
         robot._build(self.name, self.urdf, self._kinematics, self.base if base is None else base, angles, velocities, field)
         return robot
 
@@ -372,6 +390,26 @@ class UrdfRobot:
         result: FloatArray = self.base.rotation @ shifted  # into the world
         return result
 
+    def point_jacobian_rates(self, link: str, point: npt.ArrayLike) -> FloatArray:
+        """How :meth:`point_jacobian` of ``link`` at the fixed world ``point`` changes with each joint position:
+        (3, joints, joints), entry ``[:, j, k]`` = d(column k)/d(q_j) [per rad, or per length for a prismatic joint].
+
+        Analytic, from the configuration's own spatial Jacobian: a joint's twist ``xi_k = (v_k, w_k)`` (velocity of
+        the world origin's point, angular velocity) turns with every joint ``j`` that moves it by the Lie bracket
+        ``[xi_j, xi_k] = (w_j x v_k - w_k x v_j, w_j x w_k)``; the point's column is ``v_k + w_k x p``.
+        """
+        kinematics = self._kinematics
+        chain = kinematics.chain_columns[kinematics.link_in_joint[self._link(link)][0]]
+        jacobian = self._placement.jacobian * chain  # (6, joints): only the joints that move the link
+        v, w = jacobian[:3].T, jacobian[3:].T  # (joints, 3)
+        local = (np.asarray(point, dtype=float).reshape(3) - self.base.position) @ self.base.rotation
+        moves = kinematics.moves  # moves[j, k]: joint j is a strict ancestor of joint k
+        dv = np.cross(w[:, None, :], v[None, :, :]) - np.cross(w[None, :, :], v[:, None, :])  # (j, k, 3)
+        dw = np.cross(w[:, None, :], w[None, :, :])
+        rates = (dv + np.cross(dw, local)) * moves[:, :, None]
+        result: FloatArray = np.einsum("ab,jkb->ajk", self.base.rotation, rates)
+        return result
+
     def _link(self, link: str) -> str:
         if link not in self._kinematics.link_in_joint:
             raise SceneError(f"{self._field}.links", link, f"no link of that name in {self.urdf.name}")
@@ -428,6 +466,15 @@ def _limits(values: Any, names: tuple[str, ...], field: str) -> FloatArray | Non
         missing = ", ".join(n for n in names if n not in values)
         raise SceneError(field, dict(values), f"name every joint (missing: {missing})")
     return _per_joint(values, names, field)
+
+
+def _stiffness(values: Any, names: tuple[str, ...], field: str) -> FloatArray | None:
+    """Joint stiffness as :func:`_limits` reads it (a mapping names every joint: a missing one is not 0), each > 0."""
+    stiffness = _limits(values, names, field)
+    if stiffness is not None and not np.all(stiffness > 0.0):
+        shown = dict(values) if isinstance(values, Mapping) else stiffness.tolist()
+        raise SceneError(field, shown, "every joint stiffness must be > 0 (leave the key out for rigid joints)")
+    return stiffness
 
 
 def _pinocchio() -> Any:

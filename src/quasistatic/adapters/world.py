@@ -377,5 +377,11 @@ def _moved_robots(
 
 
 def _robot(robot: UrdfRobot) -> Robot:
-    """The solver's view of a URDF robot: its joint velocities, names and torque limits."""
-    return Robot(robot.name, robot.joint_velocities, joint_names=robot.joint_names, torque_limits=robot.torque_limits)
+    """The solver's view of a URDF robot: its joint velocities, names, torque limits and joint stiffness."""
+    return Robot(
+        robot.name,
+        robot.joint_velocities,
+        joint_names=robot.joint_names,
+        torque_limits=robot.torque_limits,
+        joint_stiffness=robot.joint_stiffness,
+    )

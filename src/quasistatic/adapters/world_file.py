@@ -99,9 +99,6 @@ def _robot(name: str, entry: RobotFile, folder: Path) -> UrdfRobot:
     assert entry.urdf is not None
     if entry.joint_names is not None:
         raise SceneError(f"{field}.joint_names", entry.joint_names, "a robot with a urdf has its own joint names")
-    if entry.joint_stiffness is not None:
-        reason = "joint stiffness is read for robots given by their contacts' Jacobians; a urdf robot's is not supported yet"
-        raise SceneError(f"{field}.joint_stiffness", entry.joint_stiffness, reason)
     with _within(field):
         return UrdfRobot(
             name,
@@ -111,6 +108,7 @@ def _robot(name: str, entry: RobotFile, folder: Path) -> UrdfRobot:
             q=entry.q,
             joint_velocities=entry.joint_velocities,
             torque_limits=entry.torque_limits,
+            joint_stiffness=entry.joint_stiffness,
             field=field,
         )
 

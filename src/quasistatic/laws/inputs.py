@@ -75,10 +75,14 @@ class InputVector:
         twists = {m.name: np.array(m.twist, dtype=float) for m in scene.movers if m.robot is None}
         for entry, value in zip(self.entries, np.asarray(values, dtype=float), strict=True):
             (joints if entry.kind == "joint" else twists)[entry.owner][entry.index] = value
-        robots = [Robot(r.name, joints[r.name], joint_names=r.joint_names, torque_limits=r.torque_limits) for r in scene.robots]
+        robots = [
+            Robot(r.name, joints[r.name], joint_names=r.joint_names, torque_limits=r.torque_limits, joint_stiffness=r.joint_stiffness)
+            for r in scene.robots
+        ]
         # A Scene fills in a robot-driven mover's twist with zeros, which a new Scene refuses: rebuilt without it.
         movers = [Mover(m.name, None if m.robot else twists[m.name], m.origin, m.robot) for m in scene.movers]
-        return Scene(scene.bodies, scene.contacts, movers, robots, scene.dimension, scene.gravity, scene.friction)
+        dimension, gravity, friction = scene.dimension, scene.gravity, scene.friction
+        return Scene(scene.bodies, scene.contacts, movers, robots, dimension, gravity, friction, scene.stiffness, scene.closing_time)
 
     def point_velocity_map(self, scene: Scene) -> FloatArray:
         """World velocity of each contact's mover point per unit input, (m, d, P) [length/time per input unit].

@@ -28,7 +28,7 @@ from .assemble import Problem
 from .fixed_modes import ROLLING, SEPARATING, SLIDING, FixedModeLaws, columns, system
 from .modes import ModeMasks
 
-__all__ = ["Boundary", "FixedModeDerivative", "Singular", "fixed_mode_derivative", "boundaries"]
+__all__ = ["Boundary", "FixedModeDerivative", "Singular", "singular", "polish", "force_derivative", "fixed_mode_derivative", "boundaries"]
 
 _NEWTON_ITERATIONS = 30  # Newton from an audited motion converges in two or three steps; more means no root nearby
 
@@ -70,7 +70,7 @@ class FixedModeDerivative:
 class Boundary:
     """One quantity that must stay non-negative for the modes to hold, and its gradient in the inputs.
 
-    ``what`` is one of ``separating``, ``normal_force``, ``cone``, ``slip``; ``value`` is scene-relative,
+    ``what`` is one of ``separating``, ``normal_force``, ``cone``, ``slip``, ``edge`` (3-D pyramid); ``value`` is scene-relative,
     ``gradient`` (P,) per physical unit of each input. For ``cone`` in 3-D, ``tangent``/``dtangent`` and
     ``normal``/``dnormal`` give the exact quadratic ``(mu cn)^2 - |ct|^2`` along an affine path.
     """
@@ -91,7 +91,7 @@ def fixed_mode_derivative(
 ) -> FixedModeDerivative | Singular:
     """The derivative of the motion ``(q, c)`` with modes ``masks``, for inputs with ``b = B p`` (B: (m, d, P), per V)."""
     laws = FixedModeLaws(problem, masks)
-    polished = _polish(laws, laws.start(q, c, nonnegative=False))
+    polished = polish(laws, laws.start(q, c, nonnegative=False))
     if isinstance(polished, Singular):
         return polished
     n, P, t = problem.n_dof, B.shape[2], problem.dimension - 1
@@ -105,18 +105,18 @@ def fixed_mode_derivative(
     dq = dx[:n]
     u = problem.velocities(polished[:n])
     du = np.einsum("mdn,nP->mdP", problem.J, dq) - B
-    dc = _force_derivative(laws, column - P, dx, forces, u, du)
+    dc = force_derivative(laws, column - P, dx, forces, u, du)
     sliding = (laws.kind == SLIDING) & (laws.mu > 0)
     return FixedModeDerivative(polished[:n], dq, forces, dc, u, du, affine=problem.dimension == 2 or not bool(np.any(sliding)))
 
 
-def _polish(laws: FixedModeLaws, x: FloatArray) -> FloatArray | Singular:
+def polish(laws: FixedModeLaws, x: FloatArray) -> FloatArray | Singular:
     """Newton's method on the fixed-mode laws from an audited motion: the root to machine precision, or why none."""
     for _ in range(_NEWTON_ITERATIONS):
         residual, jacobian = laws.residual(x), laws.jacobian(x)
-        singular = _singular(jacobian, laws.n)
-        if singular is not None:
-            return singular
+        why = singular(jacobian, laws.n)
+        if why is not None:
+            return why
         if float(np.max(np.abs(residual), initial=0.0)) <= NEWTON_STOP:
             return x
         x = x - np.linalg.solve(jacobian, residual)
@@ -124,7 +124,8 @@ def _polish(laws: FixedModeLaws, x: FloatArray) -> FloatArray | Singular:
     return x if converged else Singular("no_root")
 
 
-def _singular(jacobian: FloatArray, n: int) -> Singular | None:
+def singular(jacobian: FloatArray, n: int) -> Singular | None:
+    """Why the square fixed-mode system (twist first, ``n`` entries) has no unique solution, or None when it has one."""
     if jacobian.size == 0:
         return None
     _, s, vt = np.linalg.svd(jacobian)
@@ -135,7 +136,7 @@ def _singular(jacobian: FloatArray, n: int) -> Singular | None:
     return Singular("continuum" if moves_twist else "forces_indeterminate")
 
 
-def _force_derivative(
+def force_derivative(
     laws: FixedModeLaws, column: FloatArray, dx: FloatArray, forces: FloatArray, u: FloatArray, du: FloatArray
 ) -> FloatArray:
     """d(contact-frame forces)/dp, (m, d, P): unknowns read from ``dx``; sliding friction ``-mu cn e`` differentiated."""

@@ -132,7 +132,7 @@ class RobotFile(_FileModel):
 
     joint_velocities: list[_Number] | dict[str, _Number] | None = None
     torque_limits: list[_Number] | dict[str, _Number] | None = None
-    joint_stiffness: list[_Number] | None = None
+    joint_stiffness: list[_Number] | dict[str, _Number] | None = None
     joint_names: list[str] | None = None
     urdf: str | None = None
     package_dirs: list[str] = []
@@ -268,9 +268,11 @@ def scene_from_file(parsed: SceneFile) -> Scene:
 
 def plain_robot(name: str, robot: RobotFile) -> Robot:
     """The Robot of a file entry without a URDF: joint velocities and torque limits as lists."""
+    reason = "joints can be named only for a robot with a urdf; give a list, one per Jacobian column"
     if isinstance(robot.torque_limits, dict):
-        reason = "joints can be named only for a robot with a urdf; give a list, one per Jacobian column"
         raise SceneError(f"robots.{name}.torque_limits", robot.torque_limits, reason)
+    if isinstance(robot.joint_stiffness, dict):
+        raise SceneError(f"robots.{name}.joint_stiffness", robot.joint_stiffness, reason)
     return Robot(
         name,
         _velocity_list(name, robot),

@@ -7,10 +7,12 @@ free inputs ``p``: ``u = J q - b0 - B p``. Per contact mode:
 - rolling: ``u_t = 0``, the force anywhere in its cone;
 - sliding: ``|u_t| >= delta`` and friction ``-mu c_n u_t/|u_t|``.
 
-In 2-D each sliding contact slips one of two ways: for each choice of signs the
-inputs are a QP (HiGHS) and the forces an LP, both convex, and the cheapest
-feasible choice wins. In 3-D the sliding friction's direction follows the
-inputs; the problem is solved as an NLP (scipy's SLSQP) whose equalities are
+On polyhedral cones (2-D, and 3-D ``pyramid:K``) each sliding contact slides
+one of a few ways: against one of its two edges in 2-D; on a pyramid, loading
+one edge (its slip inside that edge's sector) or the two edges of a face (its
+slip along the face's normal). For each choice the inputs are a QP (HiGHS) and
+the forces an LP, both convex, and the cheapest feasible choice wins. On exact
+3-D cones the sliding friction's direction follows the inputs; the problem is solved as an NLP (scipy's SLSQP) whose equalities are
 the fixed-mode laws themselves (:func:`~quasistatic.laws.fixed_modes.system`
 with the inputs as extra columns of ``J``, as the sensitivities use it), from
 a start given by a QP and an LP. Every answer is checked by the caller's audit.
@@ -32,7 +34,7 @@ from .numerics.highs import INF, solve_lp, solve_qp
 
 __all__ = ["PlanModes", "PlannedInputs", "plan_inputs"]
 
-_MAX_SIGN_CHOICES = 2**12  # 2-D: every slip sign of up to 12 sliding contacts is tried
+_MAX_SLIDE_CHOICES = 2**12  # combinations of ways to slide tried: 12 sliding contacts in 2-D
 _START_EDGES = 16  # the 3-D start's forces lie in a 16-sided pyramid inscribed in each cone
 _NLP_ITERATIONS = 500
 
@@ -86,41 +88,84 @@ def plan_inputs(
     ``problem`` is assembled with the free inputs at zero; ``B`` (m, d, P) maps them into ``u``: ``u = J q - b - B p``.
     """
     setup = _Setup(problem, q, modes, B, hessian, linear, delta)
-    if problem.dimension == 2:
-        return _planar(setup)
+    if problem.friction.is_polyhedral(problem.dimension):
+        return _polyhedral(setup)
     return _spatial(setup)
 
 
-# --------------------------------------------------------------------------- 2-D: a QP and an LP per choice of slip signs
+# --------------------------------------------------------------------------- polyhedral cones: a QP and an LP per choice of loaded edges
 
 
-def _planar(setup: _Setup) -> PlannedInputs:
-    sliding = np.flatnonzero(setup.modes.sliding)
-    if 2 ** len(sliding) > _MAX_SIGN_CHOICES:
-        return _infeasible(setup, f"modes: {len(sliding)} sliding contacts are more than the planner tries (12)")
+@dataclass(frozen=True)
+class _Slide:
+    """One way a sliding contact may slide on a polyhedral cone.
+
+    ``loads``: the tangent directions (E, t) its friction may load, with weights >= 0 summing to ``mu c_n``
+    (one edge, or in 3-D the two edges of a face of the pyramid); its slip ``u_t`` then keeps
+    ``r . u_t = 0`` for each row of ``level`` and ``r . u_t >= v`` for each ``(r, v)`` of ``at_least``.
+    """
+
+    loads: FloatArray
+    level: tuple[FloatArray, ...]
+    at_least: tuple[tuple[FloatArray, float], ...]
+
+
+def _slides(setup: _Setup) -> list[_Slide]:
+    """Every way one sliding contact may slide: against one of its 2 edges in 2-D; in 3-D on a pyramid, loading
+    one edge ``d_j`` (its slip inside the sector where ``-d_j . u_t`` is largest) or a face (slip along its normal)."""
+    delta = setup.delta
+    if setup.problem.dimension == 2:
+        return [_Slide(np.array([[-sign]]), (), ((np.array([sign]), delta),)) for sign in (1.0, -1.0)]
+    d = np.array(_edges(setup.problem.friction.edges, 2))
+    K = len(d)
+    slides = []
+    for j in range(K):
+        after, before = d[(j + 1) % K], d[(j - 1) % K]
+        slides.append(_Slide(d[[j]], (), ((-d[j], delta), (after - d[j], 0.0), (before - d[j], 0.0))))
+        slides.append(_Slide(d[[j, (j + 1) % K]], (d[j] - after,), ((-d[j], delta),)))
+    return slides
+
+
+def _polyhedral(setup: _Setup) -> PlannedInputs:
+    sliding = np.flatnonzero(setup.modes.sliding).tolist()
+    # A way the inputs cannot give this contact's slip, whatever the other contacts do, is not combined with others.
+    ways = [[way for way in _slides(setup) if _can_slide(setup, i, way)] for i in sliding]
+    count = int(np.prod([len(w) for w in ways]))
+    if count > _MAX_SLIDE_CHOICES:
+        message = f"modes: the {len(sliding)} sliding contacts may slide in {count} combinations of ways, more than the planner tries"
+        return _infeasible(setup, f"{message} ({_MAX_SLIDE_CHOICES})")
     best: PlannedInputs | None = None
-    for signs in itertools.product((1.0, -1.0), repeat=len(sliding)):
-        slip_signs = np.zeros(setup.problem.n_contacts)
-        slip_signs[sliding] = signs
-        found = _planar_with_signs(setup, slip_signs)
+    for choice in itertools.product(*ways):
+        found = _planned_with(setup, dict(zip(sliding, choice, strict=True)))
         if found is not None and (best is None or found.cost < best.cost):
             best = found
     return best or _infeasible(setup, "no inputs give the wanted twist with these modes while the forces meet the laws")
 
 
-def _planar_with_signs(setup: _Setup, signs: FloatArray) -> PlannedInputs | None:
-    forces = _forces(setup, signs, edges=2)
+def _can_slide(setup: _Setup, contact: int, way: _Slide) -> bool:
+    """Whether some inputs meet every kinematic mode with ``contact`` sliding ``way`` (the other sliding ones free)."""
+    A, lower, upper = _velocity_rows(setup, {contact: way})
+    return solve_lp(np.zeros(A.shape[1]), A, lower, upper).status == "optimal"
+
+
+def _planned_with(setup: _Setup, slides: dict[int, _Slide]) -> PlannedInputs | None:
+    forces = _forces(setup, {i: slide.loads for i, slide in slides.items()}, edges=_rolling_edges(setup))
     if forces is None:
         return None
-    A, lower, upper = _velocity_rows(setup, signs)
+    A, lower, upper = _velocity_rows(setup, slides)
     result = solve_qp(setup.hessian, A, lower, upper, cost=setup.linear)
     if result.status != "optimal":
         return None
     return PlannedInputs("planned", result.x, forces, result.objective, "planned")
 
 
-def _velocity_rows(setup: _Setup, signs: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Rows ``lower <= A p <= upper`` of the kinematic modes, with slip ``signs`` (one direction per sliding contact, 2-D)."""
+def _rolling_edges(setup: _Setup) -> int:
+    """Edges of the pyramid a rolling force lies in: the friction model's own (2-D: both ways)."""
+    return 2 if setup.problem.dimension == 2 else setup.problem.friction.edges
+
+
+def _velocity_rows(setup: _Setup, slides: dict[int, _Slide]) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Rows ``lower <= A p <= upper`` of the kinematic modes, each sliding contact in ``slides`` sliding its way."""
     u0, B, delta, modes = setup.u0, setup.B, setup.delta, setup.modes
     t = u0.shape[1] - 1
     rows: list[FloatArray] = []
@@ -133,66 +178,52 @@ def _velocity_rows(setup: _Setup, signs: FloatArray) -> tuple[FloatArray, FloatA
         upper.append(high)
 
     for i in range(u0.shape[0]):
-        # u = u0 - B p, so a bound l <= u <= h reads u0 - h <= B p <= u0 - l
+        # u = u0 - B p, so a bound l <= r . u <= h reads r . u0 - h <= r . B p <= r . u0 - l
         if not modes.closed[i]:
             add(B[i, t], -INF, u0[i, t] - delta)
             continue
         add(B[i, t], u0[i, t], u0[i, t])
-        for s in range(t):
-            if modes.rolling[i]:
+        if modes.rolling[i]:
+            for s in range(t):
                 add(B[i, s], u0[i, s], u0[i, s])
-            elif modes.sliding[i] and t == 1:  # signs[i] u_t >= delta
-                add(signs[i] * B[i, s], -INF, signs[i] * u0[i, s] - delta)
+        elif i in slides:
+            for r in slides[i].level:
+                level = float(r @ u0[i, :t])
+                add(r @ B[i, :t], level, level)
+            for r, least in slides[i].at_least:
+                add(r @ B[i, :t], -INF, float(r @ u0[i, :t]) - least)
     P = B.shape[2]
     return (np.array(rows).reshape(len(rows), P), np.array(lower), np.array(upper))
 
 
-def _forces(setup: _Setup, slip: FloatArray, edges: int) -> FloatArray | None:
-    """Contact-frame forces (m, d) in equilibrium, with modes and friction against ``slip`` ((m,) signs in 2-D, or
-    (m, 2) directions in 3-D), rolling forces in a pyramid of ``edges`` inscribed in each cone (exact in 2-D)."""
+def _forces(setup: _Setup, loads: dict[int, FloatArray], edges: int) -> FloatArray | None:
+    """Contact-frame forces (m, d) in equilibrium with the modes: a sliding frictional contact's friction ``mu c_n``
+    spread over its ``loads`` (tangent directions, (E, d - 1)), a rolling force in a pyramid of ``edges``
+    inscribed in its cone (exact in 2-D), other closed contacts pushing along their normals."""
     problem, modes = setup.problem, setup.modes
     m, d, n = problem.n_contacts, problem.dimension, problem.n_dof
     t = d - 1
     directions = _edges(edges, t)
-    # Unknowns per contact: the normal force, then (rolling) one weight per edge of the inscribed pyramid.
-    blocks: list[tuple[int, FloatArray | None]] = []  # (contact, None for its normal force or the pyramid edge)
-    A_cols: list[FloatArray] = []
-    for i in range(m):
-        if not modes.closed[i]:
+    # Unknowns: per closed contact a plain normal force (unless it slides with friction), and one weight per edge
+    # it may load (its normal force's share; the friction mu times it along the edge).
+    blocks: list[tuple[int, FloatArray | None]] = []
+    for i in np.flatnonzero(modes.closed).tolist():
+        if i in loads:
+            blocks += [(i, e) for e in loads[i]]
             continue
-        mu = problem.mu[i]
-        normal = problem.J[i, t].copy()
-        if modes.sliding[i] and mu > 0:
-            direction = np.atleast_1d(slip[i]) / np.linalg.norm(np.atleast_1d(slip[i]))
-            normal -= mu * direction @ problem.J[i, :t]
-        A_cols.append(normal)
         blocks.append((i, None))
-        if modes.rolling[i] and mu > 0:
-            for e in directions:
-                A_cols.append(problem.J[i, t] + mu * e @ problem.J[i, :t])
-                blocks.append((i, e))
-    A = np.array(A_cols).reshape(len(A_cols), n).T  # (n, unknowns): sum of J^T c = -g
+        if modes.rolling[i] and problem.mu[i] > 0:
+            blocks += [(i, e) for e in directions]
+    columns = [problem.J[i, t] + (0.0 if e is None else problem.mu[i] * e @ problem.J[i, :t]) for i, e in blocks]
+    A = np.array(columns).reshape(len(columns), n).T  # (n, unknowns): sum of J^T c = -g
     result = solve_lp(np.zeros(A.shape[1]), A, -problem.g, -problem.g, np.zeros(A.shape[1]), None)
     if result.status != "optimal":
         return None
-    return _contact_forces(setup, blocks, result.x, slip)
-
-
-def _contact_forces(setup: _Setup, blocks: list[tuple[int, FloatArray | None]], weights: FloatArray, slip: FloatArray) -> FloatArray:
-    problem = setup.problem
-    m, d = problem.n_contacts, problem.dimension
-    t = d - 1
     c = np.zeros((m, d))
-    for (i, edge), w in zip(blocks, weights, strict=True):
-        mu = problem.mu[i]
-        if edge is None:
-            c[i, t] += w
-            if setup.modes.sliding[i] and mu > 0:
-                direction = np.atleast_1d(slip[i]) / np.linalg.norm(np.atleast_1d(slip[i]))
-                c[i, :t] -= mu * w * direction
-        else:
-            c[i, t] += w
-            c[i, :t] += mu * w * edge
+    for (i, e), w in zip(blocks, result.x, strict=True):
+        c[i, t] += w
+        if e is not None:
+            c[i, :t] += problem.mu[i] * w * e
     return c
 
 
@@ -249,7 +280,7 @@ def _spatial_start(setup: _Setup) -> tuple[FloatArray, FloatArray] | None:
     for i in np.flatnonzero(setup.modes.sliding):
         speed = np.linalg.norm(u0[i, :t])
         directions[i] = u0[i, :t] / speed if speed > setup.delta else np.eye(t)[0]
-    A, lower, upper = _velocity_rows(setup, np.zeros(u0.shape[0]))
+    A, lower, upper = _velocity_rows(setup, {})
     extra_rows, extra_values = [], []
     for i in np.flatnonzero(setup.modes.sliding):
         # u_t = (2 delta) e_i: the start slips along e_i, comfortably past delta
@@ -260,7 +291,8 @@ def _spatial_start(setup: _Setup) -> tuple[FloatArray, FloatArray] | None:
         A = np.vstack([A, np.array(extra_rows)])
         lower, upper = np.r_[lower, extra_values], np.r_[upper, extra_values]
     inputs = solve_qp(setup.hessian, A, lower, upper, cost=setup.linear)
-    forces = _forces(setup, directions, edges=_START_EDGES)
+    loads = {int(i): -directions[[i]] for i in np.flatnonzero(setup.modes.sliding & (setup.problem.mu > 0))}
+    forces = _forces(setup, loads, edges=_START_EDGES)
     if inputs.status != "optimal" or forces is None:
         return None
     return inputs.x, forces
