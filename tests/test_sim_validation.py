@@ -206,3 +206,109 @@ def test_slow_push_agrees_with_mujoco() -> None:
 @pytest.mark.slow
 def test_longer_push_agrees_with_mujoco() -> None:
     _compare_with_mujoco(2.0)
+
+
+# --------------------------------------------------------------------------- peg in hole (Whitney)
+
+PEG_HALF_WIDTH, PEG_LENGTH, PEG_MASS = 0.01, 0.08, 0.1  # peg_in_hole_*.yaml: r, L [m], mass [kg]
+SLOT_HALF_WIDTH, SLOT_MU = 0.0105, 0.3  # the slot's D / 2 [m] and its walls' friction
+PUSH_ANGLE, PEG_SPEED = math.radians(45.0), 0.01  # the inclined pusher's normal from vertical; the fingertips' speed [m/s]
+
+
+def _peg_pose(pose: qs.Pose) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """Tilt theta [rad], two-point depth l [m] (axial distance from the tip to the slot's lower left edge), axis, tip centre."""
+    axis = pose.rotation[:, 2]
+    tip = pose.position + PEG_LENGTH / 2 * axis
+    edge = np.array([-SLOT_HALF_WIDTH, 0.0, 0.0])
+    return math.atan2(axis[0], axis[2]), float(axis @ (tip - edge)), axis, tip
+
+
+def _two_point_depth(theta: float) -> float:
+    """Depth at which a peg tilted by theta spans the slot: 2r cos(theta) + l sin(theta) = D."""
+    return (2 * SLOT_HALF_WIDTH - 2 * PEG_HALF_WIDTH * math.cos(theta)) / math.sin(theta)
+
+
+def _whitney_limit(theta: float) -> float:
+    """Whitney's two-point line for a push at psi = phi + theta to the axis, at the bottom corner: it jams iff l <= l*."""
+    r, mu, slope = PEG_HALF_WIDTH, SLOT_MU, math.tan(PUSH_ANGLE + theta)
+    return 2 * mu * r * ((PEG_LENGTH / r - mu) * slope - 1) / (1 + mu * slope)
+
+
+def _peg_statics(pose: qs.Pose) -> tuple[float, float, float]:
+    """Normal forces N1 (right wall), N2 (left edge) and the push P of the peg sliding in, from equilibrium in the x-z plane."""
+    theta, _, axis, tip = _peg_pose(pose)
+    side = np.array([math.cos(theta), 0.0, -math.sin(theta)])  # the peg's +x face normal
+    mu = SLOT_MU
+    directions = [np.array([-1.0, 0.0, -mu]), side - mu * axis, np.array([-math.sin(PUSH_ANGLE), 0.0, math.cos(PUSH_ANGLE)])]
+    points = [tip + PEG_HALF_WIDTH * side, np.array([-SLOT_HALF_WIDTH, 0.0, 0.0]), tip - PEG_LENGTH * axis + PEG_HALF_WIDTH * side]
+    com = pose.position
+    rows = np.array([[f[0], f[2], (p - com)[2] * f[0] - (p - com)[0] * f[2]] for f, p in zip(directions, points, strict=True)]).T
+    n1, n2, push = np.linalg.solve(rows, [0.0, PEG_MASS * GRAVITY, 0.0])
+    return float(n1), float(n2), float(push)
+
+
+def _pair_force(step: qs.sim.StepResult, other: str) -> np.ndarray:
+    return np.sum([c.force for c in step.contacts if c.other == other], axis=0)
+
+
+def _contact_time(scene: Path) -> float:
+    """When the rising peg's left side comes within the contact margin of the slot's lower left edge [s]."""
+    world = qs.load_world(scene)
+    theta, _, _, tip = _peg_pose(world.bodies[0].pose)
+    side = np.array([math.cos(theta), 0.0, -math.sin(theta)])
+    gap = -PEG_HALF_WIDTH - side @ (np.array([-SLOT_HALF_WIDTH, 0.0, 0.0]) - tip)
+    return (gap - world.contact_margin) / (PEG_SPEED * math.sin(theta))  # rising by dz closes it by dz sin(theta)
+
+
+def test_peg_jams_at_two_point_contact_inside_whitneys_region() -> None:
+    """Tilted 2.5 degrees, the peg reaches two-point contact at l = 23.4 mm < l* = 33.5 mm: jammed there, at once."""
+    scene = EXAMPLES / "peg_in_hole_jam.yaml"
+    dt = 0.25
+    trajectory = simulate(scene, duration=1.0, dt=dt)
+    assert trajectory.status == "jammed" and trajectory.certified
+    made = [e for e in trajectory.events if e.kind == "contact made"]
+    jam = next(e for e in trajectory.events if e.kind == "jammed")
+    assert [e.pair for e in made] == [("peg", "left")] and jam.time == made[0].time == trajectory.times[-1]
+    assert abs(jam.time - _contact_time(scene)) <= dt / 64  # located within the event window
+    theta, depth, _, _ = _peg_pose(trajectory.states[-1].bodies["peg"])
+    assert theta == pytest.approx(math.radians(2.5), abs=1e-9)  # it rose unturned in one-point contact
+    # the contact is made within the margin (8 um), 8 um / sin(theta) = 0.18 mm before the exact span
+    assert abs(depth - _two_point_depth(theta)) < 0.25e-3
+    assert depth < _whitney_limit(theta)  # inside Whitney's jamming region
+    assert {c.other for c in trajectory.steps[-1].contacts} == {"left", "right", "pusher", "finger", "front", "back"}
+
+
+def _check_peg_slides_in(duration: float, dt: float) -> None:
+    """From two-point contact the peg rises while it straightens, spanning the slot, with the forces of the statics."""
+    scene = EXAMPLES / "peg_in_hole_slide.yaml"
+    trajectory = simulate(scene, duration=duration, dt=dt, ambiguous="min_power")
+    assert trajectory.status == "completed" and trajectory.certified
+    made = next(e for e in trajectory.events if e.kind == "contact made")
+    assert made.pair == ("peg", "left") and abs(made.time - _contact_time(scene)) <= dt / 64
+    assert any(e.kind == "contact broken" and e.pair == ("peg", "finger") for e in trajectory.events)
+    sliding = [i for i, t in enumerate(trajectory.times) if t >= made.time]
+    assert len(sliding) >= 3
+    margin = qs.load_world(scene).contact_margin
+    poses = [_peg_pose(trajectory.states[i].bodies["peg"]) for i in sliding]
+    theta, depth = np.array([p[0] for p in poses]), np.array([p[1] for p in poses])
+    assert depth[0] > _whitney_limit(theta[0])  # outside Whitney's jamming region
+    assert np.all(np.diff(theta) < 0) and np.all(np.diff(depth) > 0)
+    span = 2 * PEG_HALF_WIDTH * np.cos(theta) + depth * np.sin(theta) - 2 * SLOT_HALF_WIDTH
+    assert np.all(np.abs(span) <= margin)  # it keeps spanning the slot: the left contact is never lost
+    for i in sliding:
+        step = trajectory.steps[i]
+        assert sum(c.other == "left" and c.mode == "sliding" for c in step.contacts) == 2
+        n1, n2, push = _peg_statics(trajectory.states[i].bodies["peg"])
+        assert min(n1, n2, push) > 0
+        assert np.linalg.norm(_pair_force(step, "pusher")) == pytest.approx(push, rel=2e-3)
+        assert -_pair_force(step, "right")[0] == pytest.approx(n1, rel=2e-3)
+
+
+def test_peg_slides_in_outside_whitneys_region() -> None:
+    """Tilted 1.5 degrees, two-point contact comes at l = 38.5 mm > l* = 32.4 mm: the peg slides in."""
+    _check_peg_slides_in(duration=0.75, dt=0.25)
+
+
+@pytest.mark.slow
+def test_peg_slides_in_over_a_longer_run() -> None:
+    _check_peg_slides_in(duration=1.5, dt=0.1)
