@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import quasistatic as qs
-from quasistatic.sim import Evaluation, Inputs, SimModel, State, StepOptions, evaluate, simulate
+from quasistatic.sim import Evaluation, Inputs, SimModel, State, StepOptions, advance, evaluate, simulate
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "sim"
 GRAVITY = 9.81
@@ -312,3 +312,126 @@ def test_peg_slides_in_outside_whitneys_region() -> None:
 @pytest.mark.slow
 def test_peg_slides_in_over_a_longer_run() -> None:
     _check_peg_slides_in(duration=1.5, dt=0.1)
+
+
+# --------------------------------------------------------------------------- a lift against MuJoCo
+
+LIFT_SIDE, LIFT_MASS, LIFT_MU, LIFT_SPEED = 0.05, 0.2, 0.8, 0.01  # the cube [m], [kg], friction, the jaws' speed up [m/s]
+JAW_ANGLE = math.radians(60.0)  # each jaw's face from vertical: a wedge narrowing downward
+JAW_SIZE, JAW_BELOW = (0.01, 0.08, 0.05), 0.008  # jaw box (thickness, width, length) [m]; face length below the contact
+STAND_RADIUS = 0.01  # the cube rests on a ball stand (one point, at z = 0) between the jaws
+
+
+def _jaw_pose(side: int) -> tuple[np.ndarray, np.ndarray]:
+    """Centre and rotation of the jaw whose inclined face touches the cube's bottom edge on ``side`` (-1 left, +1 right)."""
+    normal = np.array([-side * math.cos(JAW_ANGLE), 0.0, math.sin(JAW_ANGLE)])  # into the cube
+    along = np.array([side * math.sin(JAW_ANGLE), 0.0, math.cos(JAW_ANGLE)])  # up the face
+    thickness, _, length = JAW_SIZE
+    centre = np.array([side * LIFT_SIDE / 2, 0.0, 0.0]) + along * (length / 2 - JAW_BELOW) - normal * thickness / 2
+    c, s = math.cos(side * JAW_ANGLE), math.sin(side * JAW_ANGLE)
+    return centre, np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])  # about y: local x to the face normal
+
+
+def _lift_scene(jaws: bool = True) -> dict[str, object]:
+    """The cube on its ball stand between two jaws moving up: inclined into a wedge, or (``jaws=False``) parallel plates."""
+    movers: dict[str, object] = {"stand": {"shape": {"sphere": STAND_RADIUS}, "pose": {"position": [0.0, 0.0, -STAND_RADIUS]}}}
+    for name, side in (("left", -1), ("right", 1)):
+        centre, rotation = _jaw_pose(side) if jaws else (np.array([side * (LIFT_SIDE + JAW_SIZE[0]) / 2, 0.0, LIFT_SIDE / 2]), np.eye(3))
+        movers[name] = {
+            "shape": {"box": list(JAW_SIZE)},
+            "pose": {"position": centre.tolist(), "rotation": {"matrix": rotation.tolist()}},
+            "twist": [0.0, 0.0, LIFT_SPEED, 0.0, 0.0, 0.0],
+        }
+    return {
+        "quasistatic": 1,
+        "friction": "pyramid:4",
+        "bodies": {"cube": {"mass": LIFT_MASS, "shape": {"box": [LIFT_SIDE] * 3}, "pose": {"position": [0.0, 0.0, LIFT_SIDE / 2]}}},
+        "movers": movers,
+        "contact_detection": {"friction": {"default": LIFT_MU}},
+    }
+
+
+def _mujoco_lift(duration: float) -> tuple[np.ndarray, float]:
+    """The cube's final position and turn [rad] in MuJoCo: the same numbers, the jaws mocap bodies moved at LIFT_SPEED."""
+    mujoco = pytest.importorskip("mujoco", reason="MuJoCo cross-check: pip install 'quasistatic[test]'")
+    half, jaws = LIFT_SIDE / 2, []
+    for name, side in (("left", -1), ("right", 1)):
+        centre, rotation = _jaw_pose(side)
+        quat = np.zeros(4)
+        mujoco.mju_mat2Quat(quat, rotation.flatten())
+        jaws.append(
+            f'<body name="{name}" mocap="true" pos="{" ".join(map(str, centre))}" quat="{" ".join(map(str, quat))}">'
+            f'<geom type="box" size="{" ".join(str(x / 2) for x in JAW_SIZE)}" friction="{LIFT_MU} 0 0"/></body>'
+        )
+    xml = f"""
+    <mujoco>
+      <option timestep="0.001" cone="pyramidal" gravity="0 0 -{GRAVITY}"/>
+      <worldbody>
+        <geom name="stand" type="sphere" pos="0 0 {-STAND_RADIUS}" size="{STAND_RADIUS}" friction="{LIFT_MU} 0 0"/>
+        <body name="cube" pos="0 0 {half}"><freejoint/>
+          <geom type="box" size="{half} {half} {half}" mass="{LIFT_MASS}" friction="{LIFT_MU} 0 0"/></body>
+        {"".join(jaws)}
+      </worldbody>
+    </mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    settle = int(0.2 / model.opt.timestep)
+    for _ in range(settle):  # the cube sinks into the soft stand before the lift starts
+        mujoco.mj_step(model, data)
+    start, jaw_start = data.qpos[:3].copy(), data.mocap_pos.copy()
+    for i in range(int(round(duration / model.opt.timestep))):
+        data.mocap_pos[:] = jaw_start + [0.0, 0.0, LIFT_SPEED * (i + 1) * model.opt.timestep]
+        mujoco.mj_step(model, data)
+    for _ in range(settle):  # the jaws stopped: whatever the cube still moves is spent
+        mujoco.mj_step(model, data)
+    turn = 2.0 * math.acos(min(1.0, abs(float(data.qpos[3]))))
+    return data.qpos[:3] - start + [0.0, 0.0, half], turn
+
+
+LIFT_TOLERANCE = 1e-4
+"""Final cube positions agree within 0.1 mm (and turns within 0.1 degree).
+
+The quasi-static cube rises exactly with the jaws (both contacts rolling, rigid). MuJoCo's contacts are
+soft: once the jaws carry the weight instead of the stand, the cube sinks into them until their springs
+carry m g (measured 0.020 mm behind, whatever the lift). 0.1 mm is five times that and 1 % of a 1 cm lift; the
+lift is along a symmetry line, so 0.1 degree allows round-off and the pyramids' edges.
+"""
+
+
+def _check_lift_against_mujoco(positions: np.ndarray, rotation: np.ndarray, duration: float) -> None:
+    mujoco_position, mujoco_turn = _mujoco_lift(duration)
+    np.testing.assert_allclose(positions, [0.0, 0.0, LIFT_SIDE / 2 + LIFT_SPEED * duration], atol=1e-9)  # by hand
+    assert math.acos(min(1.0, (np.trace(rotation) - 1) / 2)) < 1e-9
+    np.testing.assert_allclose(mujoco_position, positions, atol=LIFT_TOLERANCE)
+    assert math.degrees(mujoco_turn) < 0.1
+
+
+def test_wedge_lift_step_agrees_with_mujoco() -> None:
+    """One certified step of 0.5 s: every listed motion lifts the cube with the jaws, off its stand, as MuJoCo does."""
+    world = qs.load_world(_lift_scene())
+    evaluation = evaluate(SimModel(world, StepOptions(ambiguous="min_power")), State.of(world), Inputs())
+    assert evaluation.certified and evaluation.status in ("solved", "ambiguous")
+    for motion in evaluation.solution.solutions or (evaluation.solution.motion,):  # several listed: the same twist
+        np.testing.assert_allclose(motion.twists["cube"], [0, 0, LIFT_SPEED, 0, 0, 0], atol=1e-12)
+        stand = {c.mode for c, found in zip(motion.contacts, evaluation.detection.contacts, strict=True) if found.other == "stand"}
+        assert stand == {"separating"}
+    cube = advance(evaluation, 0.5).bodies["cube"]
+    _check_lift_against_mujoco(cube.position, cube.rotation, 0.5)
+
+
+@pytest.mark.slow
+def test_lift_run_agrees_with_mujoco() -> None:
+    trajectory = simulate(_lift_scene(), duration=1.0, dt=0.5, ambiguous="min_power")
+    assert trajectory.status == "completed" and trajectory.certified
+    assert any(e.kind == "contact broken" and e.pair == ("cube", "stand") for e in trajectory.events)
+    _check_lift_against_mujoco(trajectory.positions("cube")[-1], trajectory.rotations("cube")[-1], 1.0)
+
+
+@pytest.mark.slow
+def test_parallel_jaws_leave_the_lift_ambiguous() -> None:
+    """With parallel jaws the squeeze is free: the cube lifted and the cube left behind, the jaws slipping, both obey the laws."""
+    solution = qs.solve(qs.load_world(_lift_scene(jaws=False)))
+    assert solution.status == "ambiguous" and solution.certified
+    rises = [float(m.twists["cube"][2]) for m in solution.solutions]
+    assert any(v == pytest.approx(LIFT_SPEED, abs=1e-9) for v in rises)
+    assert any(abs(v) < 1e-9 for v in rises)
