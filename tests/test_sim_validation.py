@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import quasistatic as qs
-from quasistatic.sim import Evaluation, Inputs, SimModel, State, StepOptions, evaluate, simulate
+from quasistatic.sim import Evaluation, Inputs, SimModel, State, StepOptions, advance, evaluate, simulate
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "sim"
 GRAVITY = 9.81
@@ -206,3 +206,232 @@ def test_slow_push_agrees_with_mujoco() -> None:
 @pytest.mark.slow
 def test_longer_push_agrees_with_mujoco() -> None:
     _compare_with_mujoco(2.0)
+
+
+# --------------------------------------------------------------------------- peg in hole (Whitney)
+
+PEG_HALF_WIDTH, PEG_LENGTH, PEG_MASS = 0.01, 0.08, 0.1  # peg_in_hole_*.yaml: r, L [m], mass [kg]
+SLOT_HALF_WIDTH, SLOT_MU = 0.0105, 0.3  # the slot's D / 2 [m] and its walls' friction
+PUSH_ANGLE, PEG_SPEED = math.radians(45.0), 0.01  # the inclined pusher's normal from vertical; the fingertips' speed [m/s]
+
+
+def _peg_pose(pose: qs.Pose) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """Tilt theta [rad], two-point depth l [m] (axial distance from the tip to the slot's lower left edge), axis, tip centre."""
+    axis = pose.rotation[:, 2]
+    tip = pose.position + PEG_LENGTH / 2 * axis
+    edge = np.array([-SLOT_HALF_WIDTH, 0.0, 0.0])
+    return math.atan2(axis[0], axis[2]), float(axis @ (tip - edge)), axis, tip
+
+
+def _two_point_depth(theta: float) -> float:
+    """Depth at which a peg tilted by theta spans the slot: 2r cos(theta) + l sin(theta) = D."""
+    return (2 * SLOT_HALF_WIDTH - 2 * PEG_HALF_WIDTH * math.cos(theta)) / math.sin(theta)
+
+
+def _whitney_limit(theta: float) -> float:
+    """Whitney's two-point line for a push at psi = phi + theta to the axis, at the bottom corner: it jams iff l <= l*."""
+    r, mu, slope = PEG_HALF_WIDTH, SLOT_MU, math.tan(PUSH_ANGLE + theta)
+    return 2 * mu * r * ((PEG_LENGTH / r - mu) * slope - 1) / (1 + mu * slope)
+
+
+def _peg_statics(pose: qs.Pose) -> tuple[float, float, float]:
+    """Normal forces N1 (right wall), N2 (left edge) and the push P of the peg sliding in, from equilibrium in the x-z plane."""
+    theta, _, axis, tip = _peg_pose(pose)
+    side = np.array([math.cos(theta), 0.0, -math.sin(theta)])  # the peg's +x face normal
+    mu = SLOT_MU
+    directions = [np.array([-1.0, 0.0, -mu]), side - mu * axis, np.array([-math.sin(PUSH_ANGLE), 0.0, math.cos(PUSH_ANGLE)])]
+    points = [tip + PEG_HALF_WIDTH * side, np.array([-SLOT_HALF_WIDTH, 0.0, 0.0]), tip - PEG_LENGTH * axis + PEG_HALF_WIDTH * side]
+    com = pose.position
+    rows = np.array([[f[0], f[2], (p - com)[2] * f[0] - (p - com)[0] * f[2]] for f, p in zip(directions, points, strict=True)]).T
+    n1, n2, push = np.linalg.solve(rows, [0.0, PEG_MASS * GRAVITY, 0.0])
+    return float(n1), float(n2), float(push)
+
+
+def _pair_force(step: qs.sim.StepResult, other: str) -> np.ndarray:
+    return np.sum([c.force for c in step.contacts if c.other == other], axis=0)
+
+
+def _contact_time(scene: Path) -> float:
+    """When the rising peg's left side comes within the contact margin of the slot's lower left edge [s]."""
+    world = qs.load_world(scene)
+    theta, _, _, tip = _peg_pose(world.bodies[0].pose)
+    side = np.array([math.cos(theta), 0.0, -math.sin(theta)])
+    gap = -PEG_HALF_WIDTH - side @ (np.array([-SLOT_HALF_WIDTH, 0.0, 0.0]) - tip)
+    return (gap - world.contact_margin) / (PEG_SPEED * math.sin(theta))  # rising by dz closes it by dz sin(theta)
+
+
+def test_peg_jams_at_two_point_contact_inside_whitneys_region() -> None:
+    """Tilted 2.5 degrees, the peg reaches two-point contact at l = 23.4 mm < l* = 33.5 mm: jammed there, at once."""
+    scene = EXAMPLES / "peg_in_hole_jam.yaml"
+    dt = 0.25
+    trajectory = simulate(scene, duration=1.0, dt=dt)
+    assert trajectory.status == "jammed" and trajectory.certified
+    made = [e for e in trajectory.events if e.kind == "contact made"]
+    jam = next(e for e in trajectory.events if e.kind == "jammed")
+    assert [e.pair for e in made] == [("peg", "left")] and jam.time == made[0].time == trajectory.times[-1]
+    assert abs(jam.time - _contact_time(scene)) <= dt / 64  # located within the event window
+    theta, depth, _, _ = _peg_pose(trajectory.states[-1].bodies["peg"])
+    assert theta == pytest.approx(math.radians(2.5), abs=1e-9)  # it rose unturned in one-point contact
+    # the contact is made within the margin (8 um), 8 um / sin(theta) = 0.18 mm before the exact span
+    assert abs(depth - _two_point_depth(theta)) < 0.25e-3
+    assert depth < _whitney_limit(theta)  # inside Whitney's jamming region
+    assert {c.other for c in trajectory.steps[-1].contacts} == {"left", "right", "pusher", "finger", "front", "back"}
+
+
+def _check_peg_slides_in(duration: float, dt: float) -> None:
+    """From two-point contact the peg rises while it straightens, spanning the slot, with the forces of the statics."""
+    scene = EXAMPLES / "peg_in_hole_slide.yaml"
+    trajectory = simulate(scene, duration=duration, dt=dt, ambiguous="min_power")
+    assert trajectory.status == "completed" and trajectory.certified
+    made = next(e for e in trajectory.events if e.kind == "contact made")
+    assert made.pair == ("peg", "left") and abs(made.time - _contact_time(scene)) <= dt / 64
+    assert any(e.kind == "contact broken" and e.pair == ("peg", "finger") for e in trajectory.events)
+    sliding = [i for i, t in enumerate(trajectory.times) if t >= made.time]
+    assert len(sliding) >= 3
+    margin = qs.load_world(scene).contact_margin
+    poses = [_peg_pose(trajectory.states[i].bodies["peg"]) for i in sliding]
+    theta, depth = np.array([p[0] for p in poses]), np.array([p[1] for p in poses])
+    assert depth[0] > _whitney_limit(theta[0])  # outside Whitney's jamming region
+    assert np.all(np.diff(theta) < 0) and np.all(np.diff(depth) > 0)
+    span = 2 * PEG_HALF_WIDTH * np.cos(theta) + depth * np.sin(theta) - 2 * SLOT_HALF_WIDTH
+    assert np.all(np.abs(span) <= margin)  # it keeps spanning the slot: the left contact is never lost
+    for i in sliding:
+        step = trajectory.steps[i]
+        assert sum(c.other == "left" and c.mode == "sliding" for c in step.contacts) == 2
+        n1, n2, push = _peg_statics(trajectory.states[i].bodies["peg"])
+        assert min(n1, n2, push) > 0
+        assert np.linalg.norm(_pair_force(step, "pusher")) == pytest.approx(push, rel=2e-3)
+        assert -_pair_force(step, "right")[0] == pytest.approx(n1, rel=2e-3)
+
+
+def test_peg_slides_in_outside_whitneys_region() -> None:
+    """Tilted 1.5 degrees, two-point contact comes at l = 38.5 mm > l* = 32.4 mm: the peg slides in."""
+    _check_peg_slides_in(duration=0.75, dt=0.25)
+
+
+@pytest.mark.slow
+def test_peg_slides_in_over_a_longer_run() -> None:
+    _check_peg_slides_in(duration=1.5, dt=0.1)
+
+
+# --------------------------------------------------------------------------- a lift against MuJoCo
+
+LIFT_SIDE, LIFT_MASS, LIFT_MU, LIFT_SPEED = 0.05, 0.2, 0.8, 0.01  # the cube [m], [kg], friction, the jaws' speed up [m/s]
+JAW_ANGLE = math.radians(60.0)  # each jaw's face from vertical: a wedge narrowing downward
+JAW_SIZE, JAW_BELOW = (0.01, 0.08, 0.05), 0.008  # jaw box (thickness, width, length) [m]; face length below the contact
+STAND_RADIUS = 0.01  # the cube rests on a ball stand (one point, at z = 0) between the jaws
+
+
+def _jaw_pose(side: int) -> tuple[np.ndarray, np.ndarray]:
+    """Centre and rotation of the jaw whose inclined face touches the cube's bottom edge on ``side`` (-1 left, +1 right)."""
+    normal = np.array([-side * math.cos(JAW_ANGLE), 0.0, math.sin(JAW_ANGLE)])  # into the cube
+    along = np.array([side * math.sin(JAW_ANGLE), 0.0, math.cos(JAW_ANGLE)])  # up the face
+    thickness, _, length = JAW_SIZE
+    centre = np.array([side * LIFT_SIDE / 2, 0.0, 0.0]) + along * (length / 2 - JAW_BELOW) - normal * thickness / 2
+    c, s = math.cos(side * JAW_ANGLE), math.sin(side * JAW_ANGLE)
+    return centre, np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])  # about y: local x to the face normal
+
+
+def _lift_scene(jaws: bool = True) -> dict[str, object]:
+    """The cube on its ball stand between two jaws moving up: inclined into a wedge, or (``jaws=False``) parallel plates."""
+    movers: dict[str, object] = {"stand": {"shape": {"sphere": STAND_RADIUS}, "pose": {"position": [0.0, 0.0, -STAND_RADIUS]}}}
+    for name, side in (("left", -1), ("right", 1)):
+        centre, rotation = _jaw_pose(side) if jaws else (np.array([side * (LIFT_SIDE + JAW_SIZE[0]) / 2, 0.0, LIFT_SIDE / 2]), np.eye(3))
+        movers[name] = {
+            "shape": {"box": list(JAW_SIZE)},
+            "pose": {"position": centre.tolist(), "rotation": {"matrix": rotation.tolist()}},
+            "twist": [0.0, 0.0, LIFT_SPEED, 0.0, 0.0, 0.0],
+        }
+    return {
+        "quasistatic": 1,
+        "friction": "pyramid:4",
+        "bodies": {"cube": {"mass": LIFT_MASS, "shape": {"box": [LIFT_SIDE] * 3}, "pose": {"position": [0.0, 0.0, LIFT_SIDE / 2]}}},
+        "movers": movers,
+        "contact_detection": {"friction": {"default": LIFT_MU}},
+    }
+
+
+def _mujoco_lift(duration: float) -> tuple[np.ndarray, float]:
+    """The cube's final position and turn [rad] in MuJoCo: the same numbers, the jaws mocap bodies moved at LIFT_SPEED."""
+    mujoco = pytest.importorskip("mujoco", reason="MuJoCo cross-check: pip install 'quasistatic[test]'")
+    half, jaws = LIFT_SIDE / 2, []
+    for name, side in (("left", -1), ("right", 1)):
+        centre, rotation = _jaw_pose(side)
+        quat = np.zeros(4)
+        mujoco.mju_mat2Quat(quat, rotation.flatten())
+        jaws.append(
+            f'<body name="{name}" mocap="true" pos="{" ".join(map(str, centre))}" quat="{" ".join(map(str, quat))}">'
+            f'<geom type="box" size="{" ".join(str(x / 2) for x in JAW_SIZE)}" friction="{LIFT_MU} 0 0"/></body>'
+        )
+    xml = f"""
+    <mujoco>
+      <option timestep="0.001" cone="pyramidal" gravity="0 0 -{GRAVITY}"/>
+      <worldbody>
+        <geom name="stand" type="sphere" pos="0 0 {-STAND_RADIUS}" size="{STAND_RADIUS}" friction="{LIFT_MU} 0 0"/>
+        <body name="cube" pos="0 0 {half}"><freejoint/>
+          <geom type="box" size="{half} {half} {half}" mass="{LIFT_MASS}" friction="{LIFT_MU} 0 0"/></body>
+        {"".join(jaws)}
+      </worldbody>
+    </mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    settle = int(0.2 / model.opt.timestep)
+    for _ in range(settle):  # the cube sinks into the soft stand before the lift starts
+        mujoco.mj_step(model, data)
+    start, jaw_start = data.qpos[:3].copy(), data.mocap_pos.copy()
+    for i in range(int(round(duration / model.opt.timestep))):
+        data.mocap_pos[:] = jaw_start + [0.0, 0.0, LIFT_SPEED * (i + 1) * model.opt.timestep]
+        mujoco.mj_step(model, data)
+    for _ in range(settle):  # the jaws stopped: whatever the cube still moves is spent
+        mujoco.mj_step(model, data)
+    turn = 2.0 * math.acos(min(1.0, abs(float(data.qpos[3]))))
+    return data.qpos[:3] - start + [0.0, 0.0, half], turn
+
+
+LIFT_TOLERANCE = 1e-4
+"""Final cube positions agree within 0.1 mm (and turns within 0.1 degree).
+
+The quasi-static cube rises exactly with the jaws (both contacts rolling, rigid). MuJoCo's contacts are
+soft: once the jaws carry the weight instead of the stand, the cube sinks into them until their springs
+carry m g (measured 0.020 mm behind, whatever the lift). 0.1 mm is five times that and 1 % of a 1 cm lift; the
+lift is along a symmetry line, so 0.1 degree allows round-off and the pyramids' edges.
+"""
+
+
+def _check_lift_against_mujoco(positions: np.ndarray, rotation: np.ndarray, duration: float) -> None:
+    mujoco_position, mujoco_turn = _mujoco_lift(duration)
+    np.testing.assert_allclose(positions, [0.0, 0.0, LIFT_SIDE / 2 + LIFT_SPEED * duration], atol=1e-9)  # by hand
+    assert math.acos(min(1.0, (np.trace(rotation) - 1) / 2)) < 1e-9
+    np.testing.assert_allclose(mujoco_position, positions, atol=LIFT_TOLERANCE)
+    assert math.degrees(mujoco_turn) < 0.1
+
+
+def test_wedge_lift_step_agrees_with_mujoco() -> None:
+    """One certified step of 0.5 s: every listed motion lifts the cube with the jaws, off its stand, as MuJoCo does."""
+    world = qs.load_world(_lift_scene())
+    evaluation = evaluate(SimModel(world, StepOptions(ambiguous="min_power")), State.of(world), Inputs())
+    assert evaluation.certified and evaluation.status in ("solved", "ambiguous")
+    for motion in evaluation.solution.solutions or (evaluation.solution.motion,):  # several listed: the same twist
+        np.testing.assert_allclose(motion.twists["cube"], [0, 0, LIFT_SPEED, 0, 0, 0], atol=1e-12)
+        stand = {c.mode for c, found in zip(motion.contacts, evaluation.detection.contacts, strict=True) if found.other == "stand"}
+        assert stand == {"separating"}
+    cube = advance(evaluation, 0.5).bodies["cube"]
+    _check_lift_against_mujoco(cube.position, cube.rotation, 0.5)
+
+
+@pytest.mark.slow
+def test_lift_run_agrees_with_mujoco() -> None:
+    trajectory = simulate(_lift_scene(), duration=1.0, dt=0.5, ambiguous="min_power")
+    assert trajectory.status == "completed" and trajectory.certified
+    assert any(e.kind == "contact broken" and e.pair == ("cube", "stand") for e in trajectory.events)
+    _check_lift_against_mujoco(trajectory.positions("cube")[-1], trajectory.rotations("cube")[-1], 1.0)
+
+
+@pytest.mark.slow
+def test_parallel_jaws_leave_the_lift_ambiguous() -> None:
+    """With parallel jaws the squeeze is free: the cube lifted and the cube left behind, the jaws slipping, both obey the laws."""
+    solution = qs.solve(qs.load_world(_lift_scene(jaws=False)))
+    assert solution.status == "ambiguous" and solution.certified
+    rises = [float(m.twists["cube"][2]) for m in solution.solutions]
+    assert any(v == pytest.approx(LIFT_SPEED, abs=1e-9) for v in rises)
+    assert any(abs(v) < 1e-9 for v in rises)

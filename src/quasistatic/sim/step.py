@@ -280,12 +280,53 @@ def _pushed_out(state: State, world: World, deep: list[tuple[Contact, float]]) -
 
 
 def advance(evaluation: Evaluation, h: float) -> State:
-    """The state after following the evaluation's motion for a time ``h``: screws for bodies and movers, joints integrated."""
+    """The state after following the evaluation's motion for a time ``h``: screws for bodies and movers, joints integrated.
+
+    Contacts the motion keeps closed (rolling or sliding) are closed again at the end of the step where
+    they have drifted open (see :func:`_reclosed`).
+    """
     state, world = evaluation.state, evaluation.world
     bodies = {b.name: advance_pose(state.bodies[b.name], evaluation.twist(b.name), b.body().com, h) for b in world.bodies}
     movers = {m.name: advance_pose(state.movers[m.name], _mover_twist(m.twist), m.pose.position, h) for m in world.movers}
     robots = {r.name: state.robots[r.name] + h * np.asarray(r.joint_velocities, dtype=float) for r in world.robots}
-    return State(state.time + h, bodies, movers, robots)
+    return _reclosed(evaluation, State(state.time + h, bodies, movers, robots))
+
+
+def _reclosed(evaluation: Evaluation, state: State) -> State:
+    """``state`` with the contacts the motion kept closed moved shut again where they drifted open.
+
+    A step follows the tangent of a curved path, so a closed contact sliding over a turning face ends
+    the step a little open or a little inside (second order in the step). Inside is corrected at the next
+    step (:data:`SIM_PENETRATION`); open would, past the margin, lose a contact the motion never broke.
+    So a contact found after the step whose nearest contact of the same pair before it (within the
+    look-ahead band) was closed, and which has opened beyond :data:`SIM_APPROACH` of the margin, is shut
+    by the same least motion that corrects penetration, holding the other closed contacts where they are.
+    Separating contacts are left alone.
+    """
+    if evaluation.motion is None:
+        return state
+    before = [(c, r.mode) for c, r in zip(evaluation.detection.contacts, evaluation.motion.contacts, strict=True)]
+    if not any(mode in ("rolling", "sliding") for _, mode in before):
+        return state
+    world = state.applied(evaluation.world)
+    band = SIM_LOOKAHEAD * world.size
+    found = world.detect()
+    kept = [(c, gap) for c, gap in zip(found.contacts, found.gaps, strict=True) if _was_closed(before, c, band)]
+    opened = SIM_APPROACH * evaluation.margin
+    if all(gap <= opened for _, gap in kept):
+        return state
+    # the drifted ones shut, the other closed ones held where they are (a gap of 0 asks for no motion along its normal)
+    return _pushed_out(state, world, [(c, gap if gap > opened else 0.0) for c, gap in kept])
+
+
+def _was_closed(before: list[tuple[Contact, Mode]], contact: Contact, band: float) -> bool:
+    """The contact of the same pair nearest to ``contact`` before the step lies within ``band`` and was rolling or sliding."""
+    pair = (contact.body, contact.other)
+    same_pair = [(float(np.linalg.norm(c.point - contact.point)), mode) for c, mode in before if (c.body, c.other) == pair]
+    if not same_pair:
+        return False
+    distance, mode = min(same_pair, key=lambda entry: entry[0])
+    return distance <= band and mode in ("rolling", "sliding")
 
 
 def _mover_twist(twist: npt.ArrayLike | None) -> FloatArray:
