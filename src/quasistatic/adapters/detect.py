@@ -335,7 +335,7 @@ class Layout:
                 if k not in placed:
                     placed[k] = _placed(self.owners[k], self.shapes[k], Pose.from_trusted_arrays(positions[k], rotations[k]))
             found += _pair_contacts(query, placed[i], placed[j], i, j)
-        return sorted(found, key=lambda c: (c.first, c.second, tuple(c.point)))
+        return sorted(found, key=lambda c: (c.first, c.second, c.point.tolist()))  # plain floats compare faster than numpy's
 
     def _may_touch(self, i: int, j: int) -> bool:
         """Colliders of different owners, not both unbounded, that the caller lets touch: asked once per pair."""
@@ -373,9 +373,16 @@ class _Query:
     def __init__(self, coal: Any, margin: float, positions: FloatArray, rotations: FloatArray) -> None:
         self.coal, self.margin, self._positions, self._rotations = coal, margin, positions, rotations
         self.request = _request(coal, margin)
-        self.moved_request = _request(coal, margin)  # its margin is set per pair
         self.result = coal.CollisionResult()
         self._placed: dict[int, Any] = {}
+        self._moved_request: Any = None
+
+    @property
+    def moved_request(self) -> Any:
+        """A request for pairs moved apart (its margin is set per pair); made when a pair first needs it."""
+        if self._moved_request is None:
+            self._moved_request = _request(self.coal, self.margin)
+        return self._moved_request
 
     def transform(self, index: int) -> Any:
         if index not in self._placed:
