@@ -245,7 +245,7 @@ def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count:
     closed, mu = masks.closed, problem.mu
     if np.any(closed & masks.sliding & (mu > 0.0)):
         return False
-    inradius = 1.0 if problem.dimension == 2 else float(np.cos(np.pi / edge_count))  # 2-D: the two edges are the cone
+    inradius = _inradius(problem.dimension, edge_count)
     rho = np.where(mu > 0.0, mu * inradius, 1.0)  # frictionless: its normal force >= 0
     kept = np.flatnonzero(closed)
     for _ in range(problem.n_contacts + 1):
@@ -277,6 +277,14 @@ def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count:
         if 2.0 * reach * z[j] > LP_FEASIBILITY:
             return True
     return False
+
+
+def _inradius(dimension: int, edge_count: int) -> float:
+    """Radius of the disc inside the unit friction polygon of ``edge_count`` edges: 2-D, its two edges are the cone;
+    3-D, a regular polygon's inscribed circle; no edges (no friction), none."""
+    if dimension == 2:
+        return 1.0 if edge_count >= 2 else 0.0
+    return float(np.cos(np.pi / edge_count)) if edge_count >= 3 else 0.0
 
 
 def _wrench_columns(problem: Problem, contacts: np.ndarray) -> np.ndarray:
