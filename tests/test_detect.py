@@ -321,7 +321,7 @@ def test_the_sweep_gives_exactly_the_pairs_whose_boxes_meet(count: int) -> None:
     assert candidate_pairs(colliders, 0.01) == expected
 
 
-@pytest.mark.parametrize("count", [3, 23, 48])
+@pytest.mark.parametrize("count", [3, 23, 48, 60])
 def test_the_layout_gives_the_pairs_of_the_broad_phase(count: int) -> None:
     """The layout's pairs (one compiled loop where numba is installed) are the broad phase's, less what may not touch."""
     rng = np.random.default_rng(count)
@@ -333,6 +333,12 @@ def test_the_layout_gives_the_pairs_of_the_broad_phase(count: int) -> None:
     rotations = np.array([c.pose.rotation for c in colliders])
     expected = [(i, j) for i, j in candidate_pairs(colliders, 0.01) if colliders[i].owner != colliders[j].owner]
     assert layout.pairs(positions, rotations, 0.01) == expected
+    # Free bodies given as a set (decided for every pair at once) or as the same rule asked per pair: the same pairs.
+    free = {"c1", "c4"}
+    by_set = Layout([c.owner for c in colliders], [c.shape for c in colliders], free=free)
+    by_rule = Layout([c.owner for c in colliders], [c.shape for c in colliders], lambda a, b: a in free or b in free)
+    chosen = [(i, j) for i, j in expected if colliders[i].owner in free or colliders[j].owner in free]
+    assert by_set.pairs(positions, rotations, 0.01) == by_rule.pairs(positions, rotations, 0.01) == chosen
 
 
 def _face_down(rng: np.random.Generator, vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ shapes' axes and the line between their centres, and never passes NaN on.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -280,16 +280,44 @@ class Layout:
         Each collider's shape, in its own frame.
     pairs : callable (owner, owner) -> bool, optional
         Whether two owners may touch, as for :func:`detect`.
+    free : collection of str, optional
+        Instead of ``pairs``: the owners that are free bodies; only pairs with one of them may touch.
+        Decided for every pair at once, where ``pairs`` is asked once per pair that comes near.
     """
 
-    def __init__(self, owners: Sequence[str], shapes: Sequence[Shape], pairs: Callable[[str, str], bool] | None = None) -> None:
+    def __init__(
+        self,
+        owners: Sequence[str],
+        shapes: Sequence[Shape],
+        pairs: Callable[[str, str], bool] | None = None,
+        *,
+        free: Collection[str] | None = None,
+    ) -> None:
+        if pairs is not None and free is not None:
+            raise SceneError("free", sorted(free), "give either pairs or free, not both")
         self.owners, self.shapes, self._pairs = tuple(owners), tuple(shapes), pairs
+        self._free = None if free is None else frozenset(free)
         boxes = np.array([shape.derived("box", _local_box) for shape in self.shapes], dtype=float).reshape(-1, 2, 3)
         self._box_centres, self._box_halves = boxes[:, 0], boxes[:, 1]
         self._unbounded = np.array([isinstance(shape, Halfspace) for shape in self.shapes], dtype=bool)
         self._asked: dict[tuple[int, int], bool] = {}  # (i, j) -> may they touch: the owners never change
         size = len(self.owners) if len(self.owners) <= _ALL_PAIRS else 0
         self._allowed = np.full((size, size), -1, dtype=np.int8)  # the same, as a matrix for small layouts: -1 not asked yet
+        if size and self._free is not None:
+            self._allowed = self._free_pairs().astype(np.int8)
+
+    def _free_pairs(self) -> BoolArray:
+        """Which pairs may touch when only pairs with a free body do: different owners, not both unbounded, one free."""
+        free_owners = self._free or frozenset()
+        index = {owner: k for k, owner in enumerate(dict.fromkeys(self.owners))}
+        owner = np.array([index[o] for o in self.owners])
+        free = np.array([o in free_owners for o in self.owners], dtype=bool)
+        unbounded = self._unbounded
+        different = owner[:, None] != owner[None, :]
+        either_free = np.logical_or(free[:, None], free[None, :])
+        both_unbounded = np.logical_and(unbounded[:, None], unbounded[None, :])
+        allowed: BoolArray = different & either_free & ~both_unbounded
+        return allowed
 
     def __len__(self) -> int:
         return len(self.owners)
@@ -343,7 +371,8 @@ class Layout:
         if known is None:
             a, b = self.owners[i], self.owners[j]
             unbounded = self._unbounded[i] and self._unbounded[j]  # environment against environment
-            known = self._asked[i, j] = a != b and not unbounded and (self._pairs is None or self._pairs(a, b))
+            allowed = a in self._free or b in self._free if self._free is not None else self._pairs is None or self._pairs(a, b)
+            known = self._asked[i, j] = a != b and not unbounded and allowed
         return known
 
 
