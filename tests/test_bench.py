@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -133,7 +134,10 @@ def test_robot_rows_are_tabled_and_skips_are_said() -> None:
         pipeline.PipelineRow("detect growth", 40, 76, 76, 136, 5, 4e-3, 3e-3, 5e-3),
         pipeline.PipelineRow("allegro pipeline (certified)", skipped="coal/pinocchio not installed"),
     )
-    assert pipeline.growth_exponent(list(rows)) == pytest.approx(1.0)
+    assert pipeline.growth_exponent(list(rows)) == pytest.approx(1.0)  # one row has no CPU time: the wall times
+    # CPU time linear in the near pairs, wall time (inflated unevenly by other work) quadratic.
+    wall_square = [replace(r, cpu_median=1e-3 * r.near / 19, median=1e-3 * (r.near / 19) ** 2) for r in rows[:3]]
+    assert pipeline.growth_exponent(wall_square) == pytest.approx(1.0)  # the CPU times decide where every row has one
     config = BenchConfig(batch=False, robots=False)
     result = runner.BenchResult(config, runner.machine_info(), (), (), 1.0, pipeline=rows)
     console = Console(file=io.StringIO(), width=200)

@@ -91,8 +91,14 @@ def run_pipeline(full: bool, budget: float, say: Callable[[str], None]) -> list[
 
 
 def growth_exponent(rows: list[PipelineRow]) -> float | None:
-    """Least-squares slope of log(median detect time) against log(near pairs) over the growth rows."""
-    points = [(r.near, r.median) for r in rows if r.case == "detect growth" and r.median is not None and r.near > 0]
+    """Least-squares slope of log(median detect time) against log(near pairs) over the growth rows.
+
+    The CPU-time medians when every growth row has one (other work on the machine inflates wall time
+    unevenly across rows, and so the slope), else the wall-time medians.
+    """
+    growth = [r for r in rows if r.case == "detect growth" and r.median is not None and r.near > 0]
+    cpu = all(r.cpu_median is not None for r in growth)
+    points = [(r.near, float((r.cpu_median if cpu else r.median) or 0.0)) for r in growth]
     if len({n for n, _ in points}) < 3:
         return None
     return float(np.polyfit(np.log([n for n, _ in points]), np.log([t for _, t in points]), 1)[0])
