@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -128,12 +129,15 @@ def test_contradictions_are_claims_against_the_certified_answer() -> None:
 
 def test_robot_rows_are_tabled_and_skips_are_said() -> None:
     rows = (
-        pipeline.PipelineRow("detect growth", 10, 19, 19, 34, 5, 1e-3, 9e-4, 2e-3),
+        pipeline.PipelineRow("detect growth", 10, 19, 19, 34, 5, 1e-3, 9e-4, 2e-3, cpu_median=7.25e-4),
         pipeline.PipelineRow("detect growth", 20, 38, 38, 68, 5, 2e-3, 1e-3, 3e-3),
         pipeline.PipelineRow("detect growth", 40, 76, 76, 136, 5, 4e-3, 3e-3, 5e-3),
         pipeline.PipelineRow("allegro pipeline (certified)", skipped="coal/pinocchio not installed"),
     )
-    assert pipeline.growth_exponent(list(rows)) == pytest.approx(1.0)
+    assert pipeline.growth_exponent(list(rows)) == pytest.approx(1.0)  # one row has no CPU time: the wall times
+    # CPU time linear in the near pairs, wall time (inflated unevenly by other work) quadratic.
+    wall_square = [replace(r, cpu_median=1e-3 * r.near / 19, median=1e-3 * (r.near / 19) ** 2) for r in rows[:3]]
+    assert pipeline.growth_exponent(wall_square) == pytest.approx(1.0)  # the CPU times decide where every row has one
     config = BenchConfig(batch=False, robots=False)
     result = runner.BenchResult(config, runner.machine_info(), (), (), 1.0, pipeline=rows)
     console = Console(file=io.StringIO(), width=200)
@@ -143,6 +147,7 @@ def test_robot_rows_are_tabled_and_skips_are_said() -> None:
     data = result.to_dict()
     assert data["detect_growth"] == pytest.approx(1.0) and len(data["pipeline"]) == 4
     assert "| allegro pipeline (certified) |" in markdown_tables(data)
+    assert "| CPU median |" in markdown_tables(data) and "725 µs" in markdown_tables(data)  # the process time, beside the wall time
 
 
 def test_robot_scenes_touch_where_they_should() -> None:

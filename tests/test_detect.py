@@ -25,6 +25,7 @@ from quasistatic.adapters import (  # noqa: E402  (after the skip: coal is optio
     Convex,
     Cylinder,
     Halfspace,
+    Layout,
     Mesh,
     Pose,
     Sphere,
@@ -318,6 +319,102 @@ def test_the_sweep_gives_exactly_the_pairs_whose_boxes_meet(count: int) -> None:
     ]
     expected = sorted(expected + [(i, count) for i in range(count)])  # the table meets everything
     assert candidate_pairs(colliders, 0.01) == expected
+
+
+@pytest.mark.parametrize("count", [3, 23, 48, 60])
+def test_the_layout_gives_the_pairs_of_the_broad_phase(count: int) -> None:
+    """The layout's pairs (one compiled loop where numba is installed) are the broad phase's, less what may not touch."""
+    rng = np.random.default_rng(count)
+    shapes = [Box(rng.uniform(0.02, 0.2, size=3)), Sphere(0.05), Capsule(0.02, 0.1)]
+    colliders = [Collider(f"c{i % 7}", shapes[i % 3], Pose(rng.uniform(0, 0.6, size=3), _rotation(rng))) for i in range(count)]
+    colliders.append(TABLE)
+    layout = Layout([c.owner for c in colliders], [c.shape for c in colliders])
+    positions = np.array([c.pose.position for c in colliders])
+    rotations = np.array([c.pose.rotation for c in colliders])
+    expected = [(i, j) for i, j in candidate_pairs(colliders, 0.01) if colliders[i].owner != colliders[j].owner]
+    assert layout.pairs(positions, rotations, 0.01) == expected
+    # Free bodies given as a set (decided for every pair at once) or as the same rule asked per pair: the same pairs.
+    free = {"c1", "c4"}
+    by_set = Layout([c.owner for c in colliders], [c.shape for c in colliders], free=free)
+    by_rule = Layout([c.owner for c in colliders], [c.shape for c in colliders], lambda a, b: a in free or b in free)
+    chosen = [(i, j) for i, j in expected if colliders[i].owner in free or colliders[j].owner in free]
+    assert by_set.pairs(positions, rotations, 0.01) == by_rule.pairs(positions, rotations, 0.01) == chosen
+
+
+def _face_down(rng: np.random.Generator, vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """A rotation that turns a random face of a convex hull to face straight down, then tilts it by up to 1e-4 rad."""
+    a, b, c = vertices[triangles[rng.integers(len(triangles))]]
+    outward = np.cross(b - a, c - a)
+    outward /= np.linalg.norm(outward)
+    axis = np.cross(outward, [0.0, 0.0, -1.0])
+    angle = np.arctan2(np.linalg.norm(axis), outward @ [0.0, 0.0, -1.0])
+    turn = _axis_angle(axis / max(np.linalg.norm(axis), 1e-300), angle) if np.linalg.norm(axis) > 1e-12 else np.eye(3)
+    tilt = rng.normal(size=3)
+    return _axis_angle(tilt / np.linalg.norm(tilt), rng.uniform(0.0, 1e-4)) @ turn
+
+
+def _axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * k @ k
+
+
+def _coal_patch_corners(shape: Box | Convex, pose: Pose, margin: float) -> np.ndarray:
+    """The corners of coal's own contact patch for a polytope on the table ``z <= 0``, projected on it (the reference)."""
+    geometry = coal.Box(*shape.size) if isinstance(shape, Box) else _coal_convex(shape)
+    placed, table = coal.Transform3s(pose.rotation, pose.position), coal.Transform3s()
+    request, result = coal.CollisionRequest(), coal.CollisionResult()
+    request.security_margin = margin
+    coal.collide(geometry, placed, coal.Halfspace(np.array([0.0, 0.0, 1.0]), 0.0), table, request, result)
+    patch_request = coal.ContactPatchRequest(1, 8, margin - result.getContact(0).penetration_depth + 1e-12)
+    patches = coal.ContactPatchResult(patch_request)
+    coal.computeContactPatch(geometry, placed, coal.Halfspace(np.array([0.0, 0.0, 1.0]), 0.0), table, result, patch_request, patches)
+    patch = patches.getContactPatch(0)
+    return np.array([patch.getPointShape1(k) for k in range(patch.size())])[:, :2]
+
+
+def _coal_convex(shape: Convex) -> object:
+    model = coal.BVHModelOBBRSS()
+    model.beginModel(len(shape.triangles), len(shape.vertices))
+    model.addVertices(np.array(shape.vertices))
+    model.addTriangles(np.array(shape.triangles))
+    model.endModel()
+    model.buildConvexRepresentation(False)
+    return model.convex
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_a_polytope_face_down_on_the_table_touches_at_the_corners_of_coals_patch(seed: int) -> None:
+    """Polytopes (boxes, random hulls) resting on a face tilted within the margin: the corners detection reports
+    (from the vertices, without coal) are those of coal's contact patch, each with its own gap."""
+    rng = np.random.default_rng(seed)
+    shape: Box | Convex
+    if seed % 2:
+        shape = Box(rng.uniform(0.02, 0.2, size=3))
+        vertices = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * shape.size / 2
+        rotation = _face_down_box(rng)
+    else:
+        shape = Convex(rng.normal(size=(12, 3)) * 0.05)
+        vertices = shape.vertices
+        rotation = _face_down(rng, vertices, shape.triangles)
+    lowest = float(np.min(vertices @ rotation.T, axis=0)[2])
+    pose = Pose(rng.uniform(-0.1, 0.1, size=3) * [1, 1, 0] + [0.0, 0.0, -lowest + rng.uniform(-MARGIN, MARGIN) / 4], rotation)
+    found = detect([Collider("part", shape, pose), TABLE], margin=MARGIN)
+    world = vertices @ rotation.T + pose.position
+    heights = world[:, 2]
+    for contact in found:
+        nearest = np.argmin(np.linalg.norm(world[:, :2] - contact.point[:2], axis=1))
+        assert contact.gap == pytest.approx(heights[nearest], abs=EXACT)  # each corner's own gap
+        assert contact.normal == pytest.approx([0.0, 0.0, 1.0])
+    reference = _coal_patch_corners(shape, pose, MARGIN)
+    distinct = [p for k, p in enumerate(reference) if all(np.linalg.norm(p - q) > 1e-7 for q in reference[:k])]
+    _same_points(_points(found)[:, :2], np.array(distinct), tol=1e-7)
+
+
+def _face_down_box(rng: np.random.Generator) -> np.ndarray:
+    """A box turned by quarter turns onto a random face, tilted by up to 1e-4 rad about a random axis."""
+    turns = [np.eye(3), _axis_angle(np.array([1.0, 0.0, 0.0]), np.pi / 2), _axis_angle(np.array([0.0, 1.0, 0.0]), np.pi / 2)]
+    tilt = rng.normal(size=3)
+    return _axis_angle(tilt / np.linalg.norm(tilt), rng.uniform(0.0, 1e-4)) @ turns[int(rng.integers(3))]
 
 
 def test_pairs_the_caller_excludes_and_shapes_of_one_owner_never_touch() -> None:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import sysconfig
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -206,6 +207,12 @@ class _Placement:
 
     joints: FloatArray  # (joints, 4, 4): each joint's frame in the world (the base pose applied)
     jacobian: FloatArray  # (6, dofs): [v of the model origin; w] per joint velocity, in the model's root frame
+    base: FloatArray  # (3, 3): the base's rotation, model root frame to world
+
+    @cached_property
+    def world_jacobian(self) -> tuple[FloatArray, FloatArray]:
+        """The Jacobian's linear and angular rows (3, dofs) each turned into the world frame (the model origin's velocity)."""
+        return self.base @ self.jacobian[:3], self.base @ self.jacobian[3:]
 
 
 class UrdfRobot:
@@ -378,17 +385,16 @@ class UrdfRobot:
         """
         kinematics = self._kinematics
         chains = kinematics.chain_columns[[kinematics.link_in_joint[self._link(link)][0] for link in links]]  # (k, joints)
-        jacobian = self._placement.jacobian
-        local = (np.asarray(points, dtype=float).reshape(-1, 3) - self.base.position) @ self.base.rotation  # model root frame
-        # The linear rows minus p x (angular rows), per point (np.cross costs more than writing it out).
-        x, y, z = local[:, 0, None], local[:, 1, None], local[:, 2, None]
-        wx, wy, wz = jacobian[3], jacobian[4], jacobian[5]
-        shifted = np.empty((len(local), 3, jacobian.shape[1]))
+        linear, angular = self._placement.world_jacobian  # (3, joints) each, in the world
+        r = np.asarray(points, dtype=float).reshape(-1, 3) - self.base.position  # from the model origin, world frame
+        # The linear rows minus r x (angular rows), per point (np.cross costs more than writing it out).
+        x, y, z = r[:, 0, None], r[:, 1, None], r[:, 2, None]
+        wx, wy, wz = angular
+        shifted = np.empty((len(r), 3, angular.shape[1]))
         shifted[:, 0], shifted[:, 1], shifted[:, 2] = y * wz - z * wy, z * wx - x * wz, x * wy - y * wx
-        np.subtract(jacobian[:3], shifted, out=shifted)
+        np.subtract(linear, shifted, out=shifted)
         shifted *= chains[:, None, :]
-        result: FloatArray = self.base.rotation @ shifted  # into the world
-        return result
+        return shifted
 
     def point_jacobian_rates(self, link: str, point: npt.ArrayLike) -> FloatArray:
         """How :meth:`point_jacobian` of ``link`` at the fixed world ``point`` changes with each joint position:
@@ -422,7 +428,7 @@ def _place(kinematics: _Kinematics, angles: FloatArray, base: Pose) -> _Placemen
     model, data = kinematics.model, kinematics.data
     pinocchio.computeJointJacobians(model, data, kinematics.configuration(angles))  # runs the forward kinematics too
     joints = np.array([placement.homogeneous for placement in data.oMi.tolist()])  # a list iterates faster than Pinocchio's vector
-    return _Placement(base.matrix() @ joints, np.array(data.J, dtype=float))
+    return _Placement(base.matrix() @ joints, np.array(data.J, dtype=float), base.rotation)
 
 
 def _matrix(placement: Any) -> FloatArray:

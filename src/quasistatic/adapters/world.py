@@ -259,7 +259,7 @@ class World:
             shaped = self._shaped()
             owners = [p.name for p in shaped] + [owner for r in self.robots for owner in r.collider_owners]
             shapes = [cast(Shape, p.shape) for p in shaped] + [shape for r in self.robots for shape in r.collider_shapes]
-            return Layout(owners, shapes, self._may_touch)
+            return Layout(owners, shapes, free=self._kept("free", lambda: frozenset(b.name for b in self.bodies)))
 
         return self._kept("layout", build)
 

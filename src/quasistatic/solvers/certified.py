@@ -6,7 +6,7 @@
    only one: ``solved``, for any friction model, exact 3-D cones included.
    On exact 3-D cones, rest with every mover still is proven the only motion
    on the circles themselves when it is (:mod:`.certify.rest`: the load cannot
-   do work, so loaded contacts stick, and SCIP finds no other such motion).
+   do work, so loaded contacts stick, and LPs or else SCIP find no other such motion).
 3. Otherwise the complete SCIP search of ``scip`` runs. For polyhedral cones
    it starts from Lemke's point once every law of the search's own form is
    checked there, so SCIP only has to prove that no other motion exists
@@ -23,7 +23,7 @@ from ..laws import Problem, RawMotion
 from ..laws.polyhedral import aligned_edges, polyhedral_form
 from .certify.cheap import exact_motion, kinematically_unique, seed_point
 from .certify.exact_cone import solve_exact_3d, unique_exact_motion
-from .certify.rest import REST_PROOF, rest_is_unique
+from .certify.rest import rest_proof
 from .certify.search import certified_polyhedral, summarise
 from .result import BackendResult, Options
 
@@ -55,6 +55,7 @@ def _exact_cones(problem: Problem, options: Options) -> BackendResult:
     motion = exact_motion(problem)
     if motion is not None and kinematically_unique(problem, motion.q):
         return unique_exact_motion(problem, motion, options, _KINEMATIC)
-    if motion is not None and rest_is_unique(problem, motion.q, options):
-        return unique_exact_motion(problem, motion, options, REST_PROOF)
+    proof = None if motion is None else rest_proof(problem, motion.q, options)
+    if motion is not None and proof is not None:
+        return unique_exact_motion(problem, motion, options, proof)
     return solve_exact_3d(problem, options)

@@ -202,26 +202,107 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     """The normal-force ranges over every force consistent with twist ``q``; None when no range is wide.
 
     Wide means wider than ``LP_FEASIBILITY`` (:func:`~.ranges.ranges_are_wide`), as before the ranges
-    were deferred. Free columns of full rank: one force distribution, None. Every normal force a
+    were deferred. A segment of consistent forces through a balanced point found by least squares that
+    moves some normal force by more than that: wide, without an LP (:func:`_wide_through_balanced_point`).
+    Free columns of full rank: one force distribution, None. Every normal force a
     combination of the equations (only the edge intensities vary, as both edges of a 2-D contact
     that sticks): None, as :func:`~.ranges.value_ranges` finds them constant. Otherwise one LP
     decides (:func:`_normal_forces_vary`), and the ranges wait until they are read; where it
     cannot decide, they are worked out now and decide.
     """
-    forces = forces_at_twist(problem, edges, q, measured_masks(problem, edges, q))
+    masks = measured_masks(problem, edges, q)
+    forces = forces_at_twist(problem, edges, q, masks)
+    normal = np.arange(forces.fixed.size)[forces.polytope.normal]
+    work = partial(_normal_ranges, forces, normal)
+    if _wide_through_balanced_point(problem, masks, forces.polytope.K):
+        return IndeterminateForces(None, work, forces)
     # A small set is read densely once: each sparse conversion of a grasp's matrix costs ~0.1 ms.
     A = forces.A.toarray() if min(forces.A.shape) <= DENSE_MAX else forces.A.tocsc()
     if full_column_rank(A[:, ~forces.fixed], FORCE_RANK):
         return None
-    normal = np.arange(forces.fixed.size)[forces.polytope.normal]
     if np.all(in_row_space(A, normal)):
         return None  # each normal force is fixed by the equations (the ranges' LPs would find it constant)
-    work = partial(_normal_ranges, forces, normal)
     vary = _normal_forces_vary(A, forces, normal) if isinstance(A, np.ndarray) else None
     if vary is not None:
         return IndeterminateForces(None, work, forces) if vary else None
     ranges = work()
     return IndeterminateForces(ranges, None, forces) if ranges_are_wide(list(ranges)) else None
+
+
+def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count: int) -> bool:
+    """True when a segment of forces consistent with the modes moves some normal force by more than ``LP_FEASIBILITY``.
+
+    Only where no frictional contact slides. Every closed contact may then carry a force in its
+    ``edge_count``-gon cone (frictionless ones a normal force alone), and that cone holds the disc cone
+    ``|c_t| <= rho cn`` with ``rho = mu cos(pi / edge_count)`` (its inscribed circle; in 2-D the cone itself). A balanced point
+    ``c`` (least squares over the closed contacts; a contact whose force leaves its disc cone is dropped,
+    carrying nothing, and the rest solved again) with margins ``s_i = rho_i cn_i - |c_t,i| >= 0`` lies
+    in the set. On the contacts with ``s_i > 0``, ``z``, the projection of a normal force's unit vector on
+    the null space of their wrench map, keeps the balance, and ``c + t z`` stays in every disc cone for
+    ``|t| <= min_i s_i / (|z_t,i| + rho_i |z_n,i|)`` (and ``A (c + t z)`` within ``ZERO`` of the load, as
+    in :func:`_normal_forces_vary`): that normal force spans at least ``2 t z_j``.
+    """
+    closed, mu = masks.closed, problem.mu
+    if np.any(closed & masks.sliding & (mu > 0.0)):
+        return False
+    inradius = _inradius(problem.dimension, edge_count)
+    rho = np.where(mu > 0.0, mu * inradius, 1.0)  # frictionless: its normal force >= 0
+    kept = np.flatnonzero(closed)
+    for _ in range(problem.n_contacts + 1):
+        wrenches = _wrench_columns(problem, kept)
+        c = np.linalg.lstsq(wrenches, -problem.g, rcond=None)[0] if kept.size else np.zeros(0)
+        if float(np.max(np.abs(wrenches @ c + problem.g), initial=0.0)) > ZERO:
+            return False
+        tangent, cn = _per_contact(problem, kept, c)
+        margin = rho[kept] * cn - np.linalg.norm(tangent, axis=1)
+        if np.all(margin >= 0.0):
+            break
+        kept = kept[margin >= 0.0]
+    inner = margin > 0.0
+    kept, margin = kept[inner], margin[inner]
+    wrenches = _wrench_columns(problem, kept)
+    if kept.size == 0:
+        return False
+    basis = null_space(wrenches, FORCE_RANK)
+    normals = np.cumsum([problem.dimension if mu[i] > 0.0 else 1 for i in kept]) - 1  # each kept contact's normal column
+    for j in normals.tolist():
+        z = basis @ basis[j]
+        if z[j] <= 0.0:
+            continue
+        moved_tangent, moved_normal = _per_contact(problem, kept, z)
+        rate = np.linalg.norm(moved_tangent, axis=1) + rho[kept] * np.abs(moved_normal)
+        reach = float(np.min(margin[rate > 0.0] / rate[rate > 0.0], initial=np.inf))
+        drift = float(np.max(np.abs(wrenches @ z), initial=0.0))
+        reach = min(reach, ZERO / drift if drift > 0.0 else np.inf)
+        if 2.0 * reach * z[j] > LP_FEASIBILITY:
+            return True
+    return False
+
+
+def _inradius(dimension: int, edge_count: int) -> float:
+    """Radius of the disc inside the unit friction polygon of ``edge_count`` edges: 2-D, its two edges are the cone;
+    3-D, a regular polygon's inscribed circle; no edges (no friction), none."""
+    if dimension == 2:
+        return 1.0 if edge_count >= 2 else 0.0
+    return float(np.cos(np.pi / edge_count)) if edge_count >= 3 else 0.0
+
+
+def _wrench_columns(problem: Problem, contacts: np.ndarray) -> np.ndarray:
+    """The wrench of each force coordinate of ``contacts`` on the bodies (k n, f): tangents and normal if frictional."""
+    columns = [problem.J[i].T if problem.mu[i] > 0.0 else problem.Jn[i][:, None] for i in contacts.tolist()]
+    return np.hstack(columns) if columns else np.zeros((problem.n_dof, 0))
+
+
+def _per_contact(problem: Problem, contacts: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``x`` in the coordinates of :func:`_wrench_columns` as tangent forces (k, d - 1) and normal forces (k,)."""
+    d = problem.dimension
+    tangent, normal = np.zeros((contacts.size, d - 1)), np.zeros(contacts.size)
+    at = 0
+    for k, i in enumerate(contacts.tolist()):
+        if problem.mu[i] > 0.0:
+            tangent[k], at = x[at : at + d - 1], at + d - 1
+        normal[k], at = x[at], at + 1
+    return tangent, normal
 
 
 def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ...]:

@@ -116,13 +116,13 @@ def render_result(result: BenchResult, console: Console) -> None:
     )
 
 
-_PIPELINE_COLUMNS = ("case", "objects", "pairs", "near", "contacts", "median", "IQR", "ratio", "answer", "note")
+_PIPELINE_COLUMNS = ("case", "objects", "pairs", "near", "contacts", "median", "IQR", "CPU median", "ratio", "answer", "note")
 
 
 def _pipeline_cells(row: dict[str, Any]) -> list[str]:
     """One robots-and-geometry row as text cells, from ``PipelineRow.to_dict()``."""
     if row["skipped"]:
-        return [row["case"], "", "", "", "", "skipped", "", "", row["skipped"], ""]
+        return [row["case"], "", "", "", "", "skipped", "", "", "", row["skipped"], ""]
     answer = f"{row['status']}, certified {'yes' if row['certified'] else 'no'}" if row["status"] else ""
     return [
         row["case"],
@@ -132,13 +132,17 @@ def _pipeline_cells(row: dict[str, Any]) -> list[str]:
         str(row["contacts"]),
         format_seconds(row["median"]),
         format_seconds_range(row["p25"], row["p75"]),
+        "-" if row.get("cpu_median") is None else format_seconds(row["cpu_median"]),
         "-" if row["ratio"] is None else f"{row['ratio']:.3g}",
         answer,
         row["note"],
     ]
 
 
-_PIPELINE_CAPTION = "pairs: after the broad phase; near: left to coal (one side a free body); ratio: baseline / row median"
+_PIPELINE_CAPTION = (
+    "pairs: after the broad phase; near: left to coal (one side a free body); ratio: baseline / row median; "
+    "CPU median: the same calls' process time (less inflated by other work on a shared machine)"
+)
 
 
 def _detect_growth(slope: float | None) -> str:
@@ -216,7 +220,11 @@ def markdown_tables(data: dict[str, Any]) -> str:
         lines += ["| " + " | ".join(_sweep_cells(row)) + " |" for row in data["sweeps"]]
         lines += ["", _SWEEP_CAPTION]
     if data.get("pipeline"):
-        lines += ["", "| " + " | ".join(_PIPELINE_COLUMNS) + " |", "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |"]
+        lines += [
+            "",
+            "| " + " | ".join(_PIPELINE_COLUMNS) + " |",
+            "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |",
+        ]
         lines += ["| " + " | ".join(_pipeline_cells(row)) + " |" for row in data["pipeline"]]
         lines += ["", _PIPELINE_CAPTION + ". " + _detect_growth(data.get("detect_growth"))]
     return "\n".join(lines) + "\n"

@@ -51,7 +51,9 @@ class PipelineRow:
     """One robots-and-geometry measurement; times in seconds.
 
     ``pairs``: candidate pairs after the broad phase; ``near``: those left to coal (pairs
-    that may touch); ``ratio``: the row's baseline median / this median (> 1: faster).
+    that may touch); ``ratio``: the row's baseline median / this median (> 1: faster);
+    ``cpu_median``: the median of the same calls' process (CPU) time, which other work on a
+    shared machine inflates far less than the wall time of ``median``.
     """
 
     case: str
@@ -69,6 +71,7 @@ class PipelineRow:
     certified: bool | None = None
     skipped: str | None = None
     note: str = ""
+    cpu_median: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -88,8 +91,14 @@ def run_pipeline(full: bool, budget: float, say: Callable[[str], None]) -> list[
 
 
 def growth_exponent(rows: list[PipelineRow]) -> float | None:
-    """Least-squares slope of log(median detect time) against log(near pairs) over the growth rows."""
-    points = [(r.near, r.median) for r in rows if r.case == "detect growth" and r.median is not None and r.near > 0]
+    """Least-squares slope of log(median detect time) against log(near pairs) over the growth rows.
+
+    The CPU-time medians when every growth row has one (other work on the machine inflates wall time
+    unevenly across rows, and so the slope), else the wall-time medians.
+    """
+    growth = [r for r in rows if r.case == "detect growth" and r.median is not None and r.near > 0]
+    cpu = all(r.cpu_median is not None for r in growth)
+    points = [(r.near, float((r.cpu_median if cpu else r.median) or 0.0)) for r in growth]
     if len({n for n, _ in points}) < 3:
         return None
     return float(np.polyfit(np.log([n for n, _ in points]), np.log([t for _, t in points]), 1)[0])
@@ -265,22 +274,23 @@ def _pairs(world: World) -> tuple[list[Collider], list[tuple[int, int]], list[tu
 # --------------------------------------------------------------------------- timing
 
 
-def _times(call: Callable[[], Any], budget: float, at_least: int = 5) -> list[float]:
-    """One discarded warm-up call, then timed calls until ``budget`` seconds are spent (at least ``at_least``)."""
+def _times(call: Callable[[], Any], budget: float, at_least: int = 5) -> list[tuple[float, float]]:
+    """One discarded warm-up call, then (wall, CPU) times of calls until ``budget`` seconds are spent (at least ``at_least``)."""
     call()
-    times: list[float] = []
+    times: list[tuple[float, float]] = []
     started = time.perf_counter()
     while len(times) < at_least or (time.perf_counter() - started < budget and len(times) < 2000):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         call()
-        times.append(time.perf_counter() - t0)
+        times.append((time.perf_counter() - t0, time.process_time() - c0))
     return times
 
 
-def _timed(row: PipelineRow, times: list[float]) -> PipelineRow:
-    """``row`` with the median and quartiles of ``times``."""
-    q25, median, q75 = np.percentile(times, [25, 50, 75])
-    return replace(row, samples=len(times), median=float(median), p25=float(q25), p75=float(q75))
+def _timed(row: PipelineRow, times: list[tuple[float, float]]) -> PipelineRow:
+    """``row`` with the median and quartiles of the wall times, and the median of the CPU times."""
+    q25, median, q75 = np.percentile([wall for wall, _ in times], [25, 50, 75])
+    cpu = float(np.median([used for _, used in times]))
+    return replace(row, samples=len(times), median=float(median), p25=float(q25), p75=float(q75), cpu_median=cpu)
 
 
 def _ratio(base: PipelineRow, row: PipelineRow) -> float | None:
@@ -291,5 +301,5 @@ def _line(row: PipelineRow) -> str:
     if row.skipped:
         return f"{row.case}: skipped ({row.skipped})"
     extra = f", {row.status}, certified {row.certified}" if row.status else ""
-    median = f"median {(row.median or 0.0) * 1e3:.3g} ms over {row.samples} calls"
+    median = f"median {(row.median or 0.0) * 1e3:.3g} ms (CPU {(row.cpu_median or 0.0) * 1e3:.3g} ms) over {row.samples} calls"
     return f"{row.case}, {row.objects} objects, {row.near} near pairs: {median}{extra}"
