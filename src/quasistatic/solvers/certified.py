@@ -57,12 +57,13 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
         motion = RawMotion(seed[: form.n_q], form.forces(seed))
         return summarise(form, [motion], True, options).with_notes(certificate=_KINEMATIC)
     if problem.dimension == 2:
-        proof = prove_by_patterns(problem, seed, form.n_q)
-        if proof.verdict is PatternVerdict.UNIQUE and seed is not None:
-            motion = RawMotion(seed[: form.n_q], form.forces(seed))
+        proof = prove_by_patterns(form, seed)
+        if proof.verdict is PatternVerdict.UNIQUE and proof.seed is not None:
+            motion = RawMotion(proof.seed[: form.n_q], form.forces(proof.seed))
             return summarise(form, [motion], True, options).with_notes(certificate=PATTERN_PROOF)
         if proof.verdict is PatternVerdict.NONE:
             return diagnose(problem, edges).with_notes(certificate=NO_MOTION_PROOF)
+        seed = proof.seed
     return certified_polyhedral(problem, edges, options, seed)
 
 

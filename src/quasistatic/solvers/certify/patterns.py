@@ -34,6 +34,10 @@ contain those of every assignment below it, and a node is pruned when
 - at a leaf whose rows leave a polyhedron of twists, HiGHS finds it empty
   (LP status), or all its extremes within ``SAME_TWIST / 2`` of ``q*``.
 
+Without a seed, the first surviving leaf whose twist and forces satisfy every law
+of the form (checked as Lemke's point is, :func:`~.cheap.satisfies_form`) becomes
+the seed, and the search goes on: nodes pruned before did not depend on it.
+
 If every node is pruned the search is complete: every motion's twist is ``q*``
 (to ``SAME_TWIST`` exactly, to ``DISTINCT_TWIST / 2`` within the tolerance,
 which is the box the SCIP search excludes around a found motion), and no mode
@@ -53,8 +57,10 @@ import numpy as np
 from scipy.optimize import nnls
 
 from ...laws import Problem
+from ...laws.polyhedral import LCPForm
 from ...tolerances import DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, MOTION_RANK, PATTERN_NODES, SAME_TWIST
 from ..numerics.highs import WarmLP
+from .cheap import satisfies_form
 
 __all__ = ["PatternVerdict", "PatternProof", "prove_by_patterns", "PATTERN_PROOF", "NO_MOTION_PROOF"]
 
@@ -72,7 +78,10 @@ class PatternVerdict(Enum):
 
 @dataclass
 class PatternProof:
+    """The verdict, the seed it holds for (a point ``[q, cn, beta, lam]`` of the form), and the work done."""
+
     verdict: PatternVerdict
+    seed: np.ndarray | None = None
     nodes: int = 0
     lps: int = 0
 
@@ -91,7 +100,8 @@ class _Rows:
     norms: np.ndarray  # 2-norm of each bank row
     loads: np.ndarray
     g: np.ndarray
-    seed: np.ndarray | None
+    seed: np.ndarray | None  # the seed's twist
+    form: LCPForm
     order: list[int]  # contacts in the order they are fixed
     proof: PatternProof = field(default_factory=lambda: PatternProof(PatternVerdict.UNDECIDED))
 
@@ -136,25 +146,29 @@ _EDGES_OF = {  # which of a contact's two load columns each mode keeps
     _SLIDE_PLUS: np.array([True, False]),
     _SLIDE_MINUS: np.array([False, True]),
 }
-_ALL_MODES = (_SEPARATING, _ROLLING, _SLIDE_PLUS, _SLIDE_MINUS)
+_ALL_MODES = (_ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _SEPARATING)  # separating last: see _search
 
 
-def prove_by_patterns(problem: Problem, seed_x: np.ndarray | None, n_q: int) -> PatternProof:
-    """Whether every motion of the planar polyhedral laws has the twist of ``seed_x`` (a point ``[q, cn, beta, lam]``
-    of the form, two edges per contact), or, without one, whether no motion exists; see the module docstring."""
+def prove_by_patterns(form: LCPForm, seed_x: np.ndarray | None) -> PatternProof:
+    """Whether every motion of the planar polyhedral laws ``form`` (two edges per contact) has the twist of
+    ``seed_x`` (a point ``[q, cn, beta, lam]`` of it), or of a seed found on the way, or, without one, whether
+    no motion exists; see the module docstring."""
+    problem, n_q = form.problem, form.n_q
     Jn, Jt, bn, bt = problem.Jn, problem.Jt[:, 0, :], problem.bn, problem.bt[:, 0]
     mu = problem.mu[:, None]
     loads = np.stack([Jn + mu * Jt, Jn - mu * Jt], axis=1).reshape(-1, problem.n_dof).T
     bank = np.vstack([Jn, Jt, -Jt, Jt])
     seed = None if seed_x is None else seed_x[:n_q]
     rows = _Rows(
-        bank, np.concatenate([bn, bt, -bt, bt]), np.linalg.norm(bank, axis=1), loads, problem.g, seed, _order(problem, seed_x, n_q)
+        bank, np.concatenate([bn, bt, -bt, bt]), np.linalg.norm(bank, axis=1), loads, problem.g, seed, form, _order(problem, seed_x, n_q)
     )
+    rows.proof.seed = seed_x
     m = problem.n_contacts
     root = _Node(np.zeros(4 * m, dtype=bool), np.arange(4 * m) < m, np.ones(2 * m, dtype=bool), 0)
     fit = _forces(rows, root.columns, None)
-    closed = fit is None or _search(rows, root, fit, None)
-    rows.proof.verdict = (PatternVerdict.UNIQUE if seed is not None else PatternVerdict.NONE) if closed else PatternVerdict.UNDECIDED
+    closed = fit is None or _search(rows, root, fit, _UNKNOWN)
+    found = rows.proof.seed is not None
+    rows.proof.verdict = (PatternVerdict.UNIQUE if found else PatternVerdict.NONE) if closed else PatternVerdict.UNDECIDED
     return rows.proof
 
 
@@ -166,32 +180,66 @@ def _order(problem: Problem, seed_x: np.ndarray | None, n_q: int) -> list[int]:
     return [int(i) for i in np.argsort(-seed_x[n_q : n_q + m], kind="stable")]
 
 
-def _search(rows: _Rows, node: _Node, fit: np.ndarray, ball: _Ball | None) -> bool:
+def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
     """True when every mode assignment below ``node`` is pruned.
 
-    ``fit``: forces on the node's columns with ``|G fit + g|`` within the margin; ``ball``: where the node's
-    twists lie, when its closed rows pin them.
+    ``fit``: forces on the node's columns with ``|G fit + g|`` within the margin; ``twists``: what the node's
+    twists are known to be.
     """
     if node.depth == len(rows.order):
         return False  # a leaf that survived: another motion may exist
     contact = rows.order[node.depth]
-    for mode in _possible_modes(rows, contact, ball):
+    slide_blocked = False  # a sliding sibling's Farkas vector also holds for separating, which keeps fewer columns
+    for mode in _possible_modes(rows, contact, twists.ball):
         rows.proof.nodes += 1
         if rows.proof.nodes > PATTERN_NODES:
             return False
         child = node.child(rows, contact, mode)
-        child_fit = _forces(rows, child.columns, fit)
+        child_fit = None if mode == _SEPARATING and slide_blocked else _forces(rows, child.columns, fit)
         if child_fit is None:
+            slide_blocked |= mode in (_SLIDE_PLUS, _SLIDE_MINUS)
             continue  # no equilibrium below this node
-        twist = _twist(rows, child)
-        if twist.pruned:
+        child_twists = _child_twists(rows, child, mode, twists)
+        if child_twists.pruned:
             continue
         if child.depth == len(rows.order):
-            if twist.point or not _leaf_polyhedron_pruned(rows, child):
+            if child_twists is twists:  # every row counted: a tighter ball, perhaps the seed's
+                child_twists = _twist(rows, child)
+                if child_twists.pruned:
+                    continue
+            if child_twists.point and child_twists.ball is not None and _adopted(rows, child_twists.ball.center, child_fit):
+                continue
+            if child_twists.point or not _leaf_polyhedron_pruned(rows, child):
                 return False  # another motion, or too close to call
             continue
-        if not _search(rows, child, child_fit, twist.ball):
+        if not _search(rows, child, child_fit, child_twists):
             return False
+    return True
+
+
+def _child_twists(rows: _Rows, child: _Node, mode: int, parent: _Twists) -> _Twists:
+    """The child's twists: the parent's when its rows are the same (a separating contact, as a free one) or
+    already pin one twist (the child's lie in the same ball, and its modes were filtered against it)."""
+    if not (mode == _SEPARATING or parent.point):
+        return _twist(rows, child)
+    ball, spread = parent.ball, parent.spread
+    if parent.point and ball is not None and spread is not None and _near_seed(rows, ball.center, ball.center, spread):
+        return _PRUNED  # a seed adopted since the parent was seen
+    return parent
+
+
+def _adopted(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> bool:
+    """Without a seed: the leaf's twist ``q`` and forces ``fit`` as the seed, when they satisfy every law of the form."""
+    if rows.seed is not None:
+        return False
+    m = rows.m
+    mu = rows.form.problem.mu
+    pairs = fit.reshape(m, 2)  # unit normal forces on edges +t, -t
+    slip = rows.bank[m : 2 * m] @ q - rows.rhs[m : 2 * m]
+    x = np.concatenate([q, pairs.sum(axis=1), (mu[:, None] * pairs).ravel(), np.abs(slip)])
+    if not satisfies_form(rows.form, x):
+        return False
+    rows.seed, rows.proof.seed = q, x
     return True
 
 
@@ -207,14 +255,14 @@ def _possible_modes(rows: _Rows, contact: int, ball: _Ball | None) -> tuple[int,
     reach_t = float(rows.norms[tangent]) * ball.radius + LP_FEASIBILITY
     if abs(wn) > reach_n:
         return (_SEPARATING,)
-    modes = [_SEPARATING]
+    modes = []
     if abs(slip) <= reach_t:
         modes.append(_ROLLING)
     if slip <= reach_t:
         modes.append(_SLIDE_PLUS)
     if slip >= -reach_t:
         modes.append(_SLIDE_MINUS)
-    return tuple(modes)
+    return (*modes, _SEPARATING)
 
 
 def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndarray | None:
@@ -243,12 +291,14 @@ def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndar
 
 @dataclass(frozen=True)
 class _Twists:
-    """What a node's twists are known to be: ``pruned`` (empty, or the seed's); else within ``ball`` when
-    known, and ``point`` when the closed rows leave one twist (a leaf there is another motion)."""
+    """What a node's twists are known to be: ``pruned`` (empty, or the seed's); else within ``ball`` (2-norm,
+    for filtering modes) when known, and ``point`` when the closed rows leave one twist (a leaf there is another
+    motion)."""
 
     pruned: bool
     ball: _Ball | None = None
     point: bool = False
+    spread: np.ndarray | None = None  # of a point: how far, per entry, a loosened twist may lie from it
 
 
 _PRUNED, _UNKNOWN = _Twists(True), _Twists(False)
@@ -257,11 +307,12 @@ _PRUNED, _UNKNOWN = _Twists(True), _Twists(False)
 def _twist(rows: _Rows, node: _Node) -> _Twists:
     """The node's twists, loosened by ``LP_FEASIBILITY`` per row, bounded by the closed rows ``E q = e``.
 
-    With ``q0`` their least-squares point and ``s`` their smallest singular value, the part of ``q - q0`` in
-    E's row space has 2-norm at most ``R = sqrt(k) LP_FEASIBILITY / s`` (it is the part of ``E q - e`` in E's
-    range), and no twist exists when the residual at ``q0`` exceeds ``sqrt(k) LP_FEASIBILITY``. Rows of full
-    column rank pin the twists to the ball ``(q0, R)``; ``n - 1`` rows leave a line ``q0 + t d`` (within
-    ``R``), on which every inequality row bounds ``t``.
+    With ``E+`` the pseudo-inverse of the ``k`` rows and ``q0 = E+ e``, the part of ``q - q0`` in E's row space
+    is ``E+ (E q - e)`` (the residual ``E q0 - e`` is orthogonal to E's range), so each entry ``j`` of it is at
+    most ``LP_FEASIBILITY |E+_j|_1`` and its 2-norm at most ``R = sqrt(k) LP_FEASIBILITY / s`` (``s``: the
+    smallest singular value); no twist exists when the residual exceeds ``sqrt(k) LP_FEASIBILITY``. Rows of
+    full column rank pin the twists to one point; ``n - 1`` rows leave a line ``q0 + t d``, on which every
+    inequality row bounds ``t``.
     """
     E, e = rows.bank[node.equal], rows.rhs[node.equal]
     k, n = E.shape
@@ -271,24 +322,28 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     if sigma[-1] <= MOTION_RANK or k > n and sigma[n - 1] <= MOTION_RANK:
         return _UNKNOWN
     r = min(k, n)
-    q0 = vt[:r].T @ ((u[:, :r].T @ e) / sigma[:r])
-    slack = math.sqrt(k) * LP_FEASIBILITY
-    if float(np.linalg.norm(E @ q0 - e)) > slack:
+    pseudo_inverse = vt[:r].T @ (u[:, :r].T / sigma[:r, None])
+    q0 = pseudo_inverse @ e
+    if float(np.linalg.norm(E @ q0 - e)) > math.sqrt(k) * LP_FEASIBILITY:
         return _PRUNED
-    radius = slack / float(sigma[r - 1])
+    spread = LP_FEASIBILITY * np.abs(pseudo_inverse).sum(axis=1)
+    radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
     A, a = rows.bank[node.at_least], rows.rhs[node.at_least]
-    reserve = A @ q0 + rows.norms[node.at_least] * radius - (a - LP_FEASIBILITY)  # each row's best slack at t = 0
+    reach = LP_FEASIBILITY * np.abs(A @ pseudo_inverse).sum(axis=1)
+    reserve = A @ q0 + reach - (a - LP_FEASIBILITY)  # each row's best slack at t = 0
     if k < n:
-        return _on_line(rows, q0, vt[-1], radius, A @ vt[-1], reserve)
+        return _on_line(rows, q0, vt[-1], radius, spread, A @ vt[-1], reserve)
     if (reserve < 0.0).any():
-        return _PRUNED  # an open gap or slip sign fails on the whole ball
-    if _near_seed(rows, q0, q0, radius):
+        return _PRUNED  # an open gap or slip sign fails on the whole set
+    if _near_seed(rows, q0, q0, spread):
         return _PRUNED
-    return _Twists(False, _Ball(q0, radius), point=True)
+    return _Twists(False, _Ball(q0, radius), point=True, spread=spread)
 
 
-def _on_line(rows: _Rows, q0: np.ndarray, d: np.ndarray, radius: float, slope: np.ndarray, reserve: np.ndarray) -> _Twists:
-    """Twists ``q0 + t d`` (within ``radius``) with ``slope t + reserve >= 0`` for every inequality row."""
+def _on_line(
+    rows: _Rows, q0: np.ndarray, d: np.ndarray, radius: float, spread: np.ndarray, slope: np.ndarray, reserve: np.ndarray
+) -> _Twists:
+    """Twists ``q0 + t d`` (within ``spread`` per entry) with ``slope t + reserve >= 0`` for every inequality row."""
     if (reserve[slope == 0.0] < 0.0).any():
         return _PRUNED
     rising, falling = slope > 0.0, slope < 0.0
@@ -299,18 +354,18 @@ def _on_line(rows: _Rows, q0: np.ndarray, d: np.ndarray, radius: float, slope: n
     if not (np.isfinite(low) and np.isfinite(high)):
         return _UNKNOWN
     ends = q0 + low * d, q0 + high * d
-    if _near_seed(rows, *ends, radius):
+    if _near_seed(rows, *ends, spread):
         return _PRUNED
     return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + radius))
 
 
-def _near_seed(rows: _Rows, first: np.ndarray, second: np.ndarray, radius: float) -> bool:
+def _near_seed(rows: _Rows, first: np.ndarray, second: np.ndarray, spread: np.ndarray) -> bool:
     """Whether the segment ``first``-``second`` lies within ``SAME_TWIST / 2`` of the seed, and within
-    ``DISTINCT_TWIST / 2`` with ``radius`` added (largest entry)."""
+    ``DISTINCT_TWIST / 2`` with ``spread`` added to each entry."""
     if rows.seed is None:
         return False
-    offset = max(float(np.max(np.abs(first - rows.seed))), float(np.max(np.abs(second - rows.seed))))
-    return offset <= 0.5 * SAME_TWIST and offset + radius <= 0.5 * DISTINCT_TWIST
+    offset = np.maximum(np.abs(first - rows.seed), np.abs(second - rows.seed))
+    return float(np.max(offset)) <= 0.5 * SAME_TWIST and float(np.max(offset + spread)) <= 0.5 * DISTINCT_TWIST
 
 
 def _leaf_polyhedron_pruned(rows: _Rows, node: _Node) -> bool:
