@@ -2,7 +2,7 @@
 
 Property: the branch and bound never says "unique" (or "no motion") where
 ``method="scip"`` says otherwise, on 240 random 2-D scenes (with and without
-friction), the 2-D benchmark grasps, and degenerate scenes: a finger touching
+friction; 600 more with ``pytest -m slow``), the 2-D benchmark grasps, and degenerate scenes: a finger touching
 with zero force, equal loads (a continuum), a box resting on a table with a
 still finger. And it decides most scenes, so the property is not met by
 proving nothing. Then: the default ``certified`` method takes this path on the
@@ -79,6 +79,24 @@ def _reference_twist(problem: qs.Problem, motion: qs.Motion) -> np.ndarray:
     return np.concatenate([motion.twists[b.name] for b in problem.scene.bodies]) / units
 
 
+def _close(twist: np.ndarray, q: np.ndarray) -> bool:
+    return bool(np.max(np.abs(q - twist)) <= TWIST_RTOL * max(1.0, float(np.max(np.abs(twist)))))
+
+
+def _only_this_twist(problem: qs.Problem, reference: qs.Solution, q: np.ndarray) -> bool:
+    """SCIP's "ambiguous" list holds the twist ``q`` alone, each motion and extreme within ``TWIST_RTOL`` of it.
+
+    Seen once in 840 random scenes (seed 1392): a squeeze whose twist is 150 times the scene's speed. SCIP's
+    own point of the motion is off by more than ``SAME_TWIST`` (absolute) from the exact vertex, so its
+    pattern is taken for a continuum whose only extreme is that vertex: the same motion listed twice.
+    """
+    units = np.tile(problem.scales.twist_units(problem.dimension), len(problem.scene.bodies))
+    twists = [_reference_twist(problem, motion) for motion in reference.solutions]
+    twists += [np.concatenate([e[b.name] for b in problem.scene.bodies]) / units for m in reference.solutions for e in m.extreme_twists]
+    bounded = not any(motion.unbounded for motion in reference.solutions)
+    return reference.status == "ambiguous" and bounded and all(_close(twist, q) for twist in twists)
+
+
 def _proof_agrees_with_scip(scene: qs.Scene) -> PatternVerdict:
     """The branch and bound's verdict, after checking it against the SCIP search on the same scene."""
     problem = qs.assemble(scene)
@@ -86,11 +104,11 @@ def _proof_agrees_with_scip(scene: qs.Scene) -> PatternVerdict:
     proof = prove_by_patterns(form, seed_point(form))
     reference = qs.solve(problem, method="scip")
     if proof.verdict is PatternVerdict.UNIQUE:
-        assert reference.status == "solved", f"patterns: unique; scip: {reference.message}"
-        assert proof.seed is not None and reference.motion is not None
-        twist = _reference_twist(problem, reference.motion)
-        scale = max(1.0, float(np.max(np.abs(twist))))
-        assert np.max(np.abs(proof.seed[: form.n_q] - twist)) <= TWIST_RTOL * scale
+        assert proof.seed is not None
+        q = proof.seed[: form.n_q]
+        assert reference.status == "solved" or _only_this_twist(problem, reference, q), f"patterns: unique; scip: {reference.message}"
+        assert reference.motion is not None
+        assert _close(_reference_twist(problem, reference.motion), q)
     elif proof.verdict is PatternVerdict.NONE:
         assert reference.status in ("jammed", "unstable"), f"patterns: no motion; scip: {reference.message}"
     return proof.verdict
@@ -104,6 +122,12 @@ def test_pattern_proof_never_contradicts_scip_on_random_scenes(chunk: int) -> No
         verdicts.append(_proof_agrees_with_scip(random_scene(2, 1000 + seed, friction=friction)))
     decided = sum(v is not PatternVerdict.UNDECIDED for v in verdicts)
     assert decided >= 0.6 * len(verdicts), f"only {decided} of {len(verdicts)} decided"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("chunk", range(8, 28))
+def test_pattern_proof_never_contradicts_scip_on_random_scenes_sweep(chunk: int) -> None:
+    test_pattern_proof_never_contradicts_scip_on_random_scenes(chunk)
 
 
 @pytest.mark.parametrize("name", sorted(DEGENERATE))

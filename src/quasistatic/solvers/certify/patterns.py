@@ -27,10 +27,11 @@ contain those of every assignment below it, and a node is pruned when
   a Farkas vector ``y`` from a non-negative least-squares fit (``G^T y <= 0``,
   ``-g.y > 0``), checked here; it excludes every equilibrium whose residual is below
   ``LP_FEASIBILITY`` per row and whose total force is below :data:`FORCE_CEILING`;
-- ``Q`` is empty or lies, whole, within ``DISTINCT_TWIST / 2`` of the seed's
-  twist ``q*`` and its exact point within ``SAME_TWIST / 2`` of it (only decided
-  where the fixed rows leave one twist: a bound from their smallest singular
-  value, every row loosened by ``LP_FEASIBILITY``);
+- ``Q`` is empty (every row loosened by ``LP_FEASIBILITY``), or its exact points
+  lie within ``SAME_TWIST / 2`` of the seed's twist ``q*`` and every twist that
+  meets its rows to ``ZERO`` (as the seed is checked) within ``DISTINCT_TWIST / 2``
+  (decided where the closed rows leave one twist or a line: bounds from their
+  pseudo-inverse);
 - at a leaf whose rows leave a polyhedron of twists, HiGHS finds it empty
   (LP status), or all its extremes within ``SAME_TWIST / 2`` of ``q*``.
 
@@ -58,7 +59,7 @@ from scipy.optimize import nnls
 
 from ...laws import Problem
 from ...laws.polyhedral import LCPForm
-from ...tolerances import DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, MOTION_RANK, PATTERN_NODES, SAME_TWIST
+from ...tolerances import DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, MOTION_RANK, PATTERN_NODES, SAME_TWIST, ZERO
 from ..numerics.highs import WarmLP
 from .cheap import satisfies_form
 
@@ -308,11 +309,14 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     """The node's twists, loosened by ``LP_FEASIBILITY`` per row, bounded by the closed rows ``E q = e``.
 
     With ``E+`` the pseudo-inverse of the ``k`` rows and ``q0 = E+ e``, the part of ``q - q0`` in E's row space
-    is ``E+ (E q - e)`` (the residual ``E q0 - e`` is orthogonal to E's range), so each entry ``j`` of it is at
-    most ``LP_FEASIBILITY |E+_j|_1`` and its 2-norm at most ``R = sqrt(k) LP_FEASIBILITY / s`` (``s``: the
-    smallest singular value); no twist exists when the residual exceeds ``sqrt(k) LP_FEASIBILITY``. Rows of
-    full column rank pin the twists to one point; ``n - 1`` rows leave a line ``q0 + t d``, on which every
-    inequality row bounds ``t``.
+    is ``E+ (E q - e)`` (the residual ``E q0 - e`` is orthogonal to E's range), so its 2-norm is at most
+    ``R = sqrt(k) LP_FEASIBILITY / s`` (``s``: the smallest singular value), and no twist exists when the
+    residual exceeds ``sqrt(k) LP_FEASIBILITY``: emptiness and the modes left are decided with every row
+    loosened by the LPs' tolerance. Whether the twists are the seed's is decided for twists meeting the rows
+    to ``ZERO``, as the seed itself is checked (:func:`~.cheap.satisfies_form`): entry ``j`` then lies within
+    ``ZERO |E+_j|_1`` of the exact set (an ill-conditioned pair of contacts turns the LPs' 1e-7 into more than
+    the search's ``DISTINCT_TWIST``). Rows of full column rank pin the twists to one point; ``n - 1`` rows
+    leave a line ``q0 + t d``, on which every inequality row bounds ``t``.
     """
     E, e = rows.bank[node.equal], rows.rhs[node.equal]
     k, n = E.shape
@@ -326,7 +330,7 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     q0 = pseudo_inverse @ e
     if float(np.linalg.norm(E @ q0 - e)) > math.sqrt(k) * LP_FEASIBILITY:
         return _PRUNED
-    spread = LP_FEASIBILITY * np.abs(pseudo_inverse).sum(axis=1)
+    spread = ZERO * np.abs(pseudo_inverse).sum(axis=1)  # as far as a twist meeting the rows as the seed does may lie
     radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
     A, a = rows.bank[node.at_least], rows.rhs[node.at_least]
     reach = LP_FEASIBILITY * np.abs(A @ pseudo_inverse).sum(axis=1)
