@@ -111,7 +111,7 @@ class _Rows:
         return self.loads.shape[1] // 2
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class _Node:
     """Which bank rows hold as equalities and inequalities, which load columns may carry force, how deep."""
 
@@ -119,21 +119,25 @@ class _Node:
     at_least: np.ndarray
     columns: np.ndarray
     depth: int
+    closed_rows: int = 0  # how many entries of ``equal`` are set
 
     def child(self, rows: _Rows, contact: int, mode: int) -> _Node:
         m = rows.m
         equal, at_least, columns = self.equal.copy(), self.at_least.copy(), self.columns.copy()
         columns[2 * contact : 2 * contact + 2] &= _EDGES_OF[mode]
+        closed_rows = self.closed_rows
         if mode != _SEPARATING:
             at_least[contact], equal[contact] = False, True
+            closed_rows += 1
         if mode == _ROLLING:
             equal[m + contact] = True
+            closed_rows += 1
         elif mode != _SEPARATING:
             at_least[(2 if mode == _SLIDE_PLUS else 3) * m + contact] = True
-        return _Node(equal, at_least, columns, self.depth + 1)
+        return _Node(equal, at_least, columns, self.depth + 1, closed_rows)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class _Ball:
     """Every loosened twist of a node lies within ``radius`` (2-norm) of ``center``."""
 
@@ -290,7 +294,7 @@ def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndar
     return None if proven else lam
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class _Twists:
     """What a node's twists are known to be: ``pruned`` (empty, or the seed's); else within ``ball`` (2-norm,
     for filtering modes) when known, and ``point`` when the closed rows leave one twist (a leaf there is another
@@ -318,23 +322,25 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     the search's ``DISTINCT_TWIST``). Rows of full column rank pin the twists to one point; ``n - 1`` rows
     leave a line ``q0 + t d``, on which every inequality row bounds ``t``.
     """
-    E, e = rows.bank[node.equal], rows.rhs[node.equal]
-    k, n = E.shape
+    n = rows.g.size
+    k = node.closed_rows
     if k < n - 1 or k == 0:
         return _UNKNOWN
-    u, sigma, vt = np.linalg.svd(E, full_matrices=True)
+    E, e = rows.bank[node.equal], rows.rhs[node.equal]
+    u, sigma, vt = np.linalg.svd(E)
     if sigma[-1] <= MOTION_RANK or k > n and sigma[n - 1] <= MOTION_RANK:
         return _UNKNOWN
     r = min(k, n)
-    pseudo_inverse = vt[:r].T @ (u[:, :r].T / sigma[:r, None])
+    pseudo_inverse = (vt[:r].T / sigma[:r]) @ u[:, :r].T
     q0 = pseudo_inverse @ e
-    if float(np.linalg.norm(E @ q0 - e)) > math.sqrt(k) * LP_FEASIBILITY:
+    residual = E @ q0 - e
+    if residual @ residual > k * LP_FEASIBILITY**2:
         return _PRUNED
     spread = ZERO * np.abs(pseudo_inverse).sum(axis=1)  # as far as a twist meeting the rows as the seed does may lie
     radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
-    A, a = rows.bank[node.at_least], rows.rhs[node.at_least]
-    reach = LP_FEASIBILITY * np.abs(A @ pseudo_inverse).sum(axis=1)
-    reserve = A @ q0 + reach - (a - LP_FEASIBILITY)  # each row's best slack at t = 0
+    A = rows.bank[node.at_least]
+    # Each inequality row's best slack at q0 (t = 0 on a line), every row loosened by LP_FEASIBILITY.
+    reserve = A @ q0 + LP_FEASIBILITY * np.abs(A @ pseudo_inverse).sum(axis=1) - rows.rhs[node.at_least] + LP_FEASIBILITY
     if k < n:
         return _on_line(rows, q0, vt[-1], radius, spread, A @ vt[-1], reserve)
     if (reserve < 0.0).any():
@@ -369,7 +375,7 @@ def _near_seed(rows: _Rows, first: np.ndarray, second: np.ndarray, spread: np.nd
     if rows.seed is None:
         return False
     offset = np.maximum(np.abs(first - rows.seed), np.abs(second - rows.seed))
-    return float(np.max(offset)) <= 0.5 * SAME_TWIST and float(np.max(offset + spread)) <= 0.5 * DISTINCT_TWIST
+    return bool(offset.max() <= 0.5 * SAME_TWIST and (offset + spread).max() <= 0.5 * DISTINCT_TWIST)
 
 
 def _leaf_polyhedron_pruned(rows: _Rows, node: _Node) -> bool:
