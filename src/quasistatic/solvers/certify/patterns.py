@@ -12,7 +12,8 @@ conditions (with ``s = Jt q - bt`` the slip, ``wn = Jn q - bn`` the gap rate)::
 
 (a solution with ``cn = 0`` and ``wn = 0`` is in the first; one with ``lam = 0``
 in the second; ``lam > 0`` saturates friction on the edge that opposes the slip:
-the last two). So the LCP's solutions are the union, over the ``4^m`` mode
+the last two). A frictionless contact's three closed modes share their force
+(along the normal) and together allow any slip: one mode, ``wn = 0``. So the LCP's solutions are the union, over the ``4^m`` mode
 assignments, of polyhedra, and each of these is a product ``Q x F``: twists
 ``Q`` (kinematic rows only) times forces ``F`` (equilibrium with each contact's
 generators: both edges when rolling, one when sliding, none when separating).
@@ -68,7 +69,7 @@ __all__ = ["PatternVerdict", "PatternProof", "prove_by_patterns", "PATTERN_PROOF
 PATTERN_PROOF = "every contact-mode pattern excluded or holding the found twist alone (mode branch and bound, LPs and Farkas vectors)"
 NO_MOTION_PROOF = "no contact-mode pattern holds a motion (mode branch and bound, LPs and Farkas vectors)"
 
-_SEPARATING, _ROLLING, _SLIDE_PLUS, _SLIDE_MINUS = range(4)
+_SEPARATING, _ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _CLOSED = range(5)  # _CLOSED: a frictionless contact's three closed modes
 
 
 class PatternVerdict(Enum):
@@ -103,6 +104,7 @@ class _Rows:
     g: np.ndarray
     seed: np.ndarray | None  # the seed's twist
     form: LCPForm
+    frictionless: np.ndarray  # (m,) bool: mu = 0
     order: list[int]  # contacts in the order they are fixed
     proof: PatternProof = field(default_factory=lambda: PatternProof(PatternVerdict.UNDECIDED))
 
@@ -126,6 +128,9 @@ class _Node:
         equal, at_least, columns = self.equal.copy(), self.at_least.copy(), self.columns.copy()
         columns[2 * contact : 2 * contact + 2] &= _EDGES_OF[mode]
         closed_rows = self.closed_rows
+        if mode == _CLOSED:
+            at_least[contact], equal[contact] = False, True
+            return _Node(equal, at_least, columns, self.depth + 1, closed_rows + 1)
         if mode != _SEPARATING:
             at_least[contact], equal[contact] = False, True
             closed_rows += 1
@@ -150,8 +155,10 @@ _EDGES_OF = {  # which of a contact's two load columns each mode keeps
     _ROLLING: np.array([True, True]),
     _SLIDE_PLUS: np.array([True, False]),
     _SLIDE_MINUS: np.array([False, True]),
+    _CLOSED: np.array([True, False]),  # frictionless: both columns are the normal
 }
 _ALL_MODES = (_ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _SEPARATING)  # separating last: see _search
+_FRICTIONLESS_MODES = (_CLOSED, _SEPARATING)
 
 
 def prove_by_patterns(form: LCPForm, seed_x: np.ndarray | None) -> PatternProof:
@@ -165,7 +172,15 @@ def prove_by_patterns(form: LCPForm, seed_x: np.ndarray | None) -> PatternProof:
     bank = np.vstack([Jn, Jt, -Jt, Jt])
     seed = None if seed_x is None else seed_x[:n_q]
     rows = _Rows(
-        bank, np.concatenate([bn, bt, -bt, bt]), np.linalg.norm(bank, axis=1), loads, problem.g, seed, form, _order(problem, seed_x, n_q)
+        bank,
+        np.concatenate([bn, bt, -bt, bt]),
+        np.linalg.norm(bank, axis=1),
+        loads,
+        problem.g,
+        seed,
+        form,
+        problem.mu <= 0.0,
+        _order(problem, seed_x, n_q),
     )
     rows.proof.seed = seed_x
     m = problem.n_contacts
@@ -194,7 +209,7 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
     if node.depth == len(rows.order):
         return False  # a leaf that survived: another motion may exist
     contact = rows.order[node.depth]
-    slide_blocked = False  # a sliding sibling's Farkas vector also holds for separating, which keeps fewer columns
+    slide_blocked = False  # a closed sibling's Farkas vector also holds for separating, which keeps fewer columns
     for mode in _possible_modes(rows, contact, twists.ball):
         rows.proof.nodes += 1
         if rows.proof.nodes > PATTERN_NODES:
@@ -202,7 +217,7 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
         child = node.child(rows, contact, mode)
         child_fit = None if mode == _SEPARATING and slide_blocked else _forces(rows, child.columns, fit)
         if child_fit is None:
-            slide_blocked |= mode in (_SLIDE_PLUS, _SLIDE_MINUS)
+            slide_blocked |= mode in (_SLIDE_PLUS, _SLIDE_MINUS, _CLOSED)
             continue  # no equilibrium below this node
         child_twists = _child_twists(rows, child, mode, twists)
         if child_twists.pruned:
@@ -249,17 +264,20 @@ def _adopted(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> bool:
 
 
 def _possible_modes(rows: _Rows, contact: int, ball: _Ball | None) -> tuple[int, ...]:
-    """The modes whose twist rows some point of ``ball`` meets (loosened by ``LP_FEASIBILITY``); all four without one."""
+    """The modes whose twist rows some point of ``ball`` meets (loosened by ``LP_FEASIBILITY``); all of them without one."""
+    frictionless = bool(rows.frictionless[contact])
     if ball is None:
-        return _ALL_MODES
+        return _FRICTIONLESS_MODES if frictionless else _ALL_MODES
     m = rows.m
     normal, tangent = contact, m + contact
     wn = float(rows.bank[normal] @ ball.center - rows.rhs[normal])
-    slip = float(rows.bank[tangent] @ ball.center - rows.rhs[tangent])
     reach_n = float(rows.norms[normal]) * ball.radius + LP_FEASIBILITY
-    reach_t = float(rows.norms[tangent]) * ball.radius + LP_FEASIBILITY
     if abs(wn) > reach_n:
         return (_SEPARATING,)
+    if frictionless:
+        return _FRICTIONLESS_MODES
+    slip = float(rows.bank[tangent] @ ball.center - rows.rhs[tangent])
+    reach_t = float(rows.norms[tangent]) * ball.radius + LP_FEASIBILITY
     modes = []
     if abs(slip) <= reach_t:
         modes.append(_ROLLING)
