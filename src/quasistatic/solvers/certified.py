@@ -63,7 +63,6 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
             return summarise(form, [motion], True, options).with_notes(certificate=PATTERN_PROOF)
         if proof.verdict is PatternVerdict.NONE:
             return diagnose(problem, edges).with_notes(certificate=NO_MOTION_PROOF)
-        seed = proof.seed
     return certified_polyhedral(problem, edges, options, seed)
 
 

@@ -13,8 +13,9 @@ conditions (with ``s = Jt q - bt`` the slip, ``wn = Jn q - bn`` the gap rate)::
 (a solution with ``cn = 0`` and ``wn = 0`` is in the first; one with ``lam = 0``
 in the second; ``lam > 0`` saturates friction on the edge that opposes the slip:
 the last two). A frictionless contact's three closed modes share their force
-(along the normal) and together allow any slip: one mode, ``wn = 0``. So the LCP's solutions are the union, over the ``4^m`` mode
-assignments, of polyhedra, and each of these is a product ``Q x F``: twists
+(along the normal) and together allow any slip: one mode, ``wn = 0``. So the
+LCP's solutions are the union, over the ``4^m`` mode assignments, of
+polyhedra, and each of these is a product ``Q x F``: twists
 ``Q`` (kinematic rows only) times forces ``F`` (equilibrium with each contact's
 generators: both edges when rolling, one when sliding, none when separating).
 The twist and force conditions share no unknown once the modes are fixed.
@@ -257,6 +258,10 @@ def _adopted(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> bool:
     pairs = fit.reshape(m, 2)  # unit normal forces on edges +t, -t
     slip = rows.bank[m : 2 * m] @ q - rows.rhs[m : 2 * m]
     x = np.concatenate([q, pairs.sum(axis=1), (mu[:, None] * pairs).ravel(), np.abs(slip)])
+    # Round-off (a 1e-16 edge force, a rolling contact's 1e-16 slip) to exact zeros, as Lemke's pivots leave them:
+    # the search reads a point's pattern from which of each pair is nearer zero.
+    pairs_part = x[q.size :]  # a view: forces and slip speeds, all >= 0
+    pairs_part[pairs_part <= ZERO] = 0.0
     if not satisfies_form(rows.form, x):
         return False
     rows.seed, rows.proof.seed = q, x
