@@ -83,20 +83,6 @@ def _close(twist: np.ndarray, q: np.ndarray) -> bool:
     return bool(np.max(np.abs(q - twist)) <= TWIST_RTOL * max(1.0, float(np.max(np.abs(twist)))))
 
 
-def _only_this_twist(problem: qs.Problem, reference: qs.Solution, q: np.ndarray) -> bool:
-    """SCIP's "ambiguous" list holds the twist ``q`` alone, each motion and extreme within ``TWIST_RTOL`` of it.
-
-    Seen once in 840 random scenes (seed 1392): a squeeze whose twist is 150 times the scene's speed. SCIP's
-    own point of the motion is off by more than ``SAME_TWIST`` (absolute) from the exact vertex, so its
-    pattern is taken for a continuum whose only extreme is that vertex: the same motion listed twice.
-    """
-    units = np.tile(problem.scales.twist_units(problem.dimension), len(problem.scene.bodies))
-    twists = [_reference_twist(problem, motion) for motion in reference.solutions]
-    twists += [np.concatenate([e[b.name] for b in problem.scene.bodies]) / units for m in reference.solutions for e in m.extreme_twists]
-    bounded = not any(motion.unbounded for motion in reference.solutions)
-    return reference.status == "ambiguous" and bounded and all(_close(twist, q) for twist in twists)
-
-
 def _proof_agrees_with_scip(scene: qs.Scene) -> PatternVerdict:
     """The branch and bound's verdict, after checking it against the SCIP search on the same scene."""
     problem = qs.assemble(scene)
@@ -106,7 +92,7 @@ def _proof_agrees_with_scip(scene: qs.Scene) -> PatternVerdict:
     if proof.verdict is PatternVerdict.UNIQUE:
         assert proof.seed is not None
         q = proof.seed[: form.n_q]
-        assert reference.status == "solved" or _only_this_twist(problem, reference, q), f"patterns: unique; scip: {reference.message}"
+        assert reference.status == "solved", f"patterns: unique; scip: {reference.message}"
         assert reference.motion is not None
         assert _close(_reference_twist(problem, reference.motion), q)
     elif proof.verdict is PatternVerdict.NONE:
