@@ -29,6 +29,8 @@ __all__ = [
     "COMPLIANCE_RANK",
     "MOTION_RANK",
     "LP_FEASIBILITY",
+    "FORCE_CEILING",
+    "PATTERN_NODES",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
     "BASIS_FEASIBILITY",
@@ -123,6 +125,17 @@ MOTION_RANK = 1e-9
 
 LP_FEASIBILITY = 1e-7
 """What HiGHS and SCIP meet constraints to; a certificate or range checked with their output uses the same [-]."""
+
+FORCE_CEILING = 1e6
+"""Largest total scene-relative force a Farkas vector of the mode branch and bound must exclude [-]: its check
+``G^T y <= 0`` is met to round-off (1e-16 of the load) only, which rules out every equilibrium with forces below
+``LP_FEASIBILITY / round-off``; a million times the scene's force scale is past what SCIP itself resolves, whose
+equilibrium rows are met to ``LP_FEASIBILITY`` (at 1e6 that is a tenth of the load)."""
+
+PATTERN_NODES = 512
+"""Most nodes of the planar mode branch and bound (:mod:`quasistatic.solvers.certify.patterns`) before it gives
+the proof to the SCIP search [-]: measured, the benchmark's 2-D grasps of 2-8 contacts need 6-300 and random
+scenes at most 92; a node costs ~55 us, so the budget wastes at most ~30 ms before SCIP."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""

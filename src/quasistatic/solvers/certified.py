@@ -7,13 +7,22 @@
    On exact 3-D cones, rest with every mover still is proven the only motion
    on the circles themselves when it is (:mod:`.certify.rest`: the load cannot
    do work, so loaded contacts stick, and LPs or else SCIP find no other such motion).
-3. Otherwise the complete SCIP search of ``scip`` runs. For polyhedral cones
+3. Planar problems: a branch and bound over each contact's mode (separating,
+   rolling, sliding either way), whose nodes are pruned by checked Farkas
+   vectors (no forces balance the load), singular-value bounds on the twists
+   the closed contacts leave, and LP statuses (:mod:`.certify.patterns`), proves
+   that every motion has Lemke's twist (``solved``), or, without a Lemke point,
+   that no motion exists (then ``jammed``/``unstable`` as the search would say,
+   :func:`~.certify.diagnose.diagnose`). It needs no SCIP; where a pattern may
+   hold another motion, or past its node budget, it proves nothing and step 4
+   runs.
+4. Otherwise the complete SCIP search of ``scip`` runs. For polyhedral cones
    it starts from Lemke's point once every law of the search's own form is
    checked there, so SCIP only has to prove that no other motion exists
    (measured 10-20 % faster on 2-D grasps). The 8-edge pyramid search of exact
    3-D cones is not seeded: measured, its proof then took 1.4x longer.
 
-Everything not proven by step 2 is decided by the same search as ``scip``, so
+Everything not proven by steps 2-3 is decided by the same search as ``scip``, so
 the answers are the same; prescribed modes go straight to it.
 """
 
@@ -22,7 +31,9 @@ from __future__ import annotations
 from ..laws import Problem, RawMotion
 from ..laws.polyhedral import aligned_edges, polyhedral_form
 from .certify.cheap import exact_motion, kinematically_unique, seed_point
+from .certify.diagnose import diagnose
 from .certify.exact_cone import solve_exact_3d, unique_exact_motion
+from .certify.patterns import NO_MOTION_PROOF, PATTERN_PROOF, PatternVerdict, prove_by_patterns
 from .certify.rest import rest_proof
 from .certify.search import certified_polyhedral, summarise
 from .result import BackendResult, Options
@@ -45,6 +56,13 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
     if seed is not None and kinematically_unique(problem, seed[: form.n_q]):
         motion = RawMotion(seed[: form.n_q], form.forces(seed))
         return summarise(form, [motion], True, options).with_notes(certificate=_KINEMATIC)
+    if problem.dimension == 2:
+        proof = prove_by_patterns(form, seed)
+        if proof.verdict is PatternVerdict.UNIQUE and proof.seed is not None:
+            motion = RawMotion(proof.seed[: form.n_q], form.forces(proof.seed))
+            return summarise(form, [motion], True, options).with_notes(certificate=PATTERN_PROOF)
+        if proof.verdict is PatternVerdict.NONE:
+            return diagnose(problem, edges).with_notes(certificate=NO_MOTION_PROOF)
     return certified_polyhedral(problem, edges, options, seed)
 
 

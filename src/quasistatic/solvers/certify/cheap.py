@@ -48,7 +48,7 @@ from ...tolerances import (
 from ..numerics.lcp import PIVOTS_PER_ROW, LemkeInputs, lemke_motion, split_lcp_point
 from ..numerics.lemke import SOLUTION
 
-__all__ = ["seed_point", "exact_motion", "kinematically_unique", "kinematic_radius"]
+__all__ = ["seed_point", "satisfies_form", "exact_motion", "kinematically_unique", "kinematic_radius"]
 
 
 def seed_point(form: LCPForm) -> np.ndarray | None:
@@ -65,7 +65,7 @@ def seed_point(form: LCPForm) -> np.ndarray | None:
     if status != SOLUTION:
         return None
     x = _form_point(form, z, data.frictional)
-    return x if _satisfies(form, x) else None
+    return x if satisfies_form(form, x) else None
 
 
 def exact_motion(problem: Problem) -> RawMotion | None:
@@ -93,7 +93,7 @@ def _form_point(form: LCPForm, z: np.ndarray, frictional: np.ndarray) -> np.ndar
     return np.r_[q, z[2 * n : 2 * n + m], beta.ravel(), lam]
 
 
-def _satisfies(form: LCPForm, x: np.ndarray) -> bool:
+def satisfies_form(form: LCPForm, x: np.ndarray) -> bool:
     """Equilibrium, signs and complementarity of ``x`` hold to ``ZERO`` (scene-relative)."""
     w = form.W @ x - form.r
     pairs = x[form.pair_cols]

@@ -227,10 +227,12 @@ def _pattern_motion(form: LCPForm, x: np.ndarray, z: np.ndarray, options: Option
     lower = np.r_[np.full(form.n_q, -np.inf), np.zeros(N - form.n_q)]
     extremes, free = twist_extremes(form.n_q, A_eq, b_eq, A_in, b_in, lower)
     unbounded = bool(free)
-    q = x[: form.n_q]
-    continuum = unbounded or any(np.max(np.abs(e - q)) > SAME_TWIST for e in extremes)
+    # One extreme (the 2n LPs' optima within SAME_TWIST of each other) is one twist, that vertex: SCIP's own point
+    # meets the rows to its tolerance only, and where the twist is large (150 x the scene's speed) it was more
+    # than SAME_TWIST off it, so a single motion was listed twice, once as a "continuum" of that one extreme.
+    continuum = unbounded or len(extremes) > 1
     if not continuum:
-        return RawMotion(q, form.forces(x), (), False)
+        return RawMotion(extremes[0] if extremes else x[: form.n_q], form.forces(x), (), False)
     # Represent a continuum by a point inside it, so its modes are those of its interior:
     # every inequality as slack as it can be, the pairs' own variables (slip speeds) included.
     free_pairs = np.eye(N)[cols[z == 0]]

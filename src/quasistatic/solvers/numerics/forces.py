@@ -25,7 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...laws import ModeMasks, Problem, slips
-from ...laws.polyhedral import ForcePolytope, aligned_edges, force_polytope
+from ...laws.polyhedral import ForcePolytope, aligned_edges, dense_force_matrix, force_polytope
 from ...tolerances import FORCE_RANK, LP_FEASIBILITY, ZERO
 from ..result import Range
 from .highs import solve_lp
@@ -151,14 +151,7 @@ def forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: M
     frictionless contact has no edge force.
     """
     polytope = force_polytope(problem, edges)
-    K = polytope.K
-    drive = -np.einsum("mkt,mt->mk", edges, slips(problem, q))  # dissipation rate per unit edge force
-    best = drive.max(axis=1, initial=0.0)  # no edges (frictionless): nothing dissipates
-    fixed = np.zeros(polytope.A.shape[1], dtype=bool)
-    fixed[polytope.normal] = ~masks.closed
-    weaker = drive < best[:, None] - _MOVING
-    fixed[polytope.beta] = (weaker & masks.sliding[:, None]).ravel() | np.repeat(problem.mu <= 0, K)
-    fixed[polytope.slack] = masks.sliding
+    fixed = _held_columns(problem, edges, q, masks)
     # One unit row per fixed column, sparse: an identity as wide as all the columns would grow as their square.
     held = np.flatnonzero(fixed)
     # One build from index arrays (sparse vstack of small matrices costs more than the rest of this function).
@@ -169,6 +162,17 @@ def forces_at_twist(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: M
     )
     rhs = np.r_[polytope.rhs, np.zeros(int(fixed.sum()))]
     return ForcesAtTwist(polytope, edges, A, rhs, fixed)
+
+
+def _held_columns(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: ModeMasks) -> np.ndarray:
+    """Which columns of the force polytope (normal, edge, slack) the modes hold at zero (see :func:`forces_at_twist`)."""
+    m, K = edges.shape[:2]
+    drive = -np.einsum("mkt,mt->mk", edges, slips(problem, q))  # dissipation rate per unit edge force
+    best = drive.max(axis=1, initial=0.0)  # no edges (frictionless): nothing dissipates
+    weaker = drive < best[:, None] - _MOVING
+    normal = ~masks.closed
+    beta = (weaker & masks.sliding[:, None]).ravel() | np.repeat(problem.mu <= 0, K)
+    return np.concatenate([normal, beta, masks.sliding])  # the polytope's column order: normal, beta, slack
 
 
 def measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeMasks:
@@ -211,17 +215,17 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     cannot decide, they are worked out now and decide.
     """
     masks = measured_masks(problem, edges, q)
+    m, K = edges.shape[:2]
+    normal = np.arange(m)  # the polytope's first columns
+    if min(problem.n_dof + m, m * (K + 2)) <= DENSE_MAX and _forces_fixed(problem, edges, q, masks, normal):
+        return None  # decided densely, before any sparse matrix is built (~0.5 ms on a grasp)
     forces = forces_at_twist(problem, edges, q, masks)
-    normal = np.arange(forces.fixed.size)[forces.polytope.normal]
     work = partial(_normal_ranges, forces, normal)
     if _wide_through_balanced_point(problem, masks, forces.polytope.K):
         return IndeterminateForces(None, work, forces)
-    # A small set is read densely once: each sparse conversion of a grasp's matrix costs ~0.1 ms.
     A = forces.A.toarray() if min(forces.A.shape) <= DENSE_MAX else forces.A.tocsc()
-    if full_column_rank(A[:, ~forces.fixed], FORCE_RANK):
+    if not isinstance(A, np.ndarray) and _fixed_by_equations(A, forces.fixed, normal):
         return None
-    if np.all(in_row_space(A, normal)):
-        return None  # each normal force is fixed by the equations (the ranges' LPs would find it constant)
     vary = _normal_forces_vary(A, forces, normal) if isinstance(A, np.ndarray) else None
     if vary is not None:
         return IndeterminateForces(None, work, forces) if vary else None
@@ -303,6 +307,20 @@ def _per_contact(problem: Problem, contacts: np.ndarray, x: np.ndarray) -> tuple
             tangent[k], at = x[at : at + d - 1], at + d - 1
         normal[k], at = x[at], at + 1
     return tangent, normal
+
+
+def _forces_fixed(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: ModeMasks, normal: np.ndarray) -> bool:
+    """:func:`_fixed_by_equations` on the dense matrix of :func:`forces_at_twist` (the same rows, built densely)."""
+    fixed = _held_columns(problem, edges, q, masks)
+    A = np.vstack([dense_force_matrix(problem, edges), np.eye(fixed.size)[fixed]])
+    return _fixed_by_equations(A, fixed, normal)
+
+
+def _fixed_by_equations(A: np.ndarray | sp.spmatrix, fixed: np.ndarray, normal: np.ndarray) -> bool:
+    """Free columns of full rank (one force distribution), or every normal force a combination of the equations
+    (only the edge intensities vary, as both edges of a 2-D contact that sticks: the ranges' LPs would find each
+    normal force constant)."""
+    return full_column_rank(A[:, ~fixed], FORCE_RANK) or bool(np.all(in_row_space(A, normal)))
 
 
 def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ...]:

@@ -193,9 +193,11 @@ def in_row_space(A: np.ndarray | sp.spmatrix, columns: np.ndarray) -> np.ndarray
     dense = _dense(A)
     _, sigma, vt = np.linalg.svd(dense, full_matrices=False)
     basis = vt[sigma > FORCE_RANK * max(1.0, float(sigma[0]))]
-    # |e_j - P e_j|^2 = 1 - |P e_j|^2 with P the projector on the row space.
-    outside = 1.0 - np.sum(basis[:, columns] ** 2, axis=0)
-    return np.sqrt(np.maximum(outside, 0.0)) <= MOTION_RANK
+    # |e_j - P e_j| with P the projector on the row space, formed directly: as 1 - |P e_j|^2 its round-off
+    # (1e-16) would reach 1e-8 under the square root, above the threshold, and no column would ever be in it.
+    outside = -basis.T @ basis[:, columns]
+    outside[columns, np.arange(columns.size)] += 1.0
+    return np.linalg.norm(outside, axis=0) <= MOTION_RANK
 
 
 def ranges_are_wide(ranges: list[Range], tol: float = LP_FEASIBILITY) -> bool:

@@ -1,0 +1,419 @@
+"""A complete certificate for small planar problems without SCIP: branch and bound over contact modes.
+
+**What it proves.** Every solution of the planar polyhedral laws (the LCP of
+:func:`~quasistatic.laws.polyhedral.polyhedral_form`, two edges per contact)
+has, at each contact, one of four modes, and each mode is a set of *linear*
+conditions (with ``s = Jt q - bt`` the slip, ``wn = Jn q - bn`` the gap rate)::
+
+    separating  cn = 0 (so beta = 0)          twist: wn >= 0
+    rolling     force in the friction cone     twist: wn = 0, s = 0
+    sliding +   force on the edge n + mu t     twist: wn = 0, s <= 0
+    sliding -   force on the edge n - mu t     twist: wn = 0, s >= 0
+
+(a solution with ``cn = 0`` and ``wn = 0`` is in the first; one with ``lam = 0``
+in the second; ``lam > 0`` saturates friction on the edge that opposes the slip:
+the last two). A frictionless contact's three closed modes share their force
+(along the normal) and together allow any slip: one mode, ``wn = 0``. So the
+LCP's solutions are the union, over the ``4^m`` mode assignments, of
+polyhedra, and each of these is a product ``Q x F``: twists
+``Q`` (kinematic rows only) times forces ``F`` (equilibrium with each contact's
+generators: both edges when rolling, one when sliding, none when separating).
+The twist and force conditions share no unknown once the modes are fixed.
+
+A depth-first search fixes one contact's mode per level. At a node, the
+contacts not yet fixed keep only what all their modes share: ``wn >= 0`` on the
+twist and the whole cone on the force. The node's ``Q`` and ``F`` therefore
+contain those of every assignment below it, and a node is pruned when
+
+- ``F`` is empty: no forces on the allowed generators balance the load. The proof is
+  a Farkas vector ``y`` from a non-negative least-squares fit (``G^T y <= 0``,
+  ``-g.y > 0``), checked here; it excludes every equilibrium whose residual is below
+  ``LP_FEASIBILITY`` per row and whose total force is below :data:`FORCE_CEILING`;
+- ``Q`` is empty (every row loosened by ``LP_FEASIBILITY``), or its exact points
+  lie within ``SAME_TWIST / 2`` of the seed's twist ``q*`` and every twist that
+  meets its rows to ``ZERO`` (as the seed is checked) within ``DISTINCT_TWIST / 2``
+  (decided where the closed rows leave one twist or a line: bounds from their
+  pseudo-inverse);
+- at a leaf whose rows leave a polyhedron of twists, HiGHS finds it empty
+  (LP status), or all its extremes within ``SAME_TWIST / 2`` of ``q*``.
+
+Without a seed, the first surviving leaf whose twist and forces satisfy every law
+of the form (checked as Lemke's point is, :func:`~.cheap.satisfies_form`) becomes
+the seed, and the search goes on: nodes pruned before did not depend on it.
+
+If every node is pruned the search is complete: every motion's twist is ``q*``
+(to ``SAME_TWIST`` exactly, to ``DISTINCT_TWIST / 2`` within the tolerance,
+which is the box the SCIP search excludes around a found motion), and no mode
+assignment holds a continuum. Without a seed, a closed tree proves that no
+motion exists. A surviving leaf (another motion, or a case too close to call)
+or more than :data:`PATTERN_NODES` nodes gives no answer: the caller runs the
+SCIP search instead, unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+from scipy.optimize import nnls
+
+from ...laws import Problem
+from ...laws.polyhedral import LCPForm
+from ...tolerances import DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, MOTION_RANK, PATTERN_NODES, SAME_TWIST, ZERO
+from ..numerics.highs import WarmLP
+from .cheap import satisfies_form
+
+__all__ = ["PatternVerdict", "PatternProof", "prove_by_patterns", "PATTERN_PROOF", "NO_MOTION_PROOF"]
+
+PATTERN_PROOF = "every contact-mode pattern excluded or holding the found twist alone (mode branch and bound, LPs and Farkas vectors)"
+NO_MOTION_PROOF = "no contact-mode pattern holds a motion (mode branch and bound, LPs and Farkas vectors)"
+
+_SEPARATING, _ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _CLOSED = range(5)  # _CLOSED: a frictionless contact's three closed modes
+
+
+class PatternVerdict(Enum):
+    UNIQUE = "unique"  # every motion is the seed's twist
+    NONE = "none"  # no motion at all (no seed given)
+    UNDECIDED = "undecided"  # another motion may exist, or the budget ran out: run the SCIP search
+
+
+@dataclass
+class PatternProof:
+    """The verdict, the seed it holds for (a point ``[q, cn, beta, lam]`` of the form), and the work done."""
+
+    verdict: PatternVerdict
+    seed: np.ndarray | None = None
+    nodes: int = 0
+    lps: int = 0
+
+
+@dataclass
+class _Rows:
+    """A planar problem's rows, scene-relative, and the search's counters.
+
+    ``bank`` (4 m, n) holds every twist row a mode can use, ``bank q >= or = rhs``: contact ``i``'s normal row
+    (``i``), tangent row (``m + i``, rolling), and the slip signs of sliding + (``2 m + i``: ``-s >= 0``) and
+    sliding - (``3 m + i``: ``s >= 0``). ``loads`` (n, 2 m): a unit normal force on each contact's edge +t, -t.
+    """
+
+    bank: np.ndarray
+    rhs: np.ndarray
+    norms: np.ndarray  # 2-norm of each bank row
+    loads: np.ndarray
+    g: np.ndarray
+    seed: np.ndarray | None  # the seed's twist
+    form: LCPForm
+    frictionless: np.ndarray  # (m,) bool: mu = 0
+    order: list[int]  # contacts in the order they are fixed
+    proof: PatternProof = field(default_factory=lambda: PatternProof(PatternVerdict.UNDECIDED))
+
+    @property
+    def m(self) -> int:
+        return self.loads.shape[1] // 2
+
+
+@dataclass(frozen=True, slots=True)
+class _Node:
+    """Which bank rows hold as equalities and inequalities, which load columns may carry force, how deep."""
+
+    equal: np.ndarray
+    at_least: np.ndarray
+    columns: np.ndarray
+    depth: int
+    closed_rows: int = 0  # how many entries of ``equal`` are set
+
+    def child(self, rows: _Rows, contact: int, mode: int) -> _Node:
+        m = rows.m
+        equal, at_least, columns = self.equal.copy(), self.at_least.copy(), self.columns.copy()
+        columns[2 * contact : 2 * contact + 2] &= _EDGES_OF[mode]
+        closed_rows = self.closed_rows
+        if mode == _CLOSED:
+            at_least[contact], equal[contact] = False, True
+            return _Node(equal, at_least, columns, self.depth + 1, closed_rows + 1)
+        if mode != _SEPARATING:
+            at_least[contact], equal[contact] = False, True
+            closed_rows += 1
+        if mode == _ROLLING:
+            equal[m + contact] = True
+            closed_rows += 1
+        elif mode != _SEPARATING:
+            at_least[(2 if mode == _SLIDE_PLUS else 3) * m + contact] = True
+        return _Node(equal, at_least, columns, self.depth + 1, closed_rows)
+
+
+@dataclass(frozen=True, slots=True)
+class _Ball:
+    """Every loosened twist of a node lies within ``radius`` (2-norm) of ``center``."""
+
+    center: np.ndarray
+    radius: float
+
+
+_EDGES_OF = {  # which of a contact's two load columns each mode keeps
+    _SEPARATING: np.array([False, False]),
+    _ROLLING: np.array([True, True]),
+    _SLIDE_PLUS: np.array([True, False]),
+    _SLIDE_MINUS: np.array([False, True]),
+    _CLOSED: np.array([True, False]),  # frictionless: both columns are the normal
+}
+_ALL_MODES = (_ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _SEPARATING)  # separating last: see _search
+_FRICTIONLESS_MODES = (_CLOSED, _SEPARATING)
+
+
+def prove_by_patterns(form: LCPForm, seed_x: np.ndarray | None) -> PatternProof:
+    """Whether every motion of the planar polyhedral laws ``form`` (two edges per contact) has the twist of
+    ``seed_x`` (a point ``[q, cn, beta, lam]`` of it), or of a seed found on the way, or, without one, whether
+    no motion exists; see the module docstring."""
+    problem, n_q = form.problem, form.n_q
+    Jn, Jt, bn, bt = problem.Jn, problem.Jt[:, 0, :], problem.bn, problem.bt[:, 0]
+    mu = problem.mu[:, None]
+    loads = np.stack([Jn + mu * Jt, Jn - mu * Jt], axis=1).reshape(-1, problem.n_dof).T
+    bank = np.vstack([Jn, Jt, -Jt, Jt])
+    seed = None if seed_x is None else seed_x[:n_q]
+    rows = _Rows(
+        bank,
+        np.concatenate([bn, bt, -bt, bt]),
+        np.linalg.norm(bank, axis=1),
+        loads,
+        problem.g,
+        seed,
+        form,
+        problem.mu <= 0.0,
+        _order(problem, seed_x, n_q),
+    )
+    rows.proof.seed = seed_x
+    m = problem.n_contacts
+    root = _Node(np.zeros(4 * m, dtype=bool), np.arange(4 * m) < m, np.ones(2 * m, dtype=bool), 0)
+    fit = _forces(rows, root.columns, None)
+    closed = fit is None or _search(rows, root, fit, _UNKNOWN)
+    found = rows.proof.seed is not None
+    rows.proof.verdict = (PatternVerdict.UNIQUE if found else PatternVerdict.NONE) if closed else PatternVerdict.UNDECIDED
+    return rows.proof
+
+
+def _order(problem: Problem, seed_x: np.ndarray | None, n_q: int) -> list[int]:
+    """The seed's loaded contacts first, most loaded first: their modes pin the twist to the seed's soonest."""
+    m = problem.n_contacts
+    if seed_x is None:
+        return list(range(m))
+    return [int(i) for i in np.argsort(-seed_x[n_q : n_q + m], kind="stable")]
+
+
+def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
+    """True when every mode assignment below ``node`` is pruned.
+
+    ``fit``: forces on the node's columns with ``|G fit + g|`` within the margin; ``twists``: what the node's
+    twists are known to be.
+    """
+    if node.depth == len(rows.order):
+        return False  # a leaf that survived: another motion may exist
+    contact = rows.order[node.depth]
+    slide_blocked = False  # a closed sibling's Farkas vector also holds for separating, which keeps fewer columns
+    for mode in _possible_modes(rows, contact, twists.ball):
+        rows.proof.nodes += 1
+        if rows.proof.nodes > PATTERN_NODES:
+            return False
+        child = node.child(rows, contact, mode)
+        child_fit = None if mode == _SEPARATING and slide_blocked else _forces(rows, child.columns, fit)
+        if child_fit is None:
+            slide_blocked |= mode in (_SLIDE_PLUS, _SLIDE_MINUS, _CLOSED)
+            continue  # no equilibrium below this node
+        child_twists = _child_twists(rows, child, mode, twists)
+        if child_twists.pruned:
+            continue
+        if child.depth == len(rows.order):
+            if child_twists is twists:  # every row counted: a tighter ball, perhaps the seed's
+                child_twists = _twist(rows, child)
+                if child_twists.pruned:
+                    continue
+            if child_twists.point and child_twists.ball is not None and _adopted(rows, child_twists.ball.center, child_fit):
+                continue
+            if child_twists.point or not _leaf_polyhedron_pruned(rows, child):
+                return False  # another motion, or too close to call
+            continue
+        if not _search(rows, child, child_fit, child_twists):
+            return False
+    return True
+
+
+def _child_twists(rows: _Rows, child: _Node, mode: int, parent: _Twists) -> _Twists:
+    """The child's twists: the parent's when its rows are the same (a separating contact, as a free one) or
+    already pin one twist (the child's lie in the same ball, and its modes were filtered against it)."""
+    if not (mode == _SEPARATING or parent.point):
+        return _twist(rows, child)
+    ball, spread = parent.ball, parent.spread
+    if parent.point and ball is not None and spread is not None and _near_seed(rows, ball.center, ball.center, spread):
+        return _PRUNED  # a seed adopted since the parent was seen
+    return parent
+
+
+def _adopted(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> bool:
+    """Without a seed: the leaf's twist ``q`` and forces ``fit`` as the seed, when they satisfy every law of the form."""
+    if rows.seed is not None:
+        return False
+    m = rows.m
+    mu = rows.form.problem.mu
+    pairs = fit.reshape(m, 2)  # unit normal forces on edges +t, -t
+    slip = rows.bank[m : 2 * m] @ q - rows.rhs[m : 2 * m]
+    x = np.concatenate([q, pairs.sum(axis=1), (mu[:, None] * pairs).ravel(), np.abs(slip)])
+    # Round-off (a 1e-16 edge force, a rolling contact's 1e-16 slip) to exact zeros, as Lemke's pivots leave them:
+    # the search reads a point's pattern from which of each pair is nearer zero.
+    pairs_part = x[q.size :]  # a view: forces and slip speeds, all >= 0
+    pairs_part[pairs_part <= ZERO] = 0.0
+    if not satisfies_form(rows.form, x):
+        return False
+    rows.seed, rows.proof.seed = q, x
+    return True
+
+
+def _possible_modes(rows: _Rows, contact: int, ball: _Ball | None) -> tuple[int, ...]:
+    """The modes whose twist rows some point of ``ball`` meets (loosened by ``LP_FEASIBILITY``); all of them without one."""
+    frictionless = bool(rows.frictionless[contact])
+    if ball is None:
+        return _FRICTIONLESS_MODES if frictionless else _ALL_MODES
+    m = rows.m
+    normal, tangent = contact, m + contact
+    wn = float(rows.bank[normal] @ ball.center - rows.rhs[normal])
+    reach_n = float(rows.norms[normal]) * ball.radius + LP_FEASIBILITY
+    if abs(wn) > reach_n:
+        return (_SEPARATING,)
+    if frictionless:
+        return _FRICTIONLESS_MODES
+    slip = float(rows.bank[tangent] @ ball.center - rows.rhs[tangent])
+    reach_t = float(rows.norms[tangent]) * ball.radius + LP_FEASIBILITY
+    modes = []
+    if abs(slip) <= reach_t:
+        modes.append(_ROLLING)
+    if slip <= reach_t:
+        modes.append(_SLIDE_PLUS)
+    if slip >= -reach_t:
+        modes.append(_SLIDE_MINUS)
+    return (*modes, _SEPARATING)
+
+
+def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndarray | None:
+    """Non-negative forces on ``columns`` balancing the load within the margin, or None with a checked Farkas vector:
+    then no forces on them (sum below FORCE_CEILING) leave ``|G lam + g|`` below ``LP_FEASIBILITY`` per row.
+
+    ``fit``: the parent's forces; kept when they use none of the columns taken away.
+    """
+    margin = math.sqrt(rows.g.size) * LP_FEASIBILITY
+    if fit is not None and not fit[~columns].any():
+        return fit
+    G = rows.loads[:, columns]
+    lam = np.zeros(columns.size)
+    if G.shape[1]:
+        lam[columns], residual = nnls(G, -rows.g)
+    else:
+        residual = float(np.linalg.norm(rows.g))
+    if residual <= margin:
+        return lam
+    y = -(rows.loads @ lam + rows.g)
+    # For lam >= 0: y.(G lam + g) <= max(G^T y) sum(lam) + g.y, while |G lam + g| <= margin needs it >= -margin |y|.
+    worst = max(float(np.max(G.T @ y, initial=0.0)), 0.0) * FORCE_CEILING
+    proven = -float(rows.g @ y) - worst > margin * float(np.linalg.norm(y))
+    return None if proven else lam
+
+
+@dataclass(frozen=True, slots=True)
+class _Twists:
+    """What a node's twists are known to be: ``pruned`` (empty, or the seed's); else within ``ball`` (2-norm,
+    for filtering modes) when known, and ``point`` when the closed rows leave one twist (a leaf there is another
+    motion)."""
+
+    pruned: bool
+    ball: _Ball | None = None
+    point: bool = False
+    spread: np.ndarray | None = None  # of a point: how far, per entry, a loosened twist may lie from it
+
+
+_PRUNED, _UNKNOWN = _Twists(True), _Twists(False)
+
+
+def _twist(rows: _Rows, node: _Node) -> _Twists:
+    """The node's twists, loosened by ``LP_FEASIBILITY`` per row, bounded by the closed rows ``E q = e``.
+
+    With ``E+`` the pseudo-inverse of the ``k`` rows and ``q0 = E+ e``, the part of ``q - q0`` in E's row space
+    is ``E+ (E q - e)`` (the residual ``E q0 - e`` is orthogonal to E's range), so its 2-norm is at most
+    ``R = sqrt(k) LP_FEASIBILITY / s`` (``s``: the smallest singular value), and no twist exists when the
+    residual exceeds ``sqrt(k) LP_FEASIBILITY``: emptiness and the modes left are decided with every row
+    loosened by the LPs' tolerance. Whether the twists are the seed's is decided for twists meeting the rows
+    to ``ZERO``, as the seed itself is checked (:func:`~.cheap.satisfies_form`): entry ``j`` then lies within
+    ``ZERO |E+_j|_1`` of the exact set (an ill-conditioned pair of contacts turns the LPs' 1e-7 into more than
+    the search's ``DISTINCT_TWIST``). Rows of full column rank pin the twists to one point; ``n - 1`` rows
+    leave a line ``q0 + t d``, on which every inequality row bounds ``t``.
+    """
+    n = rows.g.size
+    k = node.closed_rows
+    if k < n - 1 or k == 0:
+        return _UNKNOWN
+    E, e = rows.bank[node.equal], rows.rhs[node.equal]
+    u, sigma, vt = np.linalg.svd(E)
+    if sigma[-1] <= MOTION_RANK or k > n and sigma[n - 1] <= MOTION_RANK:
+        return _UNKNOWN
+    r = min(k, n)
+    pseudo_inverse = (vt[:r].T / sigma[:r]) @ u[:, :r].T
+    q0 = pseudo_inverse @ e
+    residual = E @ q0 - e
+    if residual @ residual > k * LP_FEASIBILITY**2:
+        return _PRUNED
+    spread = ZERO * np.abs(pseudo_inverse).sum(axis=1)  # as far as a twist meeting the rows as the seed does may lie
+    radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
+    A = rows.bank[node.at_least]
+    # Each inequality row's best slack at q0 (t = 0 on a line), every row loosened by LP_FEASIBILITY.
+    reserve = A @ q0 + LP_FEASIBILITY * np.abs(A @ pseudo_inverse).sum(axis=1) - rows.rhs[node.at_least] + LP_FEASIBILITY
+    if k < n:
+        return _on_line(rows, q0, vt[-1], radius, spread, A @ vt[-1], reserve)
+    if (reserve < 0.0).any():
+        return _PRUNED  # an open gap or slip sign fails on the whole set
+    if _near_seed(rows, q0, q0, spread):
+        return _PRUNED
+    return _Twists(False, _Ball(q0, radius), point=True, spread=spread)
+
+
+def _on_line(
+    rows: _Rows, q0: np.ndarray, d: np.ndarray, radius: float, spread: np.ndarray, slope: np.ndarray, reserve: np.ndarray
+) -> _Twists:
+    """Twists ``q0 + t d`` (within ``spread`` per entry) with ``slope t + reserve >= 0`` for every inequality row."""
+    if (reserve[slope == 0.0] < 0.0).any():
+        return _PRUNED
+    rising, falling = slope > 0.0, slope < 0.0
+    low = float(np.max(-reserve[rising] / slope[rising], initial=-np.inf))
+    high = float(np.min(-reserve[falling] / slope[falling], initial=np.inf))
+    if low > high:
+        return _PRUNED
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return _UNKNOWN
+    ends = q0 + low * d, q0 + high * d
+    if _near_seed(rows, *ends, spread):
+        return _PRUNED
+    return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + radius))
+
+
+def _near_seed(rows: _Rows, first: np.ndarray, second: np.ndarray, spread: np.ndarray) -> bool:
+    """Whether the segment ``first``-``second`` lies within ``SAME_TWIST / 2`` of the seed, and within
+    ``DISTINCT_TWIST / 2`` with ``spread`` added to each entry."""
+    if rows.seed is None:
+        return False
+    offset = np.maximum(np.abs(first - rows.seed), np.abs(second - rows.seed))
+    return bool(offset.max() <= 0.5 * SAME_TWIST and (offset + spread).max() <= 0.5 * DISTINCT_TWIST)
+
+
+def _leaf_polyhedron_pruned(rows: _Rows, node: _Node) -> bool:
+    """A leaf whose rows leave a polyhedron of twists: pruned when HiGHS finds it empty, or every extreme
+    within ``SAME_TWIST / 2`` of the seed (2 n LPs on one warm model)."""
+    E, e = rows.bank[node.equal], rows.rhs[node.equal]
+    A, a = rows.bank[node.at_least], rows.rhs[node.at_least]
+    n = rows.g.size
+    model = WarmLP(np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
+    for j in range(n):
+        for maximize in (False, True):
+            rows.proof.lps += 1
+            lp = model.optimise(np.eye(1, n, j)[0], maximize)
+            if lp.status == "infeasible":
+                return True
+            if lp.status != "optimal" or rows.seed is None or abs(lp.x[j] - rows.seed[j]) > 0.5 * SAME_TWIST:
+                return False
+    return True
