@@ -26,7 +26,6 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.status import Status
 
-from .adapters import Detection, World
 from .errors import QuasistaticError, SolverError
 from .loading import load_scene, load_world
 from .model import Scene
@@ -35,6 +34,7 @@ from .report import make_console, render_contacts, render_solution, render_traje
 from .solution import Mode, Solution
 
 if TYPE_CHECKING:
+    from .adapters import Detection, World
     from .sim import Trajectory
     from .solvers import SearchProgress
     from .sweeps import SweepResult
@@ -446,7 +446,7 @@ def _run_world(trajectory_file: Path, trajectory: Trajectory, scene: Path | None
             _fail(f"{str(trajectory_file)!r} names no scene file (it was run on a World built in Python): give --scene")
         return _guarded(trajectory.scene_world)
     loaded = _guarded(lambda: load_world(scene))
-    if not isinstance(loaded, World):
+    if isinstance(loaded, Scene):
         _fail(f"--scene {str(scene)!r} lists its contacts: a trajectory is run on a scene of shapes")
     return loaded
 

@@ -11,11 +11,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from .adapters import World, world_from_file
 from .model import Scene
 from .model.io import read_scene_file, scene_from_file
+
+if TYPE_CHECKING:
+    from .adapters import World
 
 __all__ = ["load_scene", "load_world"]
 
@@ -37,4 +39,8 @@ def load_scene(source: str | Path | Mapping[str, Any]) -> Scene:
 def load_world(source: str | Path | Mapping[str, Any]) -> Scene | World:
     """A file that lists its contacts as a Scene; one with shapes or URDF robots as a World (contacts not yet found)."""
     parsed, folder = read_scene_file(source)
-    return world_from_file(parsed, folder) if parsed.is_geometric else scene_from_file(parsed)
+    if not parsed.is_geometric:
+        return scene_from_file(parsed)
+    from .adapters import world_from_file  # detection and its kernels load only for scenes of shapes
+
+    return world_from_file(parsed, folder)
