@@ -431,6 +431,8 @@ class ContactSource(Protocol):
 
     def modes(self) -> tuple[Mode, ...]: ...
 
+    def forces_and_slips(self) -> tuple[np.ndarray, np.ndarray]: ...
+
     def forces_indeterminate(self) -> bool: ...
 
 
@@ -445,6 +447,9 @@ class ContactList:
 
     def modes(self) -> tuple[Mode, ...]:
         return tuple(c.mode for c in self.contacts)
+
+    def forces_and_slips(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.array([c.force for c in self.contacts]), np.array([c.slip for c in self.contacts])
 
     def forces_indeterminate(self) -> bool:
         return any(c.normal_force_range is not None for c in self.contacts)
@@ -502,6 +507,11 @@ class Motion:
     @property
     def modes(self) -> tuple[Mode, ...]:
         return self.source.modes()
+
+    def forces_and_slips(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each contact's force and slip (m, d), world frame, as :attr:`contacts` gives them, without working
+        out the force ranges (a simulation records these at every step)."""
+        return self.source.forces_and_slips()
 
     @property
     def forces_indeterminate(self) -> bool:

@@ -166,6 +166,10 @@ class ContactTable:
         threshold = self.threshold
         return tuple(_mode(u_n, speed, threshold) for u_n, speed, _ in self.normal.tolist())
 
+    def forces_and_slips(self) -> tuple[np.ndarray, np.ndarray]:
+        force_roundoff, speed_roundoff, _ = self.roundoff
+        return _drop_roundoff(self.forces.copy(), force_roundoff), _drop_roundoff(self.slips.copy(), speed_roundoff)
+
     def results(self) -> tuple[ContactResult, ...]:
         known = self.range_list()
         ranges: list[Range | None] = list(known) if known is not None else [None] * len(self.pairs)

@@ -138,10 +138,10 @@ class Evaluation:
                 ContactRecord(c.body, c.other, c.point, c.normal, g, np.zeros(3), None)
                 for c, g in zip(contacts, self.detection.gaps, strict=True)
             )
-        results = self.motion.contacts
+        forces, slips = self.motion.forces_and_slips()  # no force ranges: a run records the forces taken
         return tuple(
-            ContactRecord(c.body, c.other, c.point, c.normal, g, np.asarray(r.force, dtype=float), r.mode, np.asarray(r.slip, dtype=float))
-            for c, g, r in zip(contacts, self.detection.gaps, results, strict=True)
+            ContactRecord(c.body, c.other, c.point, c.normal, g, force, mode, slip)
+            for c, g, force, mode, slip in zip(contacts, self.detection.gaps, forces, self.motion.modes, slips, strict=True)
         )
 
 
@@ -305,7 +305,7 @@ def _reclosed(evaluation: Evaluation, state: State) -> State:
     """
     if evaluation.motion is None:
         return state
-    before = [(c, r.mode) for c, r in zip(evaluation.detection.contacts, evaluation.motion.contacts, strict=True)]
+    before = list(zip(evaluation.detection.contacts, evaluation.motion.modes, strict=True))
     if not any(mode in ("rolling", "sliding") for _, mode in before):
         return state
     world = state.applied(evaluation.world)
