@@ -180,3 +180,19 @@ def test_indeterminate_frictional_forces_are_reported_without_running_their_rang
             hi - lo if hi is not None else np.inf for lo, hi in (c.normal_force_range for c in solution.contacts if c.normal_force_range)
         ]
         assert max(widths) > 0.0
+
+
+def test_friction_forces_that_share_a_load_are_not_claimed_unique() -> None:
+    """A box on two supports pulled gently sideways stays at rest; its normal forces are fixed, but how the two
+    supports share the sideways pull is not (any split within the cones balances it): only the normal forces
+    may be claimed unique."""
+    box = qs.Body("box", mass=1.0, com=[0.0, 0.05])
+    supports = tuple(qs.Contact("box", "table", point=[x, 0.0], normal=[0.0, 1.0], mu=0.5) for x in (-0.05, 0.05))
+    pulled = qs.Scene(dimension=2, bodies=(box,), movers=(qs.Mover("table"),), contacts=supports, gravity=[1.0, -9.81])
+    solution = qs.solve(pulled)
+    assert solution.status == "solved" and solution.certified
+    assert np.allclose(solution.twists["box"], 0.0)
+    assert "unique normal forces" in solution.message and "unique contact forces" not in solution.message
+    # the split is free: moving friction from one support to the other keeps every law
+    forces = np.array([c.force for c in solution.contacts])
+    assert np.all(np.abs(forces[:, 0]) < 0.5 * forces[:, 1] - 0.1)  # both sticking inside their cones, with room

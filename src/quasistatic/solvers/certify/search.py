@@ -58,8 +58,7 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
         return BackendResult("failed", message, tuple(motions), certified=False, search_complete=False)
     motions = [_with_force_ranges(form, motion) for motion in motions]
     if len(motions) == 1 and not motions[0].continuum:
-        indeterminate = motions[0].forces_indeterminate
-        message = "solved: one motion" + ("; the contact forces are indeterminate" if indeterminate else " with unique contact forces")
+        message = "solved: one motion" + _force_claim(form.problem, motions[0].forces_indeterminate)
         return BackendResult("solved", message, tuple(motions), search_complete=True)
     kinds = "a continuum of motions" if len(motions) == 1 else f"{len(motions)} distinct motions"
     more = "" if complete else " (the list may be incomplete)"
@@ -69,6 +68,17 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
         tuple(motions),
         search_complete=complete,
     )
+
+
+def _force_claim(problem: Problem, indeterminate: bool) -> str:
+    """What is known of a solved motion's forces. Only the normal forces' ranges are worked out: with friction,
+    the friction forces may still share a load in many ways (a box on two supports pulled sideways) and are not
+    claimed unique."""
+    if indeterminate:
+        return "; the contact forces are indeterminate"
+    if problem.is_frictionless:
+        return " with unique contact forces"
+    return " with unique normal forces (whether the friction forces are unique is not checked)"
 
 
 def _with_force_ranges(form: LCPForm, motion: RawMotion) -> RawMotion:
