@@ -435,3 +435,29 @@ def test_parallel_jaws_leave_the_lift_ambiguous() -> None:
     rises = [float(m.twists["cube"][2]) for m in solution.solutions]
     assert any(v == pytest.approx(LIFT_SPEED, abs=1e-9) for v in rises)
     assert any(abs(v) < 1e-9 for v in rises)
+
+
+def test_peg_slide_is_certified_unique_without_a_policy() -> None:
+    """Sliding in, the peg's motion is unique at every step: no policy is needed, and the last state's answer is
+    the one motion ``scip`` finds. (HiGHS's presolve once called the found motion's own pattern infeasible, and
+    that was read as a continuum free in every direction: a second, bogus motion and an ``ambiguous`` stop.)"""
+    scene = EXAMPLES / "peg_in_hole_slide.yaml"
+    run = qs.simulate(scene, duration=1.5, dt=0.25)
+    assert run.status == "completed", run.message
+    final = run.final.applied(qs.load_world(scene))
+    default, searched = qs.solve(final), qs.solve(final, method="scip")
+    assert default.status == searched.status == "solved" and default.certified
+    assert default.motion is not None and searched.motion is not None
+    np.testing.assert_allclose(default.motion.twists["peg"], searched.motion.twists["peg"], atol=1e-9)
+
+
+def test_an_unmeasured_extent_is_an_error_not_a_free_direction() -> None:
+    """An LP that cannot answer (here: an empty polyhedron) never makes a twist entry free."""
+    from quasistatic.errors import SolverError
+    from quasistatic.solvers.numerics.ranges import twist_extremes
+
+    empty = (np.array([[1.0, 0.0]]), np.array([1.0]), np.array([[-1.0, 0.0]]), np.array([0.0]))  # x0 = 1 and x0 <= 0
+    with pytest.raises(SolverError, match="could not be measured"):
+        twist_extremes(2, *empty)
+    _, free = twist_extremes(2, np.array([[1.0, 0.0]]), np.array([1.0]), np.zeros((0, 2)), np.zeros(0))
+    assert set(free) == {2, -2}  # x0 is pinned at 1, x1 runs both ways

@@ -233,12 +233,16 @@ def _load(
 
 def _run(solver: highspy.Highs, cost: np.ndarray, maximize: bool) -> LPResult:
     n = cost.size
-    try:
-        solver.run()
-    except Exception as exc:  # a crash inside HiGHS, not a status
-        raise SolverError("highs", f"HiGHS failed: {exc}") from exc
+    status = _solve(solver)
+    if status in ("infeasible", "unbounded_or_infeasible"):
+        # HiGHS's presolve has called a feasible, degenerate LP infeasible (tiny entries it keeps, rows
+        # redundant to round-off: a pattern of a peg sliding in a slot); a claim of infeasibility is
+        # confirmed by the simplex alone before anyone relies on it.
+        solver.setOptionValue("presolve", "off")
+        solver.clearSolver()
+        status = _solve(solver)
+        solver.setOptionValue("presolve", "choose")
     m = solver.getNumRow()
-    status = _STATUS.get(solver.getModelStatus(), "error")
     solution = solver.getSolution()
     x = np.array(solution.col_value) if n else np.zeros(0)
     duals = np.array(solution.row_dual) if m else np.zeros(0)
@@ -246,3 +250,11 @@ def _run(solver: highspy.Highs, cost: np.ndarray, maximize: bool) -> LPResult:
         duals = -duals
     objective = float(cost @ x) if status == "optimal" else float("nan")
     return LPResult(status, x, duals, objective)
+
+
+def _solve(solver: highspy.Highs) -> LPStatus:
+    try:
+        solver.run()
+    except Exception as exc:  # a crash inside HiGHS, not a status
+        raise SolverError("highs", f"HiGHS failed: {exc}") from exc
+    return _STATUS.get(solver.getModelStatus(), "error")

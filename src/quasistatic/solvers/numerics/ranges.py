@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ...errors import SolverError
 from ...tolerances import AT_LOWER_BOUND, FORCE_RANK, LP_FEASIBILITY, MOTION_RANK, SAME_TWIST
 from ..result import Range
 from .highs import INF, WarmLP, optimise_each, solve_lp
@@ -104,8 +105,10 @@ def twist_extremes(
             q = lp.x[:n_twist]
             if not any(np.max(np.abs(q - p)) <= SAME_TWIST for p in points):
                 points.append(q)
-        else:  # minimising sign * x_j is unbounded: x_j runs to -sign infinity
+        elif lp.status == "unbounded":  # minimising sign * x_j is unbounded: x_j runs to -sign infinity
             free.append(-sign * (j + 1))
+        else:  # no answer is not an unbounded direction (it once made a bogus continuum free in every direction)
+            raise SolverError("highs", f"the extent of a polyhedron along twist entry {j} could not be measured (LP {lp.status})")
     return points, tuple(free)
 
 
