@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -165,18 +166,13 @@ def _mujoco_push(duration: float) -> tuple[np.ndarray, float]:
       </worldbody>
       <contact><pair geom1="finger" geom2="box" condim="1"/></contact>
     </mujoco>"""
-    model = mujoco.MjModel.from_xml_string(xml)
-    data = mujoco.MjData(model)
-    settle = int(0.2 / model.opt.timestep)
-    for _ in range(settle):  # the box sinks into the soft table before the push starts
-        mujoco.mj_step(model, data)
+    model, data = _settled(mujoco, xml)
     start = data.qpos[:3].copy()
     finger = np.array([-half - FINGER, 0.0, half])
     for i in range(int(round(duration / model.opt.timestep))):
         data.mocap_pos[0] = finger + [SPEED * (i + 1) * model.opt.timestep, 0.0, 0.0]
         mujoco.mj_step(model, data)
-    for _ in range(settle):  # the finger stopped: whatever momentum the box had is spent
-        mujoco.mj_step(model, data)
+    _settle(mujoco, model, data)  # the finger stopped: whatever momentum the box had is spent
     w, _, _, z = data.qpos[3:7]
     return data.qpos[:3] - start + [0.0, 0.0, half], 2.0 * math.atan2(z, w)
 
@@ -373,17 +369,12 @@ def _mujoco_lift(duration: float) -> tuple[np.ndarray, float]:
         {"".join(jaws)}
       </worldbody>
     </mujoco>"""
-    model = mujoco.MjModel.from_xml_string(xml)
-    data = mujoco.MjData(model)
-    settle = int(0.2 / model.opt.timestep)
-    for _ in range(settle):  # the cube sinks into the soft stand before the lift starts
-        mujoco.mj_step(model, data)
+    model, data = _settled(mujoco, xml)
     start, jaw_start = data.qpos[:3].copy(), data.mocap_pos.copy()
     for i in range(int(round(duration / model.opt.timestep))):
         data.mocap_pos[:] = jaw_start + [0.0, 0.0, LIFT_SPEED * (i + 1) * model.opt.timestep]
         mujoco.mj_step(model, data)
-    for _ in range(settle):  # the jaws stopped: whatever the cube still moves is spent
-        mujoco.mj_step(model, data)
+    _settle(mujoco, model, data)  # the jaws stopped: whatever the cube still moves is spent
     turn = 2.0 * math.acos(min(1.0, abs(float(data.qpos[3]))))
     return data.qpos[:3] - start + [0.0, 0.0, half], turn
 
@@ -461,3 +452,18 @@ def test_an_unmeasured_extent_is_an_error_not_a_free_direction() -> None:
         twist_extremes(2, *empty)
     _, free = twist_extremes(2, np.array([[1.0, 0.0]]), np.array([1.0]), np.zeros((0, 2)), np.zeros(0))
     assert set(free) == {2, -2}  # x0 is pinned at 1, x1 runs both ways
+
+
+def _settled(mujoco: Any, xml: str) -> tuple[Any, Any]:
+    """The MuJoCo model of ``xml`` and its data after :func:`_settle`: soft contacts sink until they carry the load
+    before the run starts."""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    _settle(mujoco, model, data)
+    return model, data
+
+
+def _settle(mujoco: Any, model: Any, data: Any) -> None:
+    """0.2 s of MuJoCo steps with nothing driven."""
+    for _ in range(int(0.2 / model.opt.timestep)):
+        mujoco.mj_step(model, data)
