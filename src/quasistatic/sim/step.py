@@ -13,7 +13,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -74,6 +74,17 @@ class SimModel:
         band = self.margin + SIM_LOOKAHEAD * self.world.size
         return replace(self.world, detection=replace(self.world.detection, margin=band))
 
+    def found_at(self, state: State, world: World) -> Detection:
+        """``world.detect()``, ``world`` being the look-ahead World placed at ``state``; the contacts found at the
+        state a step ended on (:func:`advance` looks for drifted contacts there) serve the next step, which
+        starts on that very State. Detection reads poses and joint positions only, never the inputs."""
+        kept = self.__dict__.get("_found")
+        if kept is not None and kept[0] is state:
+            return cast(Detection, kept[1])
+        found = world.detect()
+        self.__dict__["_found"] = (state, found)  # a one-entry cache, as cached_property keeps its values
+        return found
+
     def __post_init__(self) -> None:
         if self.world.contacts or self.world.explicit_robots:
             raise SceneError(
@@ -115,6 +126,7 @@ class Evaluation:
     motion: Motion | None  # None: the run cannot go on (jammed, unstable, failed, or ambiguous under "stop")
     choice: str  # how the motion was chosen among several, or ""
     penetration: float  # the largest depth found before correction [length]
+    model: SimModel = field(repr=False, compare=False)
 
     @property
     def status(self) -> Status:
@@ -201,7 +213,7 @@ def evaluate(model: SimModel, state: State, inputs: Inputs) -> Evaluation:
     inputs.check(model.world)
     world = inputs.applied(state.applied(model.detecting))
     margin = model.margin
-    found = world.detect()
+    found = model.found_at(state, world)
     state, world, found, penetration = _corrected(model, state, inputs, world, found)
     touching = [i for i, g in enumerate(found.gaps) if g <= margin]
     near = tuple((found.contacts[i], found.gaps[i]) for i, g in enumerate(found.gaps) if g > margin)
@@ -211,7 +223,7 @@ def evaluate(model: SimModel, state: State, inputs: Inputs) -> Evaluation:
     options = model.options
     solution = solve(world.scene(detection), options.method, certify=options.certify, time_limit=options.time_limit)
     motion, choice = _chosen(solution, options.ambiguous)
-    return Evaluation(state, inputs, world, margin, detection, near, solution, motion, choice, penetration)
+    return Evaluation(state, inputs, world, margin, detection, near, solution, motion, choice, penetration, model)
 
 
 def _isolated(world: World, found: Detection, touching: list[int]) -> Mapping[str, tuple[str, float]]:
@@ -310,7 +322,7 @@ def _reclosed(evaluation: Evaluation, state: State) -> State:
         return state
     world = state.applied(evaluation.world)
     band = SIM_LOOKAHEAD * world.size
-    found = world.detect()
+    found = evaluation.model.found_at(state, world)
     kept = [(c, gap) for c, gap in zip(found.contacts, found.gaps, strict=True) if _was_closed(before, c, band)]
     opened = SIM_APPROACH * evaluation.margin
     if all(gap <= opened for _, gap in kept):
