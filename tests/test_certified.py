@@ -20,7 +20,8 @@ from quasistatic.solvers.certify.cheap import kinematic_radius, seed_point
 from quasistatic.solvers.certify.search import enumerate_motions
 from quasistatic.solvers.numerics.forces import forces_at_twist, indeterminate_forces, measured_masks
 from quasistatic.solvers.numerics.highs import solve_lp
-from quasistatic.solvers.numerics.ranges import ranges_are_wide, value_ranges
+from quasistatic.solvers.numerics.ranges import value_ranges
+from quasistatic.tolerances import LP_FEASIBILITY
 from quasistatic.tools.bench.families import grasp_2d
 from random_scenes import random_scene
 
@@ -150,17 +151,29 @@ def _eager_normal_ranges(problem: qs.Problem, edges: np.ndarray, q: np.ndarray) 
     return value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size))
 
 
+def _eager_component_ranges(problem: qs.Problem, edges: np.ndarray, q: np.ndarray) -> list[tuple[float | None, float | None]]:
+    """Every contact-frame force component's range at twist ``q`` (tangents and normal), two LPs each."""
+    forces = forces_at_twist(problem, edges, q, measured_masks(problem, edges, q))
+    m, d = problem.n_contacts, problem.scene.dimension
+    units = np.eye(m * d).reshape(m * d, m, d)
+    return forces.ranges(units)
+
+
+def _wide(ranges: list[tuple[float | None, float | None]]) -> bool:
+    return any(lo is None or hi is None or hi - lo > LP_FEASIBILITY for lo, hi in ranges)
+
+
 @pytest.mark.parametrize("scene", [grasp_2d(m, i) for m in (2, 4, 6, 8) for i in range(6)] + [random_scene(2, seed) for seed in range(30)])
 def test_deferred_frictional_force_ranges_decide_indeterminacy_as_the_ranges_do(scene: qs.Scene) -> None:
-    """``indeterminate_forces`` says "indeterminate" exactly when some normal range, worked out by LPs, is wide,
-    and the ranges it defers are those LPs' ranges."""
+    """``indeterminate_forces`` says "indeterminate" exactly when some force component's range (friction included),
+    worked out by LPs, is wide, and the normal ranges it defers are those LPs' ranges."""
     problem = qs.assemble(scene)
     edges = aligned_edges(problem, problem.friction.edges)
     result = BACKENDS["scip"].solver(problem, Options())
     for motion in (m for m in result.motions if not m.continuum):
         eager = _eager_normal_ranges(problem, edges, motion.q)
         found = indeterminate_forces(problem, edges, motion.q)
-        assert (found is not None) == ranges_are_wide(eager)
+        assert (found is not None) == _wide(_eager_component_ranges(problem, edges, motion.q))
         if found is not None:
             ranges = found.known if found.known is not None else found.lazy()
             assert [lo for lo, _ in ranges] == pytest.approx([lo for lo, _ in eager], abs=1e-9)
@@ -182,17 +195,51 @@ def test_indeterminate_frictional_forces_are_reported_without_running_their_rang
         assert max(widths) > 0.0
 
 
-def test_friction_forces_that_share_a_load_are_not_claimed_unique() -> None:
-    """A box on two supports pulled gently sideways stays at rest; its normal forces are fixed, but how the two
-    supports share the sideways pull is not (any split within the cones balances it): only the normal forces
-    may be claimed unique."""
+def _pulled_box(pull: float) -> qs.Scene:
+    """A box on two supports 0.1 apart, mu = 0.5, 1 kg, its weight with a sideways part ``pull`` [N]."""
     box = qs.Body("box", mass=1.0, com=[0.0, 0.05])
     supports = tuple(qs.Contact("box", "table", point=[x, 0.0], normal=[0.0, 1.0], mu=0.5) for x in (-0.05, 0.05))
-    pulled = qs.Scene(dimension=2, bodies=(box,), movers=(qs.Mover("table"),), contacts=supports, gravity=[1.0, -9.81])
-    solution = qs.solve(pulled)
+    return qs.Scene(dimension=2, bodies=(box,), movers=(qs.Mover("table"),), contacts=supports, gravity=[pull, -9.81])
+
+
+def test_friction_forces_that_share_a_load_are_indeterminate() -> None:
+    """A box on two supports pulled gently sideways stays at rest. Its normal forces are fixed (moments about the
+    com: 4.405 and 5.405 N), but how the two supports share the 1 N pull is not: any split with each friction
+    force within mu = 0.5 of its normal force balances it. So the forces are indeterminate, and each support's
+    friction ranges over [-mu N_i, -1 + mu N_j] (the other support taking the rest, up to its own limit)."""
+    solution = qs.solve(_pulled_box(1.0))
     assert solution.status == "solved" and solution.certified
     assert np.allclose(solution.twists["box"], 0.0)
-    assert "unique normal forces" in solution.message and "unique contact forces" not in solution.message
-    # the split is free: moving friction from one support to the other keeps every law
-    forces = np.array([c.force for c in solution.contacts])
-    assert np.all(np.abs(forces[:, 0]) < 0.5 * forces[:, 1] - 0.1)  # both sticking inside their cones, with room
+    assert solution.forces_indeterminate and "the contact forces are indeterminate" in solution.message
+    normal = np.array([4.405, 5.405])
+    for contact, n in zip(solution.contacts, normal, strict=True):
+        assert contact.normal_force_range == pytest.approx((n, n))  # only the friction varies
+    boxes = solution.motion.force_ranges
+    assert boxes is not None
+    for i, j in ((0, 1), (1, 0)):
+        (x_lo, x_hi), (y_lo, y_hi) = boxes[i]
+        assert (x_lo, x_hi) == pytest.approx((-0.5 * normal[i], -1.0 + 0.5 * normal[j]))
+        assert (y_lo, y_hi) == pytest.approx((normal[i], normal[i]))
+    contacts = solution.to_dict()["contacts"]
+    assert contacts[0]["force_range"] == [pytest.approx([x_lo, x_hi]) for x_lo, x_hi in [boxes[0][0]]] + [pytest.approx([4.405, 4.405])]
+
+
+def test_friction_forces_fixed_by_sliding_are_claimed_unique() -> None:
+    """Pushed by a frictionless fingertip at the height of its com, the box slides; both friction forces are then mu
+    times their normal forces, which the moments fix, and the push balances them: one force distribution, and
+    the answer says so."""
+    scene = _pulled_box(0.0)
+    finger = qs.Contact("box", "finger", point=[-0.05, 0.05], normal=[1.0, 0.0], mu=0.0)
+    pushed = qs.Scene(
+        dimension=2,
+        bodies=scene.bodies,
+        movers=(qs.Mover("table"), qs.Mover("finger", twist=[0.01, 0.0, 0.0])),
+        contacts=(*scene.contacts, finger),
+        gravity=scene.gravity,
+    )
+    solution = qs.solve(pushed)
+    assert solution.status == "solved" and solution.certified and solution.twists["box"][0] == pytest.approx(0.01)
+    assert not solution.forces_indeterminate and "with unique contact forces" in solution.message
+    assert solution.motion.force_ranges is None
+    forces = np.array([c.force for c in solution.contacts])[:2]
+    assert forces[:, 0] == pytest.approx(-0.5 * forces[:, 1])

@@ -7,7 +7,7 @@ already holds; numbers are shown in the scene's own units.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -17,7 +17,7 @@ from rich.table import Table
 from rich.text import Text
 
 from .model import Contact
-from .solution import Bounds, Certificate, CertificateKind, CompliantStep, ContactResult, Motion, MoverWrench, RobotLoad, Solution
+from .solution import Bounds, Certificate, CertificateKind, CompliantStep, Motion, MoverWrench, RobotLoad, Solution
 from .tolerances import DISPLAY_ZERO
 
 if TYPE_CHECKING:
@@ -100,7 +100,7 @@ def render_solution(solution: Solution, console: Console) -> None:
     suffix = " (motion 1)" if ambiguous else ""
     tables = [
         _twist_table(motion.twists, f"body twists{suffix}"),
-        _contact_table(motion.contacts, solution.forces_indeterminate, f"contacts{suffix}"),
+        _contact_table(motion, solution.forces_indeterminate, f"contacts{suffix}"),
     ]
     if motion.robot_loads:
         tables.append(_torque_table(motion.robot_loads, f"robot joint torques{suffix}"))
@@ -183,7 +183,7 @@ def _split_twist(twist: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return twist[:linear], twist[linear:]
 
 
-def _contact_table(contacts: Iterable[ContactResult], with_ranges: bool, title: str) -> Table:
+def _contact_table(motion: Motion, with_ranges: bool, title: str) -> Table:
     table = _table(title)
     table.caption = "f_n: normal force on body; force: on body; slip, u_n: velocity of body relative to other"
     table.caption_justify = "left"
@@ -198,9 +198,12 @@ def _contact_table(contacts: Iterable[ContactResult], with_ranges: bool, title: 
         ("u_n", "right"),
     ):
         table.add_column(name, justify=justify, overflow="fold")  # type: ignore[arg-type]
+    boxes = motion.force_ranges if with_ranges else None
     if with_ranges:
         table.add_column("f_n range", justify="right")
-    contacts = tuple(contacts)
+    if boxes is not None and any(box is not None for box in boxes):
+        table.add_column("force range", justify="right")
+    contacts = motion.contacts
     force_scale = max((float(np.max(np.abs(c.force), initial=0.0)) for c in contacts), default=0.0)
     speed_scale = max((max(float(np.max(np.abs(c.slip), initial=0.0)), abs(c.normal_velocity)) for c in contacts), default=0.0)
     for index, contact in enumerate(contacts):
@@ -216,8 +219,18 @@ def _contact_table(contacts: Iterable[ContactResult], with_ranges: bool, title: 
         ]
         if with_ranges:
             row.append(_format_range(contact.normal_force_range))
+        if boxes is not None and any(box is not None for box in boxes):
+            row.append(_format_box(boxes[index]))
         table.add_row(*row)
     return table
+
+
+def _format_box(bounds: tuple[Bounds, ...] | None) -> str:
+    """A force's component ranges, ``x [lo, hi] y [lo, hi]`` (``-`` for a frictionless contact)."""
+    if bounds is None:
+        return "-"
+    ends = ["-inf" if lo is None else format_float(lo) for lo, _ in bounds], ["inf" if hi is None else format_float(hi) for _, hi in bounds]
+    return " ".join(f"{axis} [{lo}, {hi}]" for axis, lo, hi in zip("xyz", *ends, strict=False))
 
 
 def _format_range(bounds: tuple[float, float | None] | None) -> str:

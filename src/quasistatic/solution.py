@@ -250,6 +250,8 @@ class LoadSource(Protocol):
 
     def mover_wrenches(self) -> tuple[MoverWrench, ...]: ...
 
+    def force_ranges(self) -> tuple[tuple[Bounds, ...] | None, ...] | None: ...
+
 
 @dataclass(frozen=True)
 class LoadList:
@@ -263,6 +265,9 @@ class LoadList:
 
     def mover_wrenches(self) -> tuple[MoverWrench, ...]:
         return self.movers
+
+    def force_ranges(self) -> tuple[tuple[Bounds, ...] | None, ...] | None:
+        return None
 
 
 @dataclass(frozen=True)
@@ -528,6 +533,13 @@ class Motion:
         """The net wrench of each mover that touches a free body, in scene order."""
         return self.loads.mover_wrenches()
 
+    @cached_property
+    def force_ranges(self) -> tuple[tuple[Bounds, ...] | None, ...] | None:
+        """When the forces are indeterminate: each frictional contact's world force components' ranges,
+        ``((lo, hi) per axis)`` [force] (None for a frictionless contact, whose ``normal_force_range`` says
+        all; an end is None when unbounded). None when the forces are unique, or not known."""
+        return self.loads.force_ranges() if self.forces_indeterminate else None
+
     @property
     def torque_limits_exceeded(self) -> dict[str, tuple[str, ...]]:
         """Robot name -> the joints whose torque limits this motion cannot meet; empty when every limit holds."""
@@ -537,7 +549,7 @@ class Motion:
         out: dict[str, Any] = {
             "bodies": {name: {"twist": _floats(t)} for name, t in self.twists.items()},
             "modes": list(self.modes),
-            "contacts": [c.to_dict() for c in self.contacts],
+            "contacts": self._contact_dicts(),
             "power": self.power.to_dict(),
             "audit": self.audit.to_dict(),
             "forces_indeterminate": self.forces_indeterminate,
@@ -550,6 +562,17 @@ class Motion:
             out["free_directions"] = list(self.free_directions)
             out["extreme_twists"] = [{n: _floats(t) for n, t in e.items()} for e in self.extreme_twists]
         return out
+
+    def _contact_dicts(self) -> list[dict[str, Any]]:
+        contacts = [c.to_dict() for c in self.contacts]
+        for out, bounds in zip(contacts, self.force_ranges or (), strict=False):
+            if bounds is not None:
+                out["force_range"] = [[_end(lo), _end(hi)] for lo, hi in bounds]
+        return contacts
+
+
+def _end(value: float | None) -> float | None:
+    return None if value is None else float(value)
 
 
 class SolveSource(Protocol):

@@ -65,6 +65,9 @@ class LoadMap:
         touched = {c.other for c in scene.contacts}
         self.robots = tuple(_robot_map(scene, robot, scales.force) for robot in scene.robots)
         self.movers = tuple(_mover_map(scene, mover, scales) for mover in scene.movers if mover.name in touched)
+        frictionless = scene.friction.kind == "none"
+        self.frictional = np.array([c.mu > 0.0 and not frictionless for c in scene.contacts], dtype=bool)
+        self.force_scale = scales.force
 
 
 def _robot_map(scene: Scene, robot: Robot, force: float) -> _RobotMap:
@@ -132,6 +135,28 @@ class LoadTable:
 
     def mover_wrenches(self) -> tuple[MoverWrench, ...]:
         return tuple(self._mover(mover) for mover in self._map().movers)
+
+    def force_ranges(self) -> tuple[tuple[Bounds, ...] | None, ...] | None:
+        """Each frictional contact's world force components' ranges over the consistent forces (None for a
+        frictionless contact: its force lies along its normal, whose range the contact gives); None when unique.
+
+        Two LPs per component, when first read: what friction leaves free (a pull shared by two supports)
+        shows here and not in the normal forces' ranges.
+        """
+        if self.force_set is None:
+            return None
+        m, d = self.forces.shape
+        load_map = self._map()
+        frictional = np.flatnonzero(load_map.frictional).tolist()
+        functionals = np.zeros((len(frictional) * d, m, d))
+        for row, (i, axis) in enumerate((i, axis) for i in frictional for axis in range(d)):
+            functionals[row, i, axis] = 1.0
+        scale = np.full(functionals.shape[0], load_map.force_scale)
+        bounds = _clean_bounds(self.force_set.ranges(functionals), scale) if frictional else ()
+        per_contact: list[tuple[Bounds, ...] | None] = [None] * m
+        for k, i in enumerate(frictional):
+            per_contact[i] = bounds[k * d : (k + 1) * d]
+        return tuple(per_contact)
 
     def _robot(self, robot: _RobotMap) -> RobotLoad:
         torques = _clean(np.einsum("jid,id->j", robot.matrix, self.forces), robot.scale)

@@ -71,14 +71,9 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
 
 
 def _force_claim(problem: Problem, indeterminate: bool) -> str:
-    """What is known of a solved motion's forces. Only the normal forces' ranges are worked out: with friction,
-    the friction forces may still share a load in many ways (a box on two supports pulled sideways) and are not
-    claimed unique."""
-    if indeterminate:
-        return "; the contact forces are indeterminate"
-    if problem.is_frictionless:
-        return " with unique contact forces"
-    return " with unique normal forces (whether the friction forces are unique is not checked)"
+    """What is known of a solved motion's forces: every component of every contact force, friction included,
+    is unique or not (:func:`~..numerics.forces.indeterminate_forces`)."""
+    return "; the contact forces are indeterminate" if indeterminate else " with unique contact forces"
 
 
 def _with_force_ranges(form: LCPForm, motion: RawMotion) -> RawMotion:

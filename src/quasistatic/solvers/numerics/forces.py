@@ -29,7 +29,7 @@ from ...laws.polyhedral import ForcePolytope, aligned_edges, dense_force_matrix,
 from ...tolerances import FORCE_RANK, LP_FEASIBILITY, ZERO
 from ..result import Range
 from .highs import solve_lp
-from .ranges import Bounds, in_row_space, linear_ranges, null_space, ranges_are_wide, rows_feasible, value_ranges
+from .ranges import Bounds, linear_ranges, null_space, ranges_are_wide, rows_feasible, rows_in_row_space, value_ranges
 from .rank import DENSE_MAX, full_column_rank
 
 __all__ = [
@@ -203,48 +203,65 @@ class IndeterminateForces:
 
 
 def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> IndeterminateForces | None:
-    """The normal-force ranges over every force consistent with twist ``q``; None when no range is wide.
+    """The normal-force ranges over every force consistent with twist ``q``; None when the contact forces are unique.
 
-    Wide means wider than ``LP_FEASIBILITY`` (:func:`~.ranges.ranges_are_wide`), as before the ranges
-    were deferred. A segment of consistent forces through a balanced point found by least squares that
-    moves some normal force by more than that: wide, without an LP (:func:`_wide_through_balanced_point`).
-    Free columns of full rank: one force distribution, None. Every normal force a
-    combination of the equations (only the edge intensities vary, as both edges of a 2-D contact
-    that sticks): None, as :func:`~.ranges.value_ranges` finds them constant. Otherwise one LP
-    decides (:func:`_normal_forces_vary`), and the ranges wait until they are read; where it
-    cannot decide, they are worked out now and decide.
+    Unique means every component of every contact force, friction included (a box at rest on two supports,
+    pulled sideways, has fixed normal forces but a free split of the pull between its supports): no
+    component varies by more than ``LP_FEASIBILITY`` over the set (:func:`~.ranges.ranges_are_wide`).
+    A segment of consistent forces through a balanced point found by least squares that moves some
+    force component by more than that: indeterminate, without an LP (:func:`_wide_through_balanced_point`).
+    Free columns of full rank: one force distribution, None. Every force component a combination of
+    the equations (only the edge intensities vary, as both edges of a 2-D contact that sticks): None.
+    Otherwise one LP decides (:func:`_forces_vary`), and the ranges wait until they are read; where it
+    cannot decide, the ranges of every component are worked out now and decide.
     """
     masks = measured_masks(problem, edges, q)
     m, K = edges.shape[:2]
     normal = np.arange(m)  # the polytope's first columns
-    if min(problem.n_dof + m, m * (K + 2)) <= DENSE_MAX and _forces_fixed(problem, edges, q, masks, normal):
+    components = _component_rows(edges)
+    if min(problem.n_dof + m, m * (K + 2)) <= DENSE_MAX and _forces_fixed(problem, edges, q, masks, components):
         return None  # decided densely, before any sparse matrix is built (~0.5 ms on a grasp)
     forces = forces_at_twist(problem, edges, q, masks)
     work = partial(_normal_ranges, forces, normal)
     if _wide_through_balanced_point(problem, masks, forces.polytope.K):
         return IndeterminateForces(None, work, forces)
     A = forces.A.toarray() if min(forces.A.shape) <= DENSE_MAX else forces.A.tocsc()
-    if not isinstance(A, np.ndarray) and _fixed_by_equations(A, forces.fixed, normal):
+    if not isinstance(A, np.ndarray) and _fixed_by_equations(A, forces.fixed, components):
         return None
-    vary = _normal_forces_vary(A, forces, normal) if isinstance(A, np.ndarray) else None
+    vary = _forces_vary(A, forces, components) if isinstance(A, np.ndarray) else None
     if vary is not None:
         return IndeterminateForces(None, work, forces) if vary else None
     ranges = work()
-    return IndeterminateForces(ranges, None, forces) if ranges_are_wide(list(ranges)) else None
+    if ranges_are_wide(list(ranges)):
+        return IndeterminateForces(ranges, None, forces)
+    friction = linear_ranges(forces.A, forces.rhs, components[m:], np.zeros(forces.fixed.size))
+    wide = any(lo is None or hi is None or hi - lo > LP_FEASIBILITY for lo, hi in friction)
+    return IndeterminateForces(ranges, None, forces) if wide else None
+
+
+def _component_rows(edges: np.ndarray) -> np.ndarray:
+    """Each contact-frame force component as a row over the force polytope's columns (normal, edges, slack):
+    the normal forces (m), then each contact's tangential components (m (d - 1)), ``sum_k beta_k edge_k``."""
+    m, K, t = edges.shape
+    rows = np.zeros((m + m * t, m * (K + 2)))
+    rows[np.arange(m), np.arange(m)] = 1.0
+    contact, edge, axis = np.meshgrid(np.arange(m), np.arange(K), np.arange(t), indexing="ij")
+    rows[m + contact * t + axis, m + contact * K + edge] = edges[contact, edge, axis]
+    return rows
 
 
 def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count: int) -> bool:
-    """True when a segment of forces consistent with the modes moves some normal force by more than ``LP_FEASIBILITY``.
+    """True when a segment of forces consistent with the modes moves some force component by more than ``LP_FEASIBILITY``.
 
     Only where no frictional contact slides. Every closed contact may then carry a force in its
     ``edge_count``-gon cone (frictionless ones a normal force alone), and that cone holds the disc cone
     ``|c_t| <= rho cn`` with ``rho = mu cos(pi / edge_count)`` (its inscribed circle; in 2-D the cone itself). A balanced point
     ``c`` (least squares over the closed contacts; a contact whose force leaves its disc cone is dropped,
     carrying nothing, and the rest solved again) with margins ``s_i = rho_i cn_i - |c_t,i| >= 0`` lies
-    in the set. On the contacts with ``s_i > 0``, ``z``, the projection of a normal force's unit vector on
+    in the set. On the contacts with ``s_i > 0``, ``z``, the projection of a component's unit vector on
     the null space of their wrench map, keeps the balance, and ``c + t z`` stays in every disc cone for
     ``|t| <= min_i s_i / (|z_t,i| + rho_i |z_n,i|)`` (and ``A (c + t z)`` within ``ZERO`` of the load, as
-    in :func:`_normal_forces_vary`): that normal force spans at least ``2 t z_j``.
+    in :func:`_forces_vary`): that component spans at least ``2 t z_j``.
     """
     closed, mu = masks.closed, problem.mu
     if np.any(closed & masks.sliding & (mu > 0.0)):
@@ -268,8 +285,7 @@ def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count:
     if kept.size == 0:
         return False
     basis = null_space(wrenches, FORCE_RANK)
-    normals = np.cumsum([problem.dimension if mu[i] > 0.0 else 1 for i in kept]) - 1  # each kept contact's normal column
-    for j in normals.tolist():
+    for j in range(basis.shape[0]):  # every force coordinate of the kept contacts: tangents and normal
         z = basis @ basis[j]
         if z[j] <= 0.0:
             continue
@@ -309,59 +325,61 @@ def _per_contact(problem: Problem, contacts: np.ndarray, x: np.ndarray) -> tuple
     return tangent, normal
 
 
-def _forces_fixed(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: ModeMasks, normal: np.ndarray) -> bool:
+def _forces_fixed(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: ModeMasks, components: np.ndarray) -> bool:
     """:func:`_fixed_by_equations` on the dense matrix of :func:`forces_at_twist` (the same rows, built densely)."""
     fixed = _held_columns(problem, edges, q, masks)
     A = np.vstack([dense_force_matrix(problem, edges), np.eye(fixed.size)[fixed]])
-    return _fixed_by_equations(A, fixed, normal)
+    return _fixed_by_equations(A, fixed, components)
 
 
-def _fixed_by_equations(A: np.ndarray | sp.spmatrix, fixed: np.ndarray, normal: np.ndarray) -> bool:
-    """Free columns of full rank (one force distribution), or every normal force a combination of the equations
+def _fixed_by_equations(A: np.ndarray | sp.spmatrix, fixed: np.ndarray, components: np.ndarray) -> bool:
+    """Free columns of full rank (one force distribution), or every force component a combination of the equations
     (only the edge intensities vary, as both edges of a 2-D contact that sticks: the ranges' LPs would find each
-    normal force constant)."""
-    return full_column_rank(A[:, ~fixed], FORCE_RANK) or bool(np.all(in_row_space(A, normal)))
+    component constant). ``components``: :func:`_component_rows`."""
+    return full_column_rank(A[:, ~fixed], FORCE_RANK) or bool(np.all(rows_in_row_space(A, components)))
 
 
 def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ...]:
     return tuple(value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size)))
 
 
-def _normal_forces_vary(A: np.ndarray, forces: ForcesAtTwist, normal: np.ndarray) -> bool | None:
-    """True: some normal force provably spans more than ``LP_FEASIBILITY`` over the set; False: every
-    normal force is constant on it; None: undecided. ``A``: ``forces.A``, dense (small sets only).
+def _forces_vary(A: np.ndarray, forces: ForcesAtTwist, components: np.ndarray) -> bool | None:
+    """True: some force component provably spans more than ``LP_FEASIBILITY`` over the set; False: every
+    component is constant on it; None: undecided. ``A``: ``forces.A``, dense (small sets only);
+    ``components``: :func:`_component_rows`.
 
     The set is ``{x >= 0 : A x = rhs}``. One LP finds the columns ``P`` that are
     positive somewhere in it and a point ``x`` positive on all of them
     (:func:`_relative_interior`). The set then lies in ``{x : A x = rhs, x = 0
-    off P}``, whose directions are the null space of ``A_P``: a normal force
-    whose column is in ``A_P``'s row space (or outside ``P``) is constant. Any
-    ``z`` in that null space keeps ``x + t z`` in the set for ``-t_minus <= t <=
-    t_plus`` (until a positive column reaches 0), so column ``j`` spans at least
-    ``z_j (t_plus + t_minus)``, with ``z`` the projection of ``e_j`` (the
-    direction that moves ``x_j`` most per unit length); ``t`` also stops where
-    ``A (x + t z)`` would leave ``rhs`` by ``ZERO`` (the basis is a null space to
-    ``FORCE_RANK``).
+    off P}``, whose directions are the null space of ``A_P``: a component ``f . x``
+    whose ``f_P`` is in ``A_P``'s row space is constant. Any ``z`` in that null
+    space keeps ``x + t z`` in the set for ``-t_minus <= t <= t_plus`` (until a
+    positive column reaches 0), so the component spans at least ``f . z (t_plus +
+    t_minus)``, with ``z`` the projection of the unit ``f_P`` (the direction that
+    moves it most per unit length); ``t`` also stops where ``A (x + t z)`` would
+    leave ``rhs`` by ``ZERO`` (the basis is a null space to ``FORCE_RANK``).
     """
     found = _relative_interior(A, forces.rhs, forces.fixed)
     if found is None:
         return None
     x, support = found
     positive = np.flatnonzero(support)
-    normal = normal[support[normal]]
-    at = np.searchsorted(positive, normal)  # each normal column's place among the positive ones
-    varying = at[~in_row_space(A[:, positive], at)]
-    if varying.size == 0:
+    rows = components[:, positive]
+    lengths = np.linalg.norm(rows, axis=1)
+    rows = rows[lengths > 0.0] / lengths[lengths > 0.0, None]  # a component on no positive column is 0 on the set
+    varying = rows[~rows_in_row_space(A[:, positive], rows)]
+    if varying.shape[0] == 0:
         return False
     basis = null_space(A[:, positive], FORCE_RANK)
-    for k in varying.tolist():
-        z = basis @ basis[k]
-        if z[k] <= 0.0:
+    for f in varying:
+        z = basis @ (basis.T @ f)
+        rate = float(f @ z)
+        if rate <= 0.0:
             continue
         drift = float(np.max(np.abs(A[:, positive] @ z), initial=0.0))
         cap = ZERO / drift if drift > 0.0 else np.inf
         reach = min(_step(x[positive], z), cap) + min(_step(x[positive], -z), cap)
-        if z[k] * reach > LP_FEASIBILITY:
+        if rate * reach > LP_FEASIBILITY:
             return True
     return None
 

@@ -24,6 +24,7 @@ __all__ = [
     "linear_ranges",
     "rows_feasible",
     "in_row_space",
+    "rows_in_row_space",
 ]
 
 Bounds = tuple[float | None, float | None]
@@ -191,16 +192,29 @@ def in_row_space(A: np.ndarray | sp.spmatrix, columns: np.ndarray) -> np.ndarray
     matrix every coordinate is taken as variable, which costs one more LP
     each and never a wrong range.
     """
+    units = np.zeros((columns.size, A.shape[1]))
+    units[np.arange(columns.size), columns] = 1.0
+    return rows_in_row_space(A, units)
+
+
+def rows_in_row_space(A: np.ndarray | sp.spmatrix, rows: np.ndarray) -> np.ndarray:
+    """Which functionals ``rows[r] . x`` are combinations of A's rows (constant wherever ``A x`` is fixed).
+
+    Each row is judged at unit length (a zero row is constant); large matrices as in :func:`in_row_space`.
+    """
     if min(A.shape) == 0 or min(A.shape) > DENSE_MAX:
-        return np.zeros(columns.size, dtype=bool)
+        return np.zeros(rows.shape[0], dtype=bool)
     dense = _dense(A)
     _, sigma, vt = np.linalg.svd(dense, full_matrices=False)
     basis = vt[sigma > FORCE_RANK * max(1.0, float(sigma[0]))]
-    # |e_j - P e_j| with P the projector on the row space, formed directly: as 1 - |P e_j|^2 its round-off
-    # (1e-16) would reach 1e-8 under the square root, above the threshold, and no column would ever be in it.
-    outside = -basis.T @ basis[:, columns]
-    outside[columns, np.arange(columns.size)] += 1.0
-    return np.linalg.norm(outside, axis=0) <= MOTION_RANK
+    lengths = np.linalg.norm(rows, axis=1)
+    units = rows[lengths > 0.0] / lengths[lengths > 0.0, None]
+    # |f - P f| with P the projector on the row space, formed directly: as 1 - |P f|^2 its round-off
+    # (1e-16) would reach 1e-8 under the square root, above the threshold, and no row would ever be in it.
+    outside = units - (units @ basis.T) @ basis
+    inside = np.ones(rows.shape[0], dtype=bool)
+    inside[lengths > 0.0] = np.linalg.norm(outside, axis=1) <= MOTION_RANK
+    return inside
 
 
 def ranges_are_wide(ranges: list[Range], tol: float = LP_FEASIBILITY) -> bool:
