@@ -6,6 +6,7 @@ deflections of a rigid body), not a solver output.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
@@ -482,3 +483,24 @@ def test_bad_urdf_joint_stiffness_is_one_error_line(tmp_path: Path, stiffness: o
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error:") and message in lines[0], result.stderr
+
+
+def test_the_viewers_live_resolve_keeps_springs_closing_time_and_joint_stiffness() -> None:
+    """The viewer re-solves the scene with its sliders' velocities; everything else must be the scene's own
+    (it once rebuilt the Scene from a few fields and dropped the springs, the closing time and joint stiffness)."""
+    pytest.importorskip("viser")
+    from quasistatic.viz import Velocities
+
+    scene = qs.load_scene(Path(__file__).resolve().parents[1] / "examples" / "compliant_grasp.yaml")
+    arm = qs.Robot("arm", [0.01, -0.02], joint_stiffness=[5.0, 7.0], torque_limits=[1.0, 2.0])
+    scene = dataclasses.replace(scene, robots=(arm,))
+    faster = Velocities({"arm": np.array([0.03, 0.04])}, {m.name: np.ones(3) * 0.001 for m in scene.movers if m.robot is None})
+    live = faster.applied(scene)
+    assert isinstance(live, qs.Scene)
+    assert live.stiffness == scene.stiffness and live.closing_time == scene.closing_time
+    assert [c.stiffness for c in live.contacts] == [c.stiffness for c in scene.contacts]
+    (robot,) = live.robots
+    assert robot.joint_velocities.tolist() == [0.03, 0.04]
+    assert robot.joint_stiffness is not None and robot.joint_stiffness.tolist() == [5.0, 7.0]
+    assert robot.torque_limits is not None and robot.torque_limits.tolist() == [1.0, 2.0]
+    assert all(np.allclose(m.twist, 0.001) for m in live.movers if m.robot is None)

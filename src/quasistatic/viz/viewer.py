@@ -25,7 +25,7 @@ import numpy as np
 
 from ..adapters import World
 from ..errors import QuasistaticError, SceneError
-from ..model import Mover, Robot, Scene
+from ..model import Robot, Scene
 from ..sim import Trajectory
 from ..solution import Motion, Solution
 from ..solve import solve, with_detection
@@ -67,19 +67,15 @@ class Velocities:
                 explicit_robots=tuple(self._robot(r) for r in scene.explicit_robots),
                 movers=tuple(dataclasses.replace(m, twist=self.movers.get(m.name, m.twist)) for m in scene.movers),
             )
-        return Scene(
-            scene.bodies,
-            scene.contacts,
-            movers=[Mover(m.name, self.movers.get(m.name, m.twist), m.origin, m.robot) for m in scene.movers],
-            robots=[self._robot(r) for r in scene.robots],
-            dimension=scene.dimension,
-            gravity=scene.gravity,
-            friction=scene.friction,
+        # Everything else (springs, closing time, joint stiffness, limits) is kept: the live answer is the scene's.
+        return dataclasses.replace(
+            scene,
+            movers=tuple(dataclasses.replace(m, twist=self.movers.get(m.name, m.twist)) for m in scene.movers),
+            robots=tuple(self._robot(r) for r in scene.robots),
         )
 
     def _robot(self, robot: Robot) -> Robot:
-        velocities = self.robots.get(robot.name, robot.joint_velocities)
-        return Robot(robot.name, velocities, joint_names=robot.joint_names, torque_limits=robot.torque_limits)
+        return dataclasses.replace(robot, joint_velocities=self.robots.get(robot.name, robot.joint_velocities))
 
 
 def _twist(twist: Any, dimension: int) -> np.ndarray:
