@@ -25,7 +25,7 @@ ALLOWED = {
     "check": {"model"},
     "solvers": {"model", "laws"},
     "adapters": {"model"},
-    "sim": {"model", "adapters", "laws", "solve", "loading"},
+    "sim": {"model", "adapters", "laws", "solve", "loading", "wedging"},
     "viz": {"model", "sim", "adapters", "solve"},  # solve: the viewer's live re-solve, through the public solve()
 }
 # The ways into viz/ from outside it, besides the CLI: the package root re-exports ``plot`` (matplotlib is

@@ -11,7 +11,12 @@ registry says they can do (``catalogue.methods``), never by name lists.
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import math
+import subprocess
+import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -20,6 +25,9 @@ from pytest import approx
 
 import quasistatic as qs
 from catalogue import G, Method, methods, puck_data, slope_data, wedge_data
+from quasistatic.wedging import wedging_friction
+
+QUASISTATIC = str(Path(sys.executable).with_name("quasistatic"))
 
 
 def floats(array: Any) -> list[float]:
@@ -150,3 +158,34 @@ def test_exact_motions_prove_ambiguity_when_another_does_not_refine() -> None:
     assert sol.status == "ambiguous", sol.message
     assert len(sol.solutions) >= 2 and all(m.audit.passed for m in sol.solutions)
     assert "incomplete" in sol.message or "incomplete" in sol.details.get("exact_cone", "")
+
+
+def test_a_wedged_jam_names_the_contacts_whose_friction_wedges_it(tmp_path: Path) -> None:
+    """The friction wedge (mu mu_f = 1.2 > 1): the finger's friction pushes the box down, the floor's holds it.
+    The console script names the contacts whose friction alone jams it, none of which can be spared; re-solving
+    checks both halves of that claim."""
+    scene_file = tmp_path / "wedge.json"
+    scene_file.write_text(json.dumps(wedge_data(1.2, 1.0)))
+    text = subprocess.run([QUASISTATIC, "solve", str(scene_file)], capture_output=True, text=True, check=True).stdout
+    assert "friction at contacts #0 (box/floor), #1 (box/floor), #2 (box/finger) wedges it" in " ".join(text.split())
+    answer = json.loads(
+        subprocess.run([QUASISTATIC, "solve", str(scene_file), "--json"], capture_output=True, text=True, check=True).stdout
+    )
+    assert answer["status"] == "jammed" and answer["diagnosis"] == "wedged"
+    assert answer["details"]["wedging_friction"] == [0, 1, 2]
+    scene = qs.load_scene(wedge_data(1.2, 1.0))
+    for spared in range(3):  # without friction at any one of them, the box moves
+        contacts = tuple(dataclasses.replace(c, mu=0.0) if i == spared else c for i, c in enumerate(scene.contacts))
+        assert qs.solve(dataclasses.replace(scene, contacts=contacts)).status != "jammed"
+
+
+def test_a_wedged_jam_leaves_out_friction_it_does_not_need() -> None:
+    """A second finger pad touching the box's top with friction, moving along with it, plays no part in the wedge
+    (made frictionless, the jam stays): it is not named."""
+    data = wedge_data(1.2, 1.0)
+    data["movers"]["pad"] = {"twist": [0.0, 0.0, 0.0]}
+    data["contacts"].append({"body": "box", "other": "pad", "point": [0.0, 0.1], "normal": [0.0, -1.0], "mu": 0.3})
+    scene = qs.load_scene(data)
+    solution = qs.solve(scene)
+    assert solution.status == "jammed" and solution.diagnosis is qs.Diagnosis.WEDGED
+    assert wedging_friction(scene) == (0, 1, 2)

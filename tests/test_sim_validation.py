@@ -272,6 +272,8 @@ def test_peg_jams_at_two_point_contact_inside_whitneys_region() -> None:
     assert abs(depth - _two_point_depth(theta)) < 0.25e-3
     assert depth < _whitney_limit(theta)  # inside Whitney's jamming region
     assert {c.other for c in trajectory.steps[-1].contacts} == {"left", "right", "pusher", "finger", "front", "back"}
+    # Whitney's two-point wedge: friction at the two walls holds the peg (the guides and fingertips are frictionless)
+    assert jam.detail.endswith("friction wedges it at: peg/left, peg/right")
 
 
 def _check_peg_slides_in(duration: float, dt: float) -> None:

@@ -117,8 +117,10 @@ def solve_command(
 def _solved(scene: Scene, detection: Detection | None, **options: Any) -> Solution:
     """The audited ``solve`` of ``scene``, with what detection found; the solvers are imported only here, when needed."""
     from .solve import solve, with_detection
+    from .wedging import with_wedging_friction
 
     solution = _guarded(lambda: solve(scene, **options))
+    solution = _guarded(lambda: with_wedging_friction(solution, scene, options.get("time_limit", 60.0)))
     return solution if detection is None else with_detection(solution, detection)
 
 

@@ -14,8 +14,9 @@ from ..adapters import World
 from ..errors import SceneError
 from ..loading import load_world
 from ..model import Scene
-from ..solution import CertificateKind
+from ..solution import CertificateKind, Diagnosis
 from ..tolerances import SIM_EVENT_TIME, ZERO
+from ..wedging import wedging_friction
 from .state import InputSource, InputTable, State, inputs_at
 from .step import AmbiguityPolicy, Evaluation, Event, SimModel, StepOptions, StepResult, advance, evaluate, moving, safe_step
 from .trajectory import RunStatus, Trajectory
@@ -202,9 +203,14 @@ def _modes_text(modes: tuple[str, ...]) -> str:
 
 
 def _blocking(evaluation: Evaluation) -> str:
-    """The contacts a kinematic jam's certificate (Farkas multipliers, one per contact) puts weight on."""
+    """The contacts a kinematic jam's certificate (Farkas multipliers, one per contact) puts weight on; for a
+    wedged jam, the contacts whose friction wedges it (:mod:`quasistatic.wedging`: a few re-solves, once a run)."""
     certificate = evaluation.solution.certificate
     contacts = evaluation.detection.contacts
+    if evaluation.solution.diagnosis is Diagnosis.WEDGED and evaluation.certified:
+        found = wedging_friction(evaluation.world.scene(evaluation.detection), evaluation.model.options.time_limit)
+        wedging = sorted({f"{contacts[i].body}/{contacts[i].other}" for i in found or ()})
+        return f"; friction wedges it at: {', '.join(wedging)}" if wedging else ""
     if certificate is None or certificate.kind is not CertificateKind.FARKAS or len(certificate.data) != len(contacts):
         return ""
     weights = np.asarray(certificate.data)
