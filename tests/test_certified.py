@@ -202,6 +202,19 @@ def _pulled_box(pull: float) -> qs.Scene:
     return qs.Scene(dimension=2, bodies=(box,), movers=(qs.Mover("table"),), contacts=supports, gravity=[pull, -9.81])
 
 
+def _pushed_box() -> qs.Scene:
+    """The box of :func:`_pulled_box`, unpulled, pushed at the height of its com by a frictionless fingertip."""
+    scene = _pulled_box(0.0)
+    finger = qs.Contact("box", "finger", point=[-0.05, 0.05], normal=[1.0, 0.0], mu=0.0)
+    return qs.Scene(
+        dimension=2,
+        bodies=scene.bodies,
+        movers=(qs.Mover("table"), qs.Mover("finger", twist=[0.01, 0.0, 0.0])),
+        contacts=(*scene.contacts, finger),
+        gravity=scene.gravity,
+    )
+
+
 def test_friction_forces_that_share_a_load_are_indeterminate() -> None:
     """A box on two supports pulled gently sideways stays at rest. Its normal forces are fixed (moments about the
     com: 4.405 and 5.405 N), but how the two supports share the 1 N pull is not: any split with each friction
@@ -228,18 +241,23 @@ def test_friction_forces_fixed_by_sliding_are_claimed_unique() -> None:
     """Pushed by a frictionless fingertip at the height of its com, the box slides; both friction forces are then mu
     times their normal forces, which the moments fix, and the push balances them: one force distribution, and
     the answer says so."""
-    scene = _pulled_box(0.0)
-    finger = qs.Contact("box", "finger", point=[-0.05, 0.05], normal=[1.0, 0.0], mu=0.0)
-    pushed = qs.Scene(
-        dimension=2,
-        bodies=scene.bodies,
-        movers=(qs.Mover("table"), qs.Mover("finger", twist=[0.01, 0.0, 0.0])),
-        contacts=(*scene.contacts, finger),
-        gravity=scene.gravity,
-    )
-    solution = qs.solve(pushed)
+    solution = qs.solve(_pushed_box())
     assert solution.status == "solved" and solution.certified and solution.twists["box"][0] == pytest.approx(0.01)
     assert not solution.forces_indeterminate and "with unique contact forces" in solution.message
     assert solution.motion.force_ranges is None
     forces = np.array([c.force for c in solution.contacts])[:2]
     assert forces[:, 0] == pytest.approx(-0.5 * forces[:, 1])
+
+
+@pytest.mark.parametrize("pushed, indeterminate", [(False, True), (True, False)])
+def test_the_ranges_decide_friction_indeterminacy_where_the_shortcuts_cannot(
+    monkeypatch: pytest.MonkeyPatch, pushed: bool, indeterminate: bool
+) -> None:
+    """With both shortcuts (the balanced point's segment, the relative interior's LP) undecided, the ranges decide:
+    a sideways pull shared by two supports is indeterminate, the sliding push's friction is not."""
+    from quasistatic.solvers.numerics import forces as forces_module
+
+    monkeypatch.setattr(forces_module, "_wide_through_balanced_point", lambda *args: False)
+    monkeypatch.setattr(forces_module, "_forces_vary", lambda *args: None)
+    solution = qs.solve(_pushed_box() if pushed else _pulled_box(1.0))
+    assert solution.status == "solved" and solution.forces_indeterminate is indeterminate

@@ -218,35 +218,51 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     masks = measured_masks(problem, edges, q)
     m, K = edges.shape[:2]
     normal = np.arange(m)  # the polytope's first columns
-    components = _component_rows(edges)
-    if min(problem.n_dof + m, m * (K + 2)) <= DENSE_MAX and _forces_fixed(problem, edges, q, masks, components):
+    if min(problem.n_dof + m, m * (K + 2)) <= DENSE_MAX and _forces_fixed(problem, edges, q, masks, _component_rows(edges)):
         return None  # decided densely, before any sparse matrix is built (~0.5 ms on a grasp)
     forces = forces_at_twist(problem, edges, q, masks)
     work = partial(_normal_ranges, forces, normal)
     if _wide_through_balanced_point(problem, masks, forces.polytope.K):
         return IndeterminateForces(None, work, forces)
     A = forces.A.toarray() if min(forces.A.shape) <= DENSE_MAX else forces.A.tocsc()
-    if not isinstance(A, np.ndarray) and _fixed_by_equations(A, forces.fixed, components):
+    if not isinstance(A, np.ndarray) and _fixed_by_equations(A, forces.fixed, None):
         return None
-    vary = _forces_vary(A, forces, components) if isinstance(A, np.ndarray) else None
+    vary = _forces_vary(A, forces, _component_rows(edges)) if isinstance(A, np.ndarray) else None
     if vary is not None:
         return IndeterminateForces(None, work, forces) if vary else None
     ranges = work()
-    if ranges_are_wide(list(ranges)):
-        return IndeterminateForces(ranges, None, forces)
-    friction = linear_ranges(forces.A, forces.rhs, components[m:], np.zeros(forces.fixed.size))
-    wide = any(lo is None or hi is None or hi - lo > LP_FEASIBILITY for lo, hi in friction)
+    wide = ranges_are_wide(list(ranges)) or _friction_varies(forces, edges)
     return IndeterminateForces(ranges, None, forces) if wide else None
+
+
+def _friction_varies(forces: ForcesAtTwist, edges: np.ndarray) -> bool:
+    """Whether some contact's tangential force spans more than ``LP_FEASIBILITY`` over the set (two LPs per component,
+    a few contacts' rows at a time: a large scene's rows all at once would be as large as the contacts squared)."""
+    m = edges.shape[0]
+    for start in range(0, m, DENSE_MAX):
+        rows = _tangent_rows(edges, np.arange(start, min(start + DENSE_MAX, m)))
+        spans = linear_ranges(forces.A, forces.rhs, rows, np.zeros(forces.fixed.size))
+        if any(lo is None or hi is None or hi - lo > LP_FEASIBILITY for lo, hi in spans):
+            return True
+    return False
 
 
 def _component_rows(edges: np.ndarray) -> np.ndarray:
     """Each contact-frame force component as a row over the force polytope's columns (normal, edges, slack):
-    the normal forces (m), then each contact's tangential components (m (d - 1)), ``sum_k beta_k edge_k``."""
+    the normal forces (m), then each contact's tangential components (m (d - 1)). Small sets only (dense)."""
+    m, K = edges.shape[:2]
+    normal = np.zeros((m, m * (K + 2)))
+    normal[np.arange(m), np.arange(m)] = 1.0
+    return np.vstack([normal, _tangent_rows(edges, np.arange(m))])
+
+
+def _tangent_rows(edges: np.ndarray, contacts: np.ndarray) -> np.ndarray:
+    """The tangential force components of ``contacts`` (``sum_k beta_k edge_k``, d - 1 each) as rows over the columns."""
     m, K, t = edges.shape
-    rows = np.zeros((m + m * t, m * (K + 2)))
-    rows[np.arange(m), np.arange(m)] = 1.0
-    contact, edge, axis = np.meshgrid(np.arange(m), np.arange(K), np.arange(t), indexing="ij")
-    rows[m + contact * t + axis, m + contact * K + edge] = edges[contact, edge, axis]
+    rows = np.zeros((contacts.size * t, m * (K + 2)))
+    at, edge, axis = np.meshgrid(np.arange(contacts.size), np.arange(K), np.arange(t), indexing="ij")
+    contact = contacts[at]
+    rows[at * t + axis, m + contact * K + edge] = edges[contact, edge, axis]
     return rows
 
 
@@ -332,11 +348,13 @@ def _forces_fixed(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: Mod
     return _fixed_by_equations(A, fixed, components)
 
 
-def _fixed_by_equations(A: np.ndarray | sp.spmatrix, fixed: np.ndarray, components: np.ndarray) -> bool:
+def _fixed_by_equations(A: np.ndarray | sp.spmatrix, fixed: np.ndarray, components: np.ndarray | None) -> bool:
     """Free columns of full rank (one force distribution), or every force component a combination of the equations
     (only the edge intensities vary, as both edges of a 2-D contact that sticks: the ranges' LPs would find each
-    component constant). ``components``: :func:`_component_rows`."""
-    return full_column_rank(A[:, ~fixed], FORCE_RANK) or bool(np.all(rows_in_row_space(A, components)))
+    component constant). ``components``: :func:`_component_rows`; None (a large set): the rank alone decides."""
+    if full_column_rank(A[:, ~fixed], FORCE_RANK):
+        return True
+    return components is not None and bool(np.all(rows_in_row_space(A, components)))
 
 
 def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ...]:
