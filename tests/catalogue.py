@@ -82,6 +82,9 @@ class Expected:
     normal_force_ranges : tuple of (lo, hi or None) or None
         When the normal forces are indeterminate: each contact's range over every
         force distribution consistent with the motion (hi None: unbounded).
+    friction_indeterminate : bool
+        The normal forces are unique but the friction forces are not (two contacts share a load
+        along the line through them): the forces are indeterminate all the same.
     continuum, unbounded : bool
         The motion stands for a continuum of motions (that extends to infinity).
     extremes : tuple of mappings body -> tuple of float
@@ -96,6 +99,7 @@ class Expected:
     modes: tuple[str, ...] | None = None
     normal_forces: tuple[float | None, ...] | None = None
     normal_force_ranges: tuple[tuple[float, float | None], ...] | None = None
+    friction_indeterminate: bool = False
     continuum: bool = False
     unbounded: bool = False
     extremes: tuple[Mapping[str, Sequence[float]], ...] = ()
@@ -539,9 +543,12 @@ def _slope_rest() -> Case:
         neither slides nor tips. Slope frame (x uphill): total friction M g sin a = 3.355 N uphill,
         total normal M g cos a = 9.218 N; moments about the com (corners at x = -+w/2, y = -h/2):
         (N2 - N1) w/2 + F h/2 = 0 with F = M g sin a, so N1 - N2 = F h/w = 1.678 N:
-        N1 = M g (cos a + (h/w) sin a)/2 = 5.448 N (downhill corner), N2 = 3.770 N. Both rolling.""",
+        N1 = M g (cos a + (h/w) sin a)/2 = 5.448 N (downhill corner), N2 = 3.770 N. Both rolling.
+        The friction is shared: F1 + F2 = F fixes only the sum (both act along the line of the
+        corners, so the moments do not split it), and any split within the cones holds: the forces
+        are indeterminate, with fixed normal forces.""",
         "solved",
-        Expected(_twist([0, 0, 0]), ("rolling", "rolling"), (n1, n2), power_input=0.0),
+        Expected(_twist([0, 0, 0]), ("rolling", "rolling"), (n1, n2), power_input=0.0, friction_indeterminate=True),
     )
 
 
