@@ -125,6 +125,9 @@ def test_cylinder_rolls_between_opposed_fingers_among_equal_power_motions() -> N
     np.testing.assert_allclose(rolling[0].twists["roller"], [0, 0, 0, 0, ROLLING_SPIN, 0], atol=1e-9)
     assert all(any(c.mode == "sliding" for c in m.contacts) for m in motions if m is not rolling[0])
     np.testing.assert_allclose([m.power.input for m in motions], 0.0, atol=1e-9)
+    # min_power cannot choose among them, and the run's record says so
+    others = ", ".join(str(i) for i in range(2, len(motions) + 1))
+    assert evaluation.choice.startswith(f"ambiguous: took motion 1 of {len(motions)}, the least input power; motions {others} tie with it")
 
 
 # --------------------------------------------------------------------------- against MuJoCo

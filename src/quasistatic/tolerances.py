@@ -282,6 +282,12 @@ SIM_EVENT_TIME = 1.0 / 64.0
 of the time step [-]: the step where it happens is bisected until the event lies in a window this wide.
 """
 
+SIM_POWER_TIE = 1e-9
+"""Input powers of an ambiguous answer's motions that differ by less than this, relative to the largest power
+of any listed motion, tie for the least (``ambiguous="min_power"``) [-]: the choice among them is then not the rule's, and the
+run records which motions tied.
+"""
+
 # --------------------------------------------------------------------------- input limits (what a scene may hold at all)
 
 MAX_MAGNITUDE = 1e30

@@ -23,7 +23,7 @@ from ..errors import SceneError
 from ..model import Contact
 from ..solution import Mode, Motion, Solution, Status
 from ..solve import solve
-from ..tolerances import SIM_APPROACH, SIM_LOOKAHEAD, SIM_PENETRATION
+from ..tolerances import SIM_APPROACH, SIM_LOOKAHEAD, SIM_PENETRATION, SIM_POWER_TIE
 from .rigid import advance_pose, point_velocity
 from .state import Inputs, State
 
@@ -244,7 +244,12 @@ def _chosen(solution: Solution, policy: AmbiguityPolicy) -> tuple[Motion | None,
     motions = solution.solutions
     best = min(range(len(motions)), key=lambda i: motions[i].power.input)
     complete = "" if solution.search_complete else " (the list is not proven complete)"
-    return motions[best], f"ambiguous: took motion {best + 1} of {len(motions)}, the least input power{complete}"
+    # Ties are judged on the powers' own scale (every power of every listed motion): a zero-power tie is exact.
+    scale = max(max(abs(m.power.input), abs(m.power.gravity), abs(m.power.dissipation)) for m in motions)
+    least = motions[best].power.input
+    tied = [i for i, m in enumerate(motions) if i != best and m.power.input - least <= SIM_POWER_TIE * scale]
+    tie = f"; motions {', '.join(str(i + 1) for i in tied)} tie with it, and the first listed was taken" if tied else ""
+    return motions[best], f"ambiguous: took motion {best + 1} of {len(motions)}, the least input power{tie}{complete}"
 
 
 # --------------------------------------------------------------------------- penetration
