@@ -189,3 +189,47 @@ def test_a_wedged_jam_leaves_out_friction_it_does_not_need() -> None:
     solution = qs.solve(scene)
     assert solution.status == "jammed" and solution.diagnosis is qs.Diagnosis.WEDGED
     assert wedging_friction(scene) == (0, 1, 2)
+
+
+def _fall_checks(scene: qs.Scene, twist: np.ndarray) -> None:
+    """A Farkas twist of "no equilibrium", checked from the scene data alone: the load does work along it, and at
+    every contact its velocity lies in the friction cone's dual (u_n >= mu |u_t|), where no force in the cone
+    takes work away."""
+    body = scene.bodies[0]
+    d = scene.dimension
+    v, w = twist[:d], twist[d:]
+    weight = body.mass * scene.gravity
+    assert float(weight @ v) > 1e-6
+    for contact in scene.contacts:
+        r = contact.point - body.com
+        u = v + (w[0] * np.array([-r[1], r[0]]) if d == 2 else np.cross(w, r))
+        u_n = float(u @ contact.normal)
+        u_t = np.linalg.norm(u - u_n * contact.normal)
+        assert u_n >= contact.mu * u_t - 1e-9, (u_n, u_t)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_an_unstable_answer_names_a_direction_no_contact_force_resists(dimension: int) -> None:
+    """A block on a 30 degree slope with mu = 0.5 < tan 30: no equilibrium. The certificate carries a twist along
+    which the weight does work and every contact opens inside its cone's dual, so no contact force can take that
+    work away (with exact 3-D cones, proven through a polygon around each circle)."""
+    scene = qs.load_scene(slope_data(30.0)) if dimension == 2 else _extruded(slope_data(30.0))
+    solution = qs.solve(scene)
+    assert solution.status == "unstable" and solution.certified
+    assert solution.certificate is not None and solution.certificate.kind is qs.CertificateKind.INFEASIBLE_EQUILIBRIUM
+    twist = np.asarray(solution.certificate.data, dtype=float)
+    assert twist.size == (3 if dimension == 2 else 6) and np.max(np.abs(twist)) == pytest.approx(1.0)
+    _fall_checks(scene, twist)
+
+
+def _extruded(data: dict[str, Any]) -> qs.Scene:
+    from quasistatic.tools.validation import extrude
+
+    return qs.load_scene(extrude(data, 0.1))
+
+
+def test_the_console_script_says_which_way_an_unstable_block_goes(tmp_path: Path) -> None:
+    scene_file = tmp_path / "slope.json"
+    scene_file.write_text(json.dumps(slope_data(30.0)))
+    text = subprocess.run([QUASISTATIC, "solve", str(scene_file)], capture_output=True, text=True, check=True).stdout
+    assert "the load does work along the twist" in " ".join(text.split())

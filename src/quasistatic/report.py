@@ -147,6 +147,9 @@ def _explain(certificate: Certificate) -> str:
         return f"blocking contacts: {listed} (the commanded motion would push the movers into the bodies there)"
     if certificate.kind is CertificateKind.RAY:
         return f"it falls or accelerates along the twist (v, ω of each body, largest entry 1): {format_vector(certificate.data)}"
+    if certificate.kind is CertificateKind.INFEASIBLE_EQUILIBRIUM and certificate.data:
+        twist = format_vector(certificate.data)
+        return f"the load does work along the twist (v, ω of each body, largest entry 1) {twist}, which no force in the cones resists"
     return ""
 
 

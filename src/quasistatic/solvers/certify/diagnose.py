@@ -12,13 +12,13 @@ from __future__ import annotations
 import numpy as np
 
 from ...laws import Problem
-from ...laws.polyhedral import force_polytope
+from ...laws.polyhedral import edge_jacobian, force_polytope
 from ...solution import Certificate, CertificateKind, Diagnosis, Status
 from ...tolerances import LP_FEASIBILITY
 from ..numerics.highs import solve_lp
 from ..result import BackendResult
 
-__all__ = ["diagnose", "equilibrium_exists", "kinematic_certificate", "MESSAGES", "no_motion"]
+__all__ = ["diagnose", "equilibrium_exists", "kinematic_certificate", "MESSAGES", "no_equilibrium_certificate", "no_motion"]
 
 MESSAGES = {
     Diagnosis.KINEMATIC: (
@@ -36,6 +36,9 @@ MESSAGES = {
     ),
 }
 """The message of each diagnosis (one sentence a person can act on)."""
+
+
+NO_EQUILIBRIUM_TEXT = "no equilibrium in the friction cones (LP infeasible)"
 
 
 def no_motion(diagnosis: Diagnosis, certificate: Certificate) -> BackendResult:
@@ -64,6 +67,38 @@ def equilibrium_exists(problem: Problem, edges: np.ndarray) -> bool:
     return lp.status == "optimal"
 
 
+def no_equilibrium_certificate(problem: Problem, edges: np.ndarray, text: str = NO_EQUILIBRIUM_TEXT) -> Certificate:
+    """Why no force in the cones spanned by ``edges`` balances the load, with the direction of the fall when it checks.
+
+    Farkas: no ``c >= 0`` on the cones' generators ``w`` (each normal plus mu times an edge, in wrench
+    space) with ``sum c w = -g`` exactly when some twist ``y`` has ``w . y >= 0`` for every generator and
+    ``g . y > 0``: along ``y`` the load does work and no contact force in the cones can take it away. That
+    twist (in physical units, largest entry 1) is the certificate's data; a cone that holds the true one
+    (the exact 3-D cone inside a circumscribed polygon) proves the same of the true cone.
+    """
+    generators = _generator_rows(problem, edges)
+    m, n = generators.shape
+    lp = solve_lp(problem.g, generators, np.zeros(m), np.full(m, np.inf), np.full(n, -1.0), np.full(n, 1.0), maximize=True)
+    if lp.status != "optimal" or lp.objective <= LP_FEASIBILITY or np.any(generators @ lp.x < -LP_FEASIBILITY * lp.objective):
+        return Certificate(CertificateKind.INFEASIBLE_EQUILIBRIUM, text)
+    units = np.tile(problem.scales.twist_units(problem.dimension), len(problem.scene.bodies))
+    physical = lp.x * units
+    direction = physical / np.max(np.abs(physical))
+    text += "; data: a twist along which the load does work that no force in the cones resists (v, omega of each body, largest entry 1)"
+    return Certificate(CertificateKind.INFEASIBLE_EQUILIBRIUM, text, tuple(direction.tolist()))
+
+
+def _generator_rows(problem: Problem, edges: np.ndarray) -> np.ndarray:
+    """Each cone generator's wrench on the bodies as a row (normal, or normal plus mu times each edge), (rows, n)."""
+    m, K = edges.shape[:2]
+    frictional = (problem.mu > 0.0) & (K > 0)
+    rows = [problem.Jn[~frictional]]
+    if np.any(frictional):
+        edge_rows = edge_jacobian(problem, edges).reshape(m, K, -1)[frictional]
+        rows.append((problem.Jn[frictional, None, :] + problem.mu[frictional, None, None] * edge_rows).reshape(-1, problem.n_dof))
+    return np.vstack(rows)
+
+
 def diagnose(problem: Problem, inner_edges: np.ndarray, outer_edges: np.ndarray | None = None) -> BackendResult:
     """Explain why no motion exists. ``inner_edges`` span cones inside the true ones.
 
@@ -79,8 +114,7 @@ def diagnose(problem: Problem, inner_edges: np.ndarray, outer_edges: np.ndarray 
         text = "equilibrium exists; no motion found by the complete search"
         return no_motion(Diagnosis.WEDGED, Certificate(CertificateKind.COMPLETE_SEARCH, text))
     if outer_edges is None or not equilibrium_exists(problem, outer_edges):
-        text = "no equilibrium in the friction cones (LP infeasible)"
-        return no_motion(Diagnosis.NO_EQUILIBRIUM, Certificate(CertificateKind.INFEASIBLE_EQUILIBRIUM, text))
+        return no_motion(Diagnosis.NO_EQUILIBRIUM, no_equilibrium_certificate(problem, inner_edges if outer_edges is None else outer_edges))
     return BackendResult(
         "failed",
         "failed: no motion was found, and whether the exact cones admit an equilibrium is too close to call",

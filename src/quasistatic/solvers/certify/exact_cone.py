@@ -49,7 +49,7 @@ from ...tolerances import (
 )
 from ..numerics.forces import least_normal_forces
 from ..result import BackendResult, Options
-from .diagnose import diagnose, equilibrium_exists, no_motion
+from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
 from .min_power import solve_min_power
 from .search import enumerate_motions, summarise
 from .wedge import exact_cones_jam
@@ -136,7 +136,7 @@ def _equilibrium_verdict(problem: Problem, count: int) -> BackendResult:
     edges = aligned_edges(problem, count)
     if not equilibrium_exists(problem, edges / np.cos(np.pi / count)):
         text = f"no equilibrium in {count}-edge pyramids around the exact cones"
-        return no_motion(Diagnosis.NO_EQUILIBRIUM, Certificate(CertificateKind.INFEASIBLE_EQUILIBRIUM, text))
+        return no_motion(Diagnosis.NO_EQUILIBRIUM, no_equilibrium_certificate(problem, edges / np.cos(np.pi / count), text))
     return BackendResult(
         "failed",
         f"failed: no motion was found, and whether the exact cones admit an equilibrium is too close to call "
