@@ -85,10 +85,18 @@ def point_from_solution(index: int, values: Sequence[float], refinement: bool, s
         message=solution.message,
         motions=motions,
         twists=tuple((name, _floats(t)) for name, t in solution.twists.items()),
-        forces=tuple(_floats(c.force) for c in solution.contacts),
+        forces=_point_forces(solution),
         modes=tuple(solution.modes),
         seconds=float(solution.seconds),
     )
+
+
+def _point_forces(solution: Solution) -> tuple[tuple[float, ...], ...]:
+    """The reported motion's contact forces, without working out force ranges (a sweep keeps none)."""
+    if solution.motion is None:
+        return ()
+    forces, _ = solution.motion.forces_and_slips()
+    return tuple(_floats(f) for f in forces)
 
 
 @dataclass(frozen=True)
