@@ -66,7 +66,7 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
         if proof.verdict is PatternVerdict.ENUMERATED:
             return summarise(form, list(proof.motions), True, options).with_notes(certificate=ENUMERATION_PROOF)
         if proof.verdict is PatternVerdict.NONE:
-            return diagnose(problem, edges).with_notes(certificate=NO_MOTION_PROOF)
+            return diagnose(problem, edges, equilibrium=proof.equilibrium).with_notes(certificate=NO_MOTION_PROOF)
     return certified_polyhedral(problem, edges, options, seed)
 
 

@@ -45,9 +45,30 @@ If every node is pruned the search is complete: every motion's twist is ``q*``
 (to ``SAME_TWIST`` exactly, to ``DISTINCT_TWIST / 2`` within the tolerance,
 which is the box the SCIP search excludes around a found motion), and no mode
 assignment holds a continuum. Without a seed, a closed tree proves that no
-motion exists. A surviving leaf (another motion, or a case too close to call)
-or more than :data:`PATTERN_NODES` nodes gives no answer: the caller runs the
-SCIP search instead, unchanged.
+motion exists.
+
+**Listing every motion.** A leaf that survives is one full mode assignment,
+so its motions are exactly ``Q x F`` (no node below it), with ``F`` non-empty
+(its non-negative fit balances the load). Its twist set ``Q`` is measured by
+``2 n`` LPs (the least and largest of each twist entry): empty (pruned), one
+twist (a single motion, as when the closed rows pin it), or a continuum: its
+extremes (the LPs' optima, distinct to ``SAME_TWIST``), the entries that run
+to infinity, and a point inside it. Every twist listed is paired with the
+leaf's forces and checked on every law of the form (:func:`~.cheap.satisfies_form`);
+``Q x F`` is a product, so each of these pairs is a motion. A single twist
+within ``DISTINCT_TWIST`` of one listed, or on a listed continuum's rows, is
+not listed again (the SCIP search excludes the same box around a motion it
+found), nor a continuum with the same extremes. Completeness: every motion
+lies in some leaf's ``Q x F``; every leaf is either pruned (its ``F`` or ``Q``
+empty, or its twists the seed's, which is listed) or listed as above. So the
+list holds every motion, to the tolerances above; the seed is listed first,
+unless a listed continuum holds it.
+
+A leaf whose point or extremes fail the form's check (too close to call), an
+LP that does not answer, more motions than asked for, or more than
+:data:`PATTERN_NODES` nodes give no answer: the caller runs the SCIP search
+instead, unchanged, which lists as many as asked and says when the list may be
+incomplete.
 """
 
 from __future__ import annotations
@@ -95,6 +116,7 @@ class PatternProof:
     nodes: int = 0
     lps: int = 0
     motions: tuple[RawMotion, ...] = ()
+    equilibrium: bool | None = None  # at the root: True, a balancing fit; False, a checked Farkas vector; None, neither
 
 
 @dataclass
@@ -199,6 +221,7 @@ def prove_by_patterns(form: LCPForm, seed_x: np.ndarray | None, max_motions: int
     m = problem.n_contacts
     root = _Node(np.zeros(4 * m, dtype=bool), np.arange(4 * m) < m, np.ones(2 * m, dtype=bool), 0)
     fit = _forces(rows, root.columns, None)
+    rows.proof.equilibrium = False if fit is None else _balances(rows, fit)
     closed = fit is None or _search(rows, root, fit, _UNKNOWN)
     rows.proof.verdict = _verdict(rows, closed)
     return rows.proof
@@ -430,13 +453,23 @@ def _possible_modes(rows: _Rows, contact: int, ball: _Ball | None) -> tuple[int,
     return (*modes, _SEPARATING)
 
 
+def _margin(rows: _Rows) -> float:
+    """How far from the load a balancing fit may be (``LP_FEASIBILITY`` per row) [-]."""
+    return math.sqrt(rows.g.size) * LP_FEASIBILITY
+
+
+def _balances(rows: _Rows, fit: np.ndarray) -> bool | None:
+    """True when ``fit`` balances the load within the margin; None when it only failed to be excluded."""
+    return True if float(np.linalg.norm(rows.loads @ fit + rows.g)) <= _margin(rows) else None
+
+
 def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndarray | None:
     """Non-negative forces on ``columns`` balancing the load within the margin, or None with a checked Farkas vector:
     then no forces on them (sum below FORCE_CEILING) leave ``|G lam + g|`` below ``LP_FEASIBILITY`` per row.
 
     ``fit``: the parent's forces; kept when they use none of the columns taken away.
     """
-    margin = math.sqrt(rows.g.size) * LP_FEASIBILITY
+    margin = _margin(rows)
     if fit is not None and not fit[~columns].any():
         return fit
     G = rows.loads[:, columns]
