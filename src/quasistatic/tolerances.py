@@ -30,6 +30,7 @@ __all__ = [
     "MOTION_RANK",
     "LP_FEASIBILITY",
     "FORCE_CEILING",
+    "FORCE_INTERIOR",
     "PATTERN_NODES",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
@@ -131,6 +132,13 @@ FORCE_CEILING = 1e6
 ``G^T y <= 0`` is met to round-off (1e-16 of the load) only, which rules out every equilibrium with forces below
 ``LP_FEASIBILITY / round-off``; a million times the scene's force scale is past what SCIP itself resolves, whose
 equilibrium rows are met to ``LP_FEASIBILITY`` (at 1e6 that is a tenth of the load)."""
+
+FORCE_INTERIOR = 1e-3
+"""Least value, relative to the load's largest scene-relative entry, that a point of a motion's consistent force
+set is asked to give every column not forced to zero, when one is sought by NNLS to decide whether the normal
+forces vary (:mod:`quasistatic.solvers.numerics.forces`) [-]. Not a tolerance on any law: a point this far inside
+lets steps along the set's directions move a normal force by more than ``LP_FEASIBILITY``; where NNLS finds none
+(a column the set holds near zero), one LP decides, as it always did."""
 
 PATTERN_NODES = 512
 """Most nodes of the planar mode branch and bound (:mod:`quasistatic.solvers.certify.patterns`) before it gives

@@ -64,6 +64,7 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
             motion = RawMotion(proof.seed[: form.n_q], form.forces(proof.seed))
             return summarise(form, [motion], True, options).with_notes(certificate=PATTERN_PROOF)
         if proof.verdict is PatternVerdict.ENUMERATED:
+            options.report(len(proof.motions), proof.nodes)  # as the SCIP search reports its steps
             return summarise(form, list(proof.motions), True, options).with_notes(certificate=ENUMERATION_PROOF)
         if proof.verdict is PatternVerdict.NONE:
             return diagnose(problem, edges, equilibrium=proof.equilibrium).with_notes(certificate=NO_MOTION_PROOF)

@@ -56,13 +56,15 @@ extremes (the LPs' optima, distinct to ``SAME_TWIST``), the entries that run
 to infinity, and a point inside it. Every twist listed is paired with the
 leaf's forces and checked on every law of the form (:func:`~.cheap.satisfies_form`);
 ``Q x F`` is a product, so each of these pairs is a motion. A single twist
-within ``DISTINCT_TWIST`` of one listed, or on a listed continuum's rows, is
-not listed again (the SCIP search excludes the same box around a motion it
-found), nor a continuum with the same extremes. Completeness: every motion
+within ``DISTINCT_TWIST`` of one listed is not listed again (the SCIP search
+excludes the same box around a motion it found), nor one on a listed
+continuum's rows whose forces cannot leave the continuum's (one LP; the
+search excludes a continuum's polyhedron by the same margin), nor a continuum
+with the same extremes. Completeness: every motion
 lies in some leaf's ``Q x F``; every leaf is either pruned (its ``F`` or ``Q``
 empty, or its twists the seed's, which is listed) or listed as above. So the
 list holds every motion, to the tolerances above; the seed is listed first,
-unless a listed continuum holds it.
+unless a listed continuum holds it with the continuum's own contact modes.
 
 A leaf whose point or extremes fail the form's check (too close to call), an
 LP that does not answer, more motions than asked for, or more than
@@ -80,10 +82,10 @@ from enum import Enum
 import numpy as np
 from scipy.optimize import nnls
 
-from ...laws import Problem, RawMotion
+from ...laws import Problem, RawMotion, contact_modes
 from ...laws.polyhedral import LCPForm
 from ...tolerances import DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, MOTION_RANK, PATTERN_NODES, SAME_TWIST, ZERO
-from ..numerics.highs import WarmLP
+from ..numerics.highs import WarmLP, solve_lp
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
@@ -158,20 +160,18 @@ class _Node:
     closed_rows: int = 0  # how many entries of ``equal`` are set
 
     def child(self, rows: _Rows, contact: int, mode: int) -> _Node:
-        m = rows.m
-        equal, at_least, columns = self.equal.copy(), self.at_least.copy(), self.columns.copy()
+        columns = self.columns.copy()
         columns[2 * contact : 2 * contact + 2] &= _EDGES_OF[mode]
-        closed_rows = self.closed_rows
-        if mode == _CLOSED:
-            at_least[contact], equal[contact] = False, True
-            return _Node(equal, at_least, columns, self.depth + 1, closed_rows + 1)
-        if mode != _SEPARATING:
-            at_least[contact], equal[contact] = False, True
-            closed_rows += 1
+        if mode == _SEPARATING:  # a free contact's twist rows: the parent's arrays, shared (no node writes them)
+            return _Node(self.equal, self.at_least, columns, self.depth + 1, self.closed_rows)
+        m = rows.m
+        equal, at_least = self.equal.copy(), self.at_least.copy()
+        at_least[contact], equal[contact] = False, True
+        closed_rows = self.closed_rows + 1
         if mode == _ROLLING:
             equal[m + contact] = True
             closed_rows += 1
-        elif mode != _SEPARATING:
+        elif mode != _CLOSED:
             at_least[(2 if mode == _SLIDE_PLUS else 3) * m + contact] = True
         return _Node(equal, at_least, columns, self.depth + 1, closed_rows)
 
@@ -235,8 +235,8 @@ def _verdict(rows: _Rows, closed: bool) -> PatternVerdict:
     if not rows.found:
         return PatternVerdict.NONE if seed_x is None else PatternVerdict.UNIQUE
     found = list(rows.found)
-    if seed_x is not None and not any(f.holds(rows.seed) for f in found):  # the seed, unless on a continuum listed
-        found.insert(0, _Found(RawMotion(seed_x[: rows.form.n_q], rows.form.forces(seed_x))))
+    if seed_x is not None and not any(_on_continuum(rows, f, rows.seed) for f in found):  # unless a continuum has it
+        found.insert(0, _Found(RawMotion(seed_x[: rows.form.n_q], rows.form.forces(seed_x)), np.zeros(0, dtype=bool)))
     if len(found) > rows.max_motions:
         return PatternVerdict.UNDECIDED  # the SCIP search lists as many as asked and says the list is incomplete
     rows.proof.motions = tuple(f.motion for f in found)
@@ -281,7 +281,7 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
             if child_twists.point and child_twists.ball is not None and _adopted(rows, child_twists.ball.center, child_fit):
                 continue
             if child_twists.point and child_twists.ball is not None:
-                listed = _record_point(rows, child_twists.ball.center, child_fit)
+                listed = _record_point(rows, child_twists.ball.center, child_fit, child.columns)
             else:
                 listed = _record_polyhedron(rows, child, child_fit)
             if not listed:
@@ -337,31 +337,26 @@ class _Found:
     twists it holds."""
 
     motion: RawMotion
+    columns: np.ndarray  # the leaf's force columns (a unit normal force on each edge it keeps)
     region: _Region | None = None
 
-    def holds(self, q: np.ndarray | None) -> bool:
-        """Whether twist ``q`` meets this continuum's rows, each loosened by ``LP_FEASIBILITY``."""
-        if q is None or self.region is None:
-            return False
-        E, e, A, a = self.region
-        return bool(np.all(np.abs(E @ q - e) <= LP_FEASIBILITY) and np.all(A @ q - a >= -LP_FEASIBILITY))
 
-
-def _record_point(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> bool:
+def _record_point(rows: _Rows, q: np.ndarray, fit: np.ndarray, columns: np.ndarray) -> bool:
     """A leaf's one twist ``q`` with forces ``fit``: listed unless a listed motion has it; False when its point
     fails a law of the form (too close to call) or there are too many motions."""
     x = _form_point(rows, q, fit)
     if x is None:
         return False
-    if not _known_point(rows, q):
-        rows.found.append(_Found(RawMotion(q, rows.form.forces(x))))
+    if not _known_point(rows, q, columns):
+        rows.found.append(_Found(RawMotion(q, rows.form.forces(x)), columns))
     return len(rows.found) <= rows.max_motions
 
 
-def _known_point(rows: _Rows, q: np.ndarray) -> bool:
-    """Whether twist ``q`` is within ``DISTINCT_TWIST`` of a listed single motion, or on a listed continuum."""
+def _known_point(rows: _Rows, q: np.ndarray, columns: np.ndarray) -> bool:
+    """Whether twist ``q`` (forces on ``columns``) is within ``DISTINCT_TWIST`` of a listed single motion, or
+    every such motion is a listed continuum's (:func:`_holds`)."""
     for found in rows.found:
-        if found.holds(q):
+        if found.region is not None and _holds(rows, found, q, columns):
             return True
         motion = found.motion
         if not motion.continuum and float(np.max(np.abs(motion.q - q))) <= DISTINCT_TWIST:
@@ -397,28 +392,61 @@ def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
     if not free and seed is not None and all(np.max(np.abs(p - seed)) <= 0.5 * SAME_TWIST for p in extremes):
         return True  # the seed's twist alone
     if not free and len(extremes) == 1:
-        return _record_point(rows, extremes[0], fit)
-    return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit)
+        return _record_point(rows, extremes[0], fit, node.columns)
+    return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit, node.columns)
 
 
-def _record_continuum(rows: _Rows, region: _Region, extremes: list[np.ndarray], free: tuple[int, ...], fit: np.ndarray) -> bool:
+def _record_continuum(
+    rows: _Rows, region: _Region, extremes: list[np.ndarray], free: tuple[int, ...], fit: np.ndarray, columns: np.ndarray
+) -> bool:
     """A leaf's continuum (see :func:`_record_polyhedron`), listed unless one with the same extremes is."""
     E, e, A, a = region
     n = rows.g.size
     inside = relative_interior_point(E, e, A, a, np.full(n, -np.inf), np.full(n, np.nan))  # NaN: no point found
+    if not free:
+        # The slack-maximising point may be a vertex (its slacks' caps do not bind in scene units): averaged with
+        # the extremes, it is inside the segment or polygon they span, so its modes are the continuum's own.
+        inside = np.mean([inside, *extremes], axis=0)
     x = _form_point(rows, inside, fit) if np.all(np.isfinite(inside)) else None
     if x is None or any(_form_point(rows, p, fit) is None for p in extremes):
         return False
     motion = RawMotion(inside, rows.form.forces(x), tuple(extremes), bool(free), free)
     if not any(_same_continuum(motion, f.motion) for f in rows.found):
-        rows.found[:] = [f for f in rows.found if not _on_region(region, f)]  # single motions it holds
-        rows.found.append(_Found(motion, region))
+        listed = _Found(motion, columns, region)
+        rows.found[:] = [f for f in rows.found if f.motion.continuum or not _holds(rows, listed, f.motion.q, f.columns)]
+        rows.found.append(listed)
     return len(rows.found) <= rows.max_motions
 
 
-def _on_region(region: _Region, found: _Found) -> bool:
-    """Whether ``found`` is a single motion on the continuum of ``region``."""
-    return not found.motion.continuum and _Found(found.motion, region).holds(found.motion.q)
+def _holds(rows: _Rows, found: _Found, q: np.ndarray, columns: np.ndarray) -> bool:
+    """Whether the continuum ``found`` holds every motion of twist ``q`` and forces on ``columns`` (a leaf's):
+    ``q`` meets its rows (each loosened by ``LP_FEASIBILITY``), and no balancing forces on ``columns`` put more
+    than ``DISTINCT_TWIST`` on a column the continuum's leaf does not keep (one LP; the SCIP search excludes a
+    continuum's polyhedron by the same margin). A twist on its boundary whose forces may leave it (both fingers
+    rolling at the end of a drag, with a harder squeeze) is a motion of its own, as the SCIP search lists it."""
+    assert found.region is not None
+    E, e, A, a = found.region
+    if not (np.all(np.abs(E @ q - e) <= LP_FEASIBILITY) and np.all(A @ q - a >= -LP_FEASIBILITY)):
+        return False
+    extra = columns & ~found.columns
+    if not extra.any():
+        return True
+    G = rows.loads[:, columns]
+    rows.proof.lps += 1
+    lp = solve_lp(extra[columns].astype(float), G, -rows.g, -rows.g, np.zeros(G.shape[1]), maximize=True)
+    return lp.status == "optimal" and lp.objective <= DISTINCT_TWIST
+
+
+def _on_continuum(rows: _Rows, found: _Found, q: np.ndarray | None) -> bool:
+    """Whether twist ``q`` is one of the continuum ``found``'s own: it meets the continuum's rows (each loosened by
+    ``LP_FEASIBILITY``) with the contact modes of the continuum's inner point. A twist on its boundary with other
+    modes (both fingers rolling at the end of a slip) is a motion of its own, as the SCIP search lists it."""
+    if q is None or found.region is None:
+        return False
+    E, e, A, a = found.region
+    inside = np.all(np.abs(E @ q - e) <= LP_FEASIBILITY) and np.all(A @ q - a >= -LP_FEASIBILITY)
+    problem = rows.form.problem
+    return bool(inside) and contact_modes(problem, q) == contact_modes(problem, found.motion.q)
 
 
 def _same_continuum(motion: RawMotion, other: RawMotion) -> bool:
@@ -557,7 +585,7 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     """
     n = rows.g.size
     E, e = rows.bank[equal], rows.rhs[equal]
-    u, sigma, vt = np.linalg.svd(E)
+    u, sigma, vt = np.linalg.svd(E, full_matrices=k < n)  # a line's direction is the last row of the full vt
     if sigma[-1] <= MOTION_RANK or k > n and sigma[n - 1] <= MOTION_RANK:
         return _UNKNOWN
     r = min(k, n)

@@ -23,10 +23,11 @@ from functools import cached_property, partial
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.optimize import nnls
 
 from ...laws import ModeMasks, Problem, slips
 from ...laws.polyhedral import ForcePolytope, aligned_edges, dense_force_matrix, force_polytope
-from ...tolerances import FORCE_RANK, LP_FEASIBILITY, ZERO
+from ...tolerances import FORCE_INTERIOR, FORCE_RANK, LP_FEASIBILITY, ZERO
 from ..result import Range
 from .highs import solve_lp
 from .ranges import Bounds, in_row_space, linear_ranges, null_space, ranges_are_wide, rows_feasible, value_ranges
@@ -226,7 +227,7 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     A = forces.A.toarray() if min(forces.A.shape) <= DENSE_MAX else forces.A.tocsc()
     if not isinstance(A, np.ndarray) and _fixed_by_equations(A, forces.fixed, normal):
         return None
-    vary = _normal_forces_vary(A, forces, normal) if isinstance(A, np.ndarray) else None
+    vary = _normal_forces_vary(A, forces, normal, problem.mu) if isinstance(A, np.ndarray) else None
     if vary is not None:
         return IndeterminateForces(None, work, forces) if vary else None
     ranges = work()
@@ -327,7 +328,7 @@ def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ..
     return tuple(value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size)))
 
 
-def _normal_forces_vary(A: np.ndarray, forces: ForcesAtTwist, normal: np.ndarray) -> bool | None:
+def _normal_forces_vary(A: np.ndarray, forces: ForcesAtTwist, normal: np.ndarray, mu: np.ndarray) -> bool | None:
     """True: some normal force provably spans more than ``LP_FEASIBILITY`` over the set; False: every
     normal force is constant on it; None: undecided. ``A``: ``forces.A``, dense (small sets only).
 
@@ -341,9 +342,10 @@ def _normal_forces_vary(A: np.ndarray, forces: ForcesAtTwist, normal: np.ndarray
     ``z_j (t_plus + t_minus)``, with ``z`` the projection of ``e_j`` (the
     direction that moves ``x_j`` most per unit length); ``t`` also stops where
     ``A (x + t z)`` would leave ``rhs`` by ``ZERO`` (the basis is a null space to
-    ``FORCE_RANK``).
+    ``FORCE_RANK``). Usually no LP is needed: a point positive on every column not forced to zero is found by
+    NNLS (:func:`_positive_point`), and those columns are then ``P``.
     """
-    found = _relative_interior(A, forces.rhs, forces.fixed)
+    found = _positive_point(A, forces, mu) or _relative_interior(A, forces.rhs, forces.fixed)
     if found is None:
         return None
     x, support = found
@@ -364,6 +366,30 @@ def _normal_forces_vary(A: np.ndarray, forces: ForcesAtTwist, normal: np.ndarray
         if z[k] * reach > LP_FEASIBILITY:
             return True
     return None
+
+
+def _positive_point(A: np.ndarray, forces: ForcesAtTwist, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """A point of ``{x >= 0 : A x = rhs}`` at least ``FORCE_INTERIOR`` of the load on every column the rows do not
+    force to zero, by NNLS (``x = floor + y``, ``y >= 0``), and those columns; None when NNLS finds none (the LP decides).
+
+    Forced to zero: the held columns, and the edge forces and friction slack of a contact whose normal force is
+    held (open) or whose friction is zero (``mu cn - sum beta - slack = 0``).
+    """
+    p = forces.polytope
+    open_contact = forces.fixed[p.normal]
+    no_slack = open_contact | (mu <= 0.0)
+    support = ~forces.fixed & ~np.concatenate([open_contact, np.repeat(open_contact, p.K), no_slack])
+    columns = np.flatnonzero(support)
+    floor = FORCE_INTERIOR * float(np.max(np.abs(forces.rhs), initial=0.0))
+    if columns.size == 0 or floor <= 0.0:
+        return None
+    free = A[:, columns]
+    y, _ = nnls(free, forces.rhs - floor * free.sum(axis=1))
+    x = np.zeros(forces.fixed.size)
+    x[columns] = y + floor
+    if float(np.max(np.abs(A @ x - forces.rhs), initial=0.0)) > ZERO:
+        return None
+    return x, support
 
 
 def _relative_interior(A: np.ndarray, rhs: np.ndarray, fixed: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
