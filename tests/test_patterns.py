@@ -11,6 +11,8 @@ benchmark grasps (the certificate names it, and SCIP is not run).
 
 from __future__ import annotations
 
+import dataclasses
+import importlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -240,3 +242,16 @@ def test_a_budget_too_small_for_every_motion_leaves_the_list_to_the_search() -> 
     assert prove_by_patterns(form, seed_point(form), max_motions=1).verdict is PatternVerdict.UNDECIDED
     solution = qs.solve(problem, max_solutions=1)
     assert solution.status == "failed" and not solution.search_complete
+
+
+def test_a_listed_continuum_has_every_extreme_audited_with_its_forces() -> None:
+    problem = qs.assemble(DEGENERATE["stick, one finger sliding (continuum)"])
+    form = polyhedral_form(problem, aligned_edges(problem, problem.friction.edges))
+    proof = prove_by_patterns(form, seed_point(form))
+    continuum = next(motion for motion in proof.motions if motion.continuum)
+    assert continuum.extremes_share_forces and len(continuum.extremes) == 2
+    audit = importlib.import_module("quasistatic.solve").audited_raw_motion
+    assert audit(problem, continuum).audit.passed
+    past_the_finger = continuum.extremes[1] + np.array([2.0, 0.0, 0.0])  # faster than the sliding finger: friction reversed
+    bogus = dataclasses.replace(continuum, extremes=(continuum.extremes[0], past_the_finger))
+    assert not audit(problem, bogus).audit.passed

@@ -410,7 +410,7 @@ def _record_continuum(
     x = _form_point(rows, inside, fit) if np.all(np.isfinite(inside)) else None
     if x is None or any(_form_point(rows, p, fit) is None for p in extremes):
         return False
-    motion = RawMotion(inside, rows.form.forces(x), tuple(extremes), bool(free), free)
+    motion = RawMotion(inside, rows.form.forces(x), tuple(extremes), bool(free), free, extremes_share_forces=True)
     if not any(_same_continuum(motion, f.motion) for f in rows.found):
         listed = _Found(motion, columns, region)
         rows.found[:] = [f for f in rows.found if f.motion.continuum or not _holds(rows, listed, f.motion.q, f.columns)]
