@@ -142,8 +142,9 @@ lets steps along the set's directions move a normal force by more than ``LP_FEAS
 
 PATTERN_NODES = 512
 """Most nodes of the planar mode branch and bound (:mod:`quasistatic.solvers.certify.patterns`) before it gives
-the proof to the SCIP search [-]: measured, the benchmark's 2-D grasps of 2-8 contacts need 6-300 and random
-scenes at most 92; a node costs ~55 us, so the budget wastes at most ~30 ms before SCIP."""
+the proof to the SCIP search [-]: measured, the benchmark's 2-D grasps of 2-8 contacts need 6-300 (their ambiguous
+ones listed in 12-130) and 840 random scenes at most 124, all decided; a node costs ~55 us, so the budget wastes at
+most ~30 ms before SCIP."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""

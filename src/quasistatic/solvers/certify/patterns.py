@@ -252,7 +252,7 @@ def _order(problem: Problem, seed_x: np.ndarray | None, n_q: int) -> list[int]:
 
 
 def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
-    """True when every mode assignment below ``node`` is pruned.
+    """True when every mode assignment below ``node`` is pruned, or its motions listed (``rows.found``).
 
     ``fit``: forces on the node's columns with ``|G fit + g|`` within the margin; ``twists``: what the node's
     twists are known to be.
