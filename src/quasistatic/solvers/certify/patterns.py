@@ -424,7 +424,8 @@ def _holds(rows: _Rows, found: _Found, q: np.ndarray, columns: np.ndarray) -> bo
     than ``DISTINCT_TWIST`` on a column the continuum's leaf does not keep (one LP; the SCIP search excludes a
     continuum's polyhedron by the same margin). A twist on its boundary whose forces may leave it (both fingers
     rolling at the end of a drag, with a harder squeeze) is a motion of its own, as the SCIP search lists it."""
-    assert found.region is not None
+    if found.region is None:
+        return False  # a single motion holds no other
     E, e, A, a = found.region
     if not (np.all(np.abs(E @ q - e) <= LP_FEASIBILITY) and np.all(A @ q - a >= -LP_FEASIBILITY)):
         return False
