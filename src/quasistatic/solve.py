@@ -199,6 +199,11 @@ def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFA
     elif raw.lazy_ranges is not None:
         ranges = partial(_physical_ranges_of, raw.lazy_ranges, scales.force)
     extremes = tuple(physical_twists(problem, e) for e in raw.extremes)
+    if raw.extremes_share_forces:
+        for extreme in raw.extremes:  # each extreme with the motion's forces: a motion too, audited as one
+            at_extreme = audited_motion(geometry, scales, to_world(problem, extreme, raw.c)[0], forces, tolerance=tolerance)
+            if not at_extreme.audit.passed:
+                return at_extreme  # the evidence: this continuum is not what it claims
     return audited_motion(
         geometry,
         scales,

@@ -30,6 +30,7 @@ __all__ = [
     "MOTION_RANK",
     "LP_FEASIBILITY",
     "FORCE_CEILING",
+    "FORCE_INTERIOR",
     "PATTERN_NODES",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
@@ -132,10 +133,18 @@ FORCE_CEILING = 1e6
 ``LP_FEASIBILITY / round-off``; a million times the scene's force scale is past what SCIP itself resolves, whose
 equilibrium rows are met to ``LP_FEASIBILITY`` (at 1e6 that is a tenth of the load)."""
 
+FORCE_INTERIOR = 1e-3
+"""Least value, relative to the load's largest scene-relative entry, that a point of a motion's consistent force
+set is asked to give every column not forced to zero, when one is sought by NNLS to decide whether the normal
+forces vary (:mod:`quasistatic.solvers.numerics.forces`) [-]. Not a tolerance on any law: a point this far inside
+lets steps along the set's directions move a normal force by more than ``LP_FEASIBILITY``; where NNLS finds none
+(a column the set holds near zero), one LP decides, as it always did."""
+
 PATTERN_NODES = 512
 """Most nodes of the planar mode branch and bound (:mod:`quasistatic.solvers.certify.patterns`) before it gives
-the proof to the SCIP search [-]: measured, the benchmark's 2-D grasps of 2-8 contacts need 6-300 and random
-scenes at most 92; a node costs ~55 us, so the budget wastes at most ~30 ms before SCIP."""
+the proof to the SCIP search [-]: measured, the benchmark's 2-D grasps of 2-8 contacts need 6-300 (their ambiguous
+ones listed in 12-130) and 840 random scenes at most 124, all decided; a node costs ~55 us, so the budget wastes at
+most ~30 ms before SCIP."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""

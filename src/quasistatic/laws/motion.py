@@ -58,6 +58,9 @@ class RawMotion:
     force_set : ForceSet or None
         With indeterminate forces: the set of consistent forces itself, for the ranges
         of robot torques and mover wrenches (LPs run only when those are read).
+    extremes_share_forces : bool
+        The forces ``c`` hold at every extreme too (one contact-mode pattern's motions are its twists times
+        its forces), so each extreme is audited with them, as the motion itself is.
     """
 
     q: FloatArray
@@ -68,6 +71,7 @@ class RawMotion:
     force_ranges: tuple[tuple[float, float | None], ...] | None = None
     lazy_ranges: Callable[[], tuple[tuple[float, float | None], ...]] | None = field(default=None, repr=False, compare=False)
     force_set: ForceSet | None = field(default=None, repr=False, compare=False)
+    extremes_share_forces: bool = False
 
     @property
     def continuum(self) -> bool:

@@ -13,9 +13,11 @@
    the closed contacts leave, and LP statuses (:mod:`.certify.patterns`), proves
    that every motion has Lemke's twist (``solved``), or, without a Lemke point,
    that no motion exists (then ``jammed``/``unstable`` as the search would say,
-   :func:`~.certify.diagnose.diagnose`). It needs no SCIP; where a pattern may
-   hold another motion, or past its node budget, it proves nothing and step 4
-   runs.
+   :func:`~.certify.diagnose.diagnose`), or lists every motion (``ambiguous``:
+   each pattern that holds one gives a single twist or a continuum, its
+   extremes measured by LPs). It needs no SCIP; where a pattern is too close
+   to call, or past its node budget or ``max_solutions``, it proves nothing
+   and step 4 runs.
 4. Otherwise the complete SCIP search of ``scip`` runs. For polyhedral cones
    it starts from Lemke's point once every law of the search's own form is
    checked there, so SCIP only has to prove that no other motion exists
@@ -33,7 +35,7 @@ from ..laws.polyhedral import aligned_edges, polyhedral_form
 from .certify.cheap import exact_motion, kinematically_unique, seed_point
 from .certify.diagnose import diagnose
 from .certify.exact_cone import solve_exact_3d, unique_exact_motion
-from .certify.patterns import NO_MOTION_PROOF, PATTERN_PROOF, PatternVerdict, prove_by_patterns
+from .certify.patterns import ENUMERATION_PROOF, NO_MOTION_PROOF, PATTERN_PROOF, PatternVerdict, prove_by_patterns
 from .certify.rest import rest_proof
 from .certify.search import certified_polyhedral, summarise
 from .result import BackendResult, Options
@@ -57,12 +59,15 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
         motion = RawMotion(seed[: form.n_q], form.forces(seed))
         return summarise(form, [motion], True, options).with_notes(certificate=_KINEMATIC)
     if problem.dimension == 2:
-        proof = prove_by_patterns(form, seed)
+        proof = prove_by_patterns(form, seed, options.max_solutions)
         if proof.verdict is PatternVerdict.UNIQUE and proof.seed is not None:
             motion = RawMotion(proof.seed[: form.n_q], form.forces(proof.seed))
             return summarise(form, [motion], True, options).with_notes(certificate=PATTERN_PROOF)
+        if proof.verdict is PatternVerdict.ENUMERATED:
+            options.report(len(proof.motions), proof.nodes)  # as the SCIP search reports its steps
+            return summarise(form, list(proof.motions), True, options).with_notes(certificate=ENUMERATION_PROOF)
         if proof.verdict is PatternVerdict.NONE:
-            return diagnose(problem, edges).with_notes(certificate=NO_MOTION_PROOF)
+            return diagnose(problem, edges, equilibrium=proof.equilibrium).with_notes(certificate=NO_MOTION_PROOF)
     return certified_polyhedral(problem, edges, options, seed)
 
 

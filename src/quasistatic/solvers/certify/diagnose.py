@@ -99,18 +99,22 @@ def _generator_rows(problem: Problem, edges: np.ndarray) -> np.ndarray:
     return np.vstack(rows)
 
 
-def diagnose(problem: Problem, inner_edges: np.ndarray, outer_edges: np.ndarray | None = None) -> BackendResult:
+def diagnose(
+    problem: Problem, inner_edges: np.ndarray, outer_edges: np.ndarray | None = None, equilibrium: bool | None = None
+) -> BackendResult:
     """Explain why no motion exists. ``inner_edges`` span cones inside the true ones.
 
     For the exact 3-D cone pass ``outer_edges`` too (a polygon around the circle):
-    no equilibrium with the outer cones proves none with the exact ones.
+    no equilibrium with the outer cones proves none with the exact ones. ``equilibrium``: whether
+    one exists in the inner cones, when the caller has decided it (the planar branch and bound's
+    root: a balancing fit, or a checked Farkas vector); None runs the LP.
     """
     multipliers = kinematic_certificate(problem)
     if multipliers is not None:
         return no_motion(
             Diagnosis.KINEMATIC, Certificate(CertificateKind.FARKAS, "kinematic (Farkas multipliers)", tuple(multipliers.tolist()))
         )
-    if equilibrium_exists(problem, inner_edges):
+    if equilibrium_exists(problem, inner_edges) if equilibrium is None else equilibrium:
         text = "equilibrium exists; no motion found by the complete search"
         return no_motion(Diagnosis.WEDGED, Certificate(CertificateKind.COMPLETE_SEARCH, text))
     if outer_edges is None or not equilibrium_exists(problem, outer_edges):

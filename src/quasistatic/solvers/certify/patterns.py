@@ -45,9 +45,32 @@ If every node is pruned the search is complete: every motion's twist is ``q*``
 (to ``SAME_TWIST`` exactly, to ``DISTINCT_TWIST / 2`` within the tolerance,
 which is the box the SCIP search excludes around a found motion), and no mode
 assignment holds a continuum. Without a seed, a closed tree proves that no
-motion exists. A surviving leaf (another motion, or a case too close to call)
-or more than :data:`PATTERN_NODES` nodes gives no answer: the caller runs the
-SCIP search instead, unchanged.
+motion exists.
+
+**Listing every motion.** A leaf that survives is one full mode assignment,
+so its motions are exactly ``Q x F`` (no node below it), with ``F`` non-empty
+(its non-negative fit balances the load). Its twist set ``Q`` is measured by
+``2 n`` LPs (the least and largest of each twist entry): empty (pruned), one
+twist (a single motion, as when the closed rows pin it), or a continuum: its
+extremes (the LPs' optima, distinct to ``SAME_TWIST``), the entries that run
+to infinity, and a point inside it. Every twist listed is paired with the
+leaf's forces and checked on every law of the form (:func:`~.cheap.satisfies_form`);
+``Q x F`` is a product, so each of these pairs is a motion. A single twist
+within ``DISTINCT_TWIST`` of one listed is not listed again (the SCIP search
+excludes the same box around a motion it found), nor one on a listed
+continuum's rows whose forces cannot leave the continuum's (one LP; the
+search excludes a continuum's polyhedron by the same margin), nor a continuum
+with the same extremes. Completeness: every motion
+lies in some leaf's ``Q x F``; every leaf is either pruned (its ``F`` or ``Q``
+empty, or its twists the seed's, which is listed) or listed as above. So the
+list holds every motion, to the tolerances above; the seed is listed first,
+unless a listed continuum holds it with the continuum's own contact modes.
+
+A leaf whose point or extremes fail the form's check (too close to call), an
+LP that does not answer, more motions than asked for, or more than
+:data:`PATTERN_NODES` nodes give no answer: the caller runs the SCIP search
+instead, unchanged, which lists as many as asked and says when the list may be
+incomplete.
 """
 
 from __future__ import annotations
@@ -59,16 +82,21 @@ from enum import Enum
 import numpy as np
 from scipy.optimize import nnls
 
-from ...laws import Problem
+from ...laws import Problem, RawMotion, contact_modes
 from ...laws.polyhedral import LCPForm
 from ...tolerances import DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, MOTION_RANK, PATTERN_NODES, SAME_TWIST, ZERO
-from ..numerics.highs import WarmLP
+from ..numerics.highs import WarmLP, solve_lp
 from .cheap import satisfies_form
+from .search import relative_interior_point
 
-__all__ = ["PatternVerdict", "PatternProof", "prove_by_patterns", "PATTERN_PROOF", "NO_MOTION_PROOF"]
+__all__ = ["PatternVerdict", "PatternProof", "prove_by_patterns", "PATTERN_PROOF", "NO_MOTION_PROOF", "ENUMERATION_PROOF"]
 
 PATTERN_PROOF = "every contact-mode pattern excluded or holding the found twist alone (mode branch and bound, LPs and Farkas vectors)"
 NO_MOTION_PROOF = "no contact-mode pattern holds a motion (mode branch and bound, LPs and Farkas vectors)"
+ENUMERATION_PROOF = (
+    "every contact-mode pattern excluded or its motions listed: single twists, continua by their extremes "
+    "(mode branch and bound, LPs and Farkas vectors)"
+)
 
 _SEPARATING, _ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _CLOSED = range(5)  # _CLOSED: a frictionless contact's three closed modes
 
@@ -76,17 +104,21 @@ _SEPARATING, _ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _CLOSED = range(5)  # _CLOSED:
 class PatternVerdict(Enum):
     UNIQUE = "unique"  # every motion is the seed's twist
     NONE = "none"  # no motion at all (no seed given)
-    UNDECIDED = "undecided"  # another motion may exist, or the budget ran out: run the SCIP search
+    ENUMERATED = "enumerated"  # several motions, or a continuum: every one of them listed in ``motions``
+    UNDECIDED = "undecided"  # a leaf too close to call, or a budget ran out: run the SCIP search
 
 
 @dataclass
 class PatternProof:
-    """The verdict, the seed it holds for (a point ``[q, cn, beta, lam]`` of the form), and the work done."""
+    """The verdict, the seed it holds for (a point ``[q, cn, beta, lam]`` of the form), every motion when
+    ``ENUMERATED`` (the seed's first), and the work done."""
 
     verdict: PatternVerdict
     seed: np.ndarray | None = None
     nodes: int = 0
     lps: int = 0
+    motions: tuple[RawMotion, ...] = ()
+    equilibrium: bool | None = None  # at the root: True, a balancing fit; False, a checked Farkas vector; None, neither
 
 
 @dataclass
@@ -108,6 +140,9 @@ class _Rows:
     frictionless: np.ndarray  # (m,) bool: mu = 0
     order: list[int]  # contacts in the order they are fixed
     proof: PatternProof = field(default_factory=lambda: PatternProof(PatternVerdict.UNDECIDED))
+    closed_sets: dict[bytes, _ClosedSet | _Twists] = field(default_factory=dict)  # by which bank rows are closed
+    max_motions: int = 16
+    found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
 
     @property
     def m(self) -> int:
@@ -125,20 +160,18 @@ class _Node:
     closed_rows: int = 0  # how many entries of ``equal`` are set
 
     def child(self, rows: _Rows, contact: int, mode: int) -> _Node:
-        m = rows.m
-        equal, at_least, columns = self.equal.copy(), self.at_least.copy(), self.columns.copy()
+        columns = self.columns.copy()
         columns[2 * contact : 2 * contact + 2] &= _EDGES_OF[mode]
-        closed_rows = self.closed_rows
-        if mode == _CLOSED:
-            at_least[contact], equal[contact] = False, True
-            return _Node(equal, at_least, columns, self.depth + 1, closed_rows + 1)
-        if mode != _SEPARATING:
-            at_least[contact], equal[contact] = False, True
-            closed_rows += 1
+        if mode == _SEPARATING:  # a free contact's twist rows: the parent's arrays, shared (no node writes them)
+            return _Node(self.equal, self.at_least, columns, self.depth + 1, self.closed_rows)
+        m = rows.m
+        equal, at_least = self.equal.copy(), self.at_least.copy()
+        at_least[contact], equal[contact] = False, True
+        closed_rows = self.closed_rows + 1
         if mode == _ROLLING:
             equal[m + contact] = True
             closed_rows += 1
-        elif mode != _SEPARATING:
+        elif mode != _CLOSED:
             at_least[(2 if mode == _SLIDE_PLUS else 3) * m + contact] = True
         return _Node(equal, at_least, columns, self.depth + 1, closed_rows)
 
@@ -162,10 +195,10 @@ _ALL_MODES = (_ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _SEPARATING)  # separating la
 _FRICTIONLESS_MODES = (_CLOSED, _SEPARATING)
 
 
-def prove_by_patterns(form: LCPForm, seed_x: np.ndarray | None) -> PatternProof:
-    """Whether every motion of the planar polyhedral laws ``form`` (two edges per contact) has the twist of
+def prove_by_patterns(form: LCPForm, seed_x: np.ndarray | None, max_motions: int = 16) -> PatternProof:
+    """Every motion of the planar polyhedral laws ``form`` (two edges per contact): whether each has the twist of
     ``seed_x`` (a point ``[q, cn, beta, lam]`` of it), or of a seed found on the way, or, without one, whether
-    no motion exists; see the module docstring."""
+    no motion exists; else every motion listed (at most ``max_motions``); see the module docstring."""
     problem, n_q = form.problem, form.n_q
     Jn, Jt, bn, bt = problem.Jn, problem.Jt[:, 0, :], problem.bn, problem.bt[:, 0]
     mu = problem.mu[:, None]
@@ -182,15 +215,32 @@ def prove_by_patterns(form: LCPForm, seed_x: np.ndarray | None) -> PatternProof:
         form,
         problem.mu <= 0.0,
         _order(problem, seed_x, n_q),
+        max_motions=max_motions,
     )
     rows.proof.seed = seed_x
     m = problem.n_contacts
     root = _Node(np.zeros(4 * m, dtype=bool), np.arange(4 * m) < m, np.ones(2 * m, dtype=bool), 0)
     fit = _forces(rows, root.columns, None)
+    rows.proof.equilibrium = False if fit is None else _balances(rows, fit)
     closed = fit is None or _search(rows, root, fit, _UNKNOWN)
-    found = rows.proof.seed is not None
-    rows.proof.verdict = (PatternVerdict.UNIQUE if found else PatternVerdict.NONE) if closed else PatternVerdict.UNDECIDED
+    rows.proof.verdict = _verdict(rows, closed)
     return rows.proof
+
+
+def _verdict(rows: _Rows, closed: bool) -> PatternVerdict:
+    """The search's verdict; a closed tree with other motions than the seed's lists them all, the seed's first."""
+    seed_x = rows.proof.seed
+    if not closed:
+        return PatternVerdict.UNDECIDED
+    if not rows.found:
+        return PatternVerdict.NONE if seed_x is None else PatternVerdict.UNIQUE
+    found = list(rows.found)
+    if seed_x is not None and not any(_on_continuum(rows, f, rows.seed) for f in found):  # unless a continuum has it
+        found.insert(0, _Found(RawMotion(seed_x[: rows.form.n_q], rows.form.forces(seed_x)), np.zeros(0, dtype=bool)))
+    if len(found) > rows.max_motions:
+        return PatternVerdict.UNDECIDED  # the SCIP search lists as many as asked and says the list is incomplete
+    rows.proof.motions = tuple(f.motion for f in found)
+    return PatternVerdict.ENUMERATED
 
 
 def _order(problem: Problem, seed_x: np.ndarray | None, n_q: int) -> list[int]:
@@ -202,7 +252,7 @@ def _order(problem: Problem, seed_x: np.ndarray | None, n_q: int) -> list[int]:
 
 
 def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
-    """True when every mode assignment below ``node`` is pruned.
+    """True when every mode assignment below ``node`` is pruned, or its motions listed (``rows.found``).
 
     ``fit``: forces on the node's columns with ``|G fit + g|`` within the margin; ``twists``: what the node's
     twists are known to be.
@@ -230,8 +280,12 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
                     continue
             if child_twists.point and child_twists.ball is not None and _adopted(rows, child_twists.ball.center, child_fit):
                 continue
-            if child_twists.point or not _leaf_polyhedron_pruned(rows, child):
-                return False  # another motion, or too close to call
+            if child_twists.point and child_twists.ball is not None:
+                listed = _record_point(rows, child_twists.ball.center, child_fit, child.columns)
+            else:
+                listed = _record_polyhedron(rows, child, child_fit)
+            if not listed:
+                return False  # too close to call, or too many motions
             continue
         if not _search(rows, child, child_fit, child_twists):
             return False
@@ -253,6 +307,15 @@ def _adopted(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> bool:
     """Without a seed: the leaf's twist ``q`` and forces ``fit`` as the seed, when they satisfy every law of the form."""
     if rows.seed is not None:
         return False
+    x = _form_point(rows, q, fit)
+    if x is None:
+        return False
+    rows.seed, rows.proof.seed = q, x
+    return True
+
+
+def _form_point(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> np.ndarray | None:
+    """The point ``[q, cn, beta, lam]`` of twist ``q`` and forces ``fit``, when it satisfies every law of the form."""
     m = rows.m
     mu = rows.form.problem.mu
     pairs = fit.reshape(m, 2)  # unit normal forces on edges +t, -t
@@ -262,10 +325,136 @@ def _adopted(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> bool:
     # the search reads a point's pattern from which of each pair is nearer zero.
     pairs_part = x[q.size :]  # a view: forces and slip speeds, all >= 0
     pairs_part[pairs_part <= ZERO] = 0.0
-    if not satisfies_form(rows.form, x):
+    return x if satisfies_form(rows.form, x) else None
+
+
+_Region = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # a leaf's twist rows: E q = e, A q >= a
+
+
+@dataclass(frozen=True, slots=True)
+class _Found:
+    """A motion a leaf holds; a continuum keeps its leaf's twist rows (``E q = e``, ``A q >= a``) to tell which
+    twists it holds."""
+
+    motion: RawMotion
+    columns: np.ndarray  # the leaf's force columns (a unit normal force on each edge it keeps)
+    region: _Region | None = None
+
+
+def _record_point(rows: _Rows, q: np.ndarray, fit: np.ndarray, columns: np.ndarray) -> bool:
+    """A leaf's one twist ``q`` with forces ``fit``: listed unless a listed motion has it; False when its point
+    fails a law of the form (too close to call) or there are too many motions."""
+    x = _form_point(rows, q, fit)
+    if x is None:
         return False
-    rows.seed, rows.proof.seed = q, x
-    return True
+    if not _known_point(rows, q, columns):
+        rows.found.append(_Found(RawMotion(q, rows.form.forces(x)), columns))
+    return len(rows.found) <= rows.max_motions
+
+
+def _known_point(rows: _Rows, q: np.ndarray, columns: np.ndarray) -> bool:
+    """Whether twist ``q`` (forces on ``columns``) is within ``DISTINCT_TWIST`` of a listed single motion, or
+    every such motion is a listed continuum's (:func:`_holds`)."""
+    for found in rows.found:
+        if found.region is not None and _holds(rows, found, q, columns):
+            return True
+        motion = found.motion
+        if not motion.continuum and float(np.max(np.abs(motion.q - q))) <= DISTINCT_TWIST:
+            return True
+    return False
+
+
+def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
+    """A leaf whose rows leave a polyhedron of twists: HiGHS measures its extent along each twist entry (2 n LPs
+    on one warm model). Empty, or every extreme within ``SAME_TWIST / 2`` of the seed: nothing new. One
+    extreme: a single motion there. Else a continuum: its extremes, its free directions, and a point inside it
+    (every inequality as slack as it can be), each with the leaf's forces and checked on every law of the form.
+    False when a check or an LP fails (too close to call) or there are too many motions."""
+    E, e = rows.bank[node.equal], rows.rhs[node.equal]
+    A, a = rows.bank[node.at_least], rows.rhs[node.at_least]
+    n = rows.g.size
+    model = WarmLP(np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
+    extremes: list[np.ndarray] = []
+    free: list[int] = []
+    for j in range(n):
+        for maximize in (False, True):
+            rows.proof.lps += 1
+            lp = model.optimise(np.eye(1, n, j)[0], maximize)
+            if lp.status == "infeasible":
+                return True
+            if lp.status == "unbounded":
+                free.append((j + 1) if maximize else -(j + 1))
+            elif lp.status != "optimal":
+                return False
+            elif not any(np.max(np.abs(lp.x - p)) <= SAME_TWIST for p in extremes):
+                extremes.append(lp.x)
+    seed = rows.seed
+    if not free and seed is not None and all(np.max(np.abs(p - seed)) <= 0.5 * SAME_TWIST for p in extremes):
+        return True  # the seed's twist alone
+    if not free and len(extremes) == 1:
+        return _record_point(rows, extremes[0], fit, node.columns)
+    return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit, node.columns)
+
+
+def _record_continuum(
+    rows: _Rows, region: _Region, extremes: list[np.ndarray], free: tuple[int, ...], fit: np.ndarray, columns: np.ndarray
+) -> bool:
+    """A leaf's continuum (see :func:`_record_polyhedron`), listed unless one with the same extremes is."""
+    E, e, A, a = region
+    n = rows.g.size
+    inside = relative_interior_point(E, e, A, a, np.full(n, -np.inf), np.full(n, np.nan))  # NaN: no point found
+    if not free:
+        # The slack-maximising point may be a vertex (its slacks' caps do not bind in scene units): averaged with
+        # the extremes, it is inside the segment or polygon they span, so its modes are the continuum's own.
+        inside = np.mean([inside, *extremes], axis=0)
+    x = _form_point(rows, inside, fit) if np.all(np.isfinite(inside)) else None
+    if x is None or any(_form_point(rows, p, fit) is None for p in extremes):
+        return False
+    motion = RawMotion(inside, rows.form.forces(x), tuple(extremes), bool(free), free, extremes_share_forces=True)
+    if not any(_same_continuum(motion, f.motion) for f in rows.found):
+        listed = _Found(motion, columns, region)
+        rows.found[:] = [f for f in rows.found if f.motion.continuum or not _holds(rows, listed, f.motion.q, f.columns)]
+        rows.found.append(listed)
+    return len(rows.found) <= rows.max_motions
+
+
+def _holds(rows: _Rows, found: _Found, q: np.ndarray, columns: np.ndarray) -> bool:
+    """Whether the continuum ``found`` holds every motion of twist ``q`` and forces on ``columns`` (a leaf's):
+    ``q`` meets its rows (each loosened by ``LP_FEASIBILITY``), and no balancing forces on ``columns`` put more
+    than ``DISTINCT_TWIST`` on a column the continuum's leaf does not keep (one LP; the SCIP search excludes a
+    continuum's polyhedron by the same margin). A twist on its boundary whose forces may leave it (both fingers
+    rolling at the end of a drag, with a harder squeeze) is a motion of its own, as the SCIP search lists it."""
+    if found.region is None:
+        return False  # a single motion holds no other
+    E, e, A, a = found.region
+    if not (np.all(np.abs(E @ q - e) <= LP_FEASIBILITY) and np.all(A @ q - a >= -LP_FEASIBILITY)):
+        return False
+    extra = columns & ~found.columns
+    if not extra.any():
+        return True
+    G = rows.loads[:, columns]
+    rows.proof.lps += 1
+    lp = solve_lp(extra[columns].astype(float), G, -rows.g, -rows.g, np.zeros(G.shape[1]), maximize=True)
+    return lp.status == "optimal" and lp.objective <= DISTINCT_TWIST
+
+
+def _on_continuum(rows: _Rows, found: _Found, q: np.ndarray | None) -> bool:
+    """Whether twist ``q`` is one of the continuum ``found``'s own: it meets the continuum's rows (each loosened by
+    ``LP_FEASIBILITY``) with the contact modes of the continuum's inner point. A twist on its boundary with other
+    modes (both fingers rolling at the end of a slip) is a motion of its own, as the SCIP search lists it."""
+    if q is None or found.region is None:
+        return False
+    E, e, A, a = found.region
+    inside = np.all(np.abs(E @ q - e) <= LP_FEASIBILITY) and np.all(A @ q - a >= -LP_FEASIBILITY)
+    problem = rows.form.problem
+    return bool(inside) and contact_modes(problem, q) == contact_modes(problem, found.motion.q)
+
+
+def _same_continuum(motion: RawMotion, other: RawMotion) -> bool:
+    """Two continua with the same free directions and the same extremes (within ``SAME_TWIST``)."""
+    if not other.continuum or other.free_axes != motion.free_axes or len(other.extremes) != len(motion.extremes):
+        return False
+    return all(any(np.max(np.abs(p - r)) <= SAME_TWIST for r in other.extremes) for p in motion.extremes)
 
 
 def _possible_modes(rows: _Rows, contact: int, ball: _Ball | None) -> tuple[int, ...]:
@@ -293,13 +482,23 @@ def _possible_modes(rows: _Rows, contact: int, ball: _Ball | None) -> tuple[int,
     return (*modes, _SEPARATING)
 
 
+def _margin(rows: _Rows) -> float:
+    """How far from the load a balancing fit may be (``LP_FEASIBILITY`` per row) [-]."""
+    return math.sqrt(rows.g.size) * LP_FEASIBILITY
+
+
+def _balances(rows: _Rows, fit: np.ndarray) -> bool | None:
+    """True when ``fit`` balances the load within the margin; None when it only failed to be excluded."""
+    return True if float(np.linalg.norm(rows.loads @ fit + rows.g)) <= _margin(rows) else None
+
+
 def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndarray | None:
     """Non-negative forces on ``columns`` balancing the load within the margin, or None with a checked Farkas vector:
     then no forces on them (sum below FORCE_CEILING) leave ``|G lam + g|`` below ``LP_FEASIBILITY`` per row.
 
     ``fit``: the parent's forces; kept when they use none of the columns taken away.
     """
-    margin = math.sqrt(rows.g.size) * LP_FEASIBILITY
+    margin = _margin(rows)
     if fit is not None and not fit[~columns].any():
         return fit
     G = rows.loads[:, columns]
@@ -335,6 +534,46 @@ _PRUNED, _UNKNOWN = _Twists(True), _Twists(False)
 def _twist(rows: _Rows, node: _Node) -> _Twists:
     """The node's twists, loosened by ``LP_FEASIBILITY`` per row, bounded by the closed rows ``E q = e``.
 
+    What the closed rows leave is worked out once per set of closed rows (:func:`_closed_set`; the two sliding
+    children of a node, and many nodes of the tree, share it); the node's inequality rows are then read off it.
+    """
+    n = rows.g.size
+    k = node.closed_rows
+    if k < n - 1 or k == 0:
+        return _UNKNOWN
+    key = node.equal.tobytes()
+    closed = rows.closed_sets.get(key)
+    if closed is None:
+        closed = rows.closed_sets[key] = _closed_set(rows, node.equal, k)
+    if isinstance(closed, _Twists):
+        return closed
+    reserve = closed.reserve[node.at_least]
+    if closed.slope is not None:
+        return _on_line(rows, closed.q0, closed.direction, closed.radius, closed.spread, closed.slope[node.at_least], reserve)
+    if (reserve < 0.0).any():
+        return _PRUNED  # an open gap or slip sign fails on the whole set
+    if _near_seed(rows, closed.q0, closed.q0, closed.spread):
+        return _PRUNED
+    return _Twists(False, _Ball(closed.q0, closed.radius), point=True, spread=closed.spread)
+
+
+@dataclass(frozen=True, slots=True)
+class _ClosedSet:
+    """The twists the closed rows leave: ``q0`` (a point, or a point of the line ``q0 + t direction``), within
+    ``radius`` (2-norm) and ``spread`` (per entry) of the loosened and the ``ZERO``-exact sets; for every bank row,
+    its best slack at ``q0`` (``reserve``) and its rate along the line (``slope``, None for a point)."""
+
+    q0: np.ndarray
+    radius: float
+    spread: np.ndarray
+    reserve: np.ndarray
+    direction: np.ndarray
+    slope: np.ndarray | None
+
+
+def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
+    """What the ``k`` closed rows ``E q = e`` leave, every row loosened by ``LP_FEASIBILITY``.
+
     With ``E+`` the pseudo-inverse of the ``k`` rows and ``q0 = E+ e``, the part of ``q - q0`` in E's row space
     is ``E+ (E q - e)`` (the residual ``E q0 - e`` is orthogonal to E's range), so its 2-norm is at most
     ``R = sqrt(k) LP_FEASIBILITY / s`` (``s``: the smallest singular value), and no twist exists when the
@@ -346,11 +585,8 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     leave a line ``q0 + t d``, on which every inequality row bounds ``t``.
     """
     n = rows.g.size
-    k = node.closed_rows
-    if k < n - 1 or k == 0:
-        return _UNKNOWN
-    E, e = rows.bank[node.equal], rows.rhs[node.equal]
-    u, sigma, vt = np.linalg.svd(E)
+    E, e = rows.bank[equal], rows.rhs[equal]
+    u, sigma, vt = np.linalg.svd(E, full_matrices=k < n)  # a line's direction is the last row of the full vt
     if sigma[-1] <= MOTION_RANK or k > n and sigma[n - 1] <= MOTION_RANK:
         return _UNKNOWN
     r = min(k, n)
@@ -361,16 +597,12 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
         return _PRUNED
     spread = ZERO * np.abs(pseudo_inverse).sum(axis=1)  # as far as a twist meeting the rows as the seed does may lie
     radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
-    A = rows.bank[node.at_least]
-    # Each inequality row's best slack at q0 (t = 0 on a line), every row loosened by LP_FEASIBILITY.
-    reserve = A @ q0 + LP_FEASIBILITY * np.abs(A @ pseudo_inverse).sum(axis=1) - rows.rhs[node.at_least] + LP_FEASIBILITY
-    if k < n:
-        return _on_line(rows, q0, vt[-1], radius, spread, A @ vt[-1], reserve)
-    if (reserve < 0.0).any():
-        return _PRUNED  # an open gap or slip sign fails on the whole set
-    if _near_seed(rows, q0, q0, spread):
-        return _PRUNED
-    return _Twists(False, _Ball(q0, radius), point=True, spread=spread)
+    # Each bank row's best slack at q0 (t = 0 on a line), every row loosened by LP_FEASIBILITY.
+    bank = rows.bank
+    reserve = bank @ q0 + LP_FEASIBILITY * np.abs(bank @ pseudo_inverse).sum(axis=1) - rows.rhs + LP_FEASIBILITY
+    direction = vt[-1]
+    slope = bank @ direction if k < n else None
+    return _ClosedSet(q0, radius, spread, reserve, direction, slope)
 
 
 def _on_line(
@@ -399,21 +631,3 @@ def _near_seed(rows: _Rows, first: np.ndarray, second: np.ndarray, spread: np.nd
         return False
     offset = np.maximum(np.abs(first - rows.seed), np.abs(second - rows.seed))
     return bool(offset.max() <= 0.5 * SAME_TWIST and (offset + spread).max() <= 0.5 * DISTINCT_TWIST)
-
-
-def _leaf_polyhedron_pruned(rows: _Rows, node: _Node) -> bool:
-    """A leaf whose rows leave a polyhedron of twists: pruned when HiGHS finds it empty, or every extreme
-    within ``SAME_TWIST / 2`` of the seed (2 n LPs on one warm model)."""
-    E, e = rows.bank[node.equal], rows.rhs[node.equal]
-    A, a = rows.bank[node.at_least], rows.rhs[node.at_least]
-    n = rows.g.size
-    model = WarmLP(np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
-    for j in range(n):
-        for maximize in (False, True):
-            rows.proof.lps += 1
-            lp = model.optimise(np.eye(1, n, j)[0], maximize)
-            if lp.status == "infeasible":
-                return True
-            if lp.status != "optimal" or rows.seed is None or abs(lp.x[j] - rows.seed[j]) > 0.5 * SAME_TWIST:
-                return False
-    return True

@@ -23,10 +23,11 @@ from functools import cached_property, partial
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.optimize import nnls
 
 from ...laws import ModeMasks, Problem, slips
 from ...laws.polyhedral import ForcePolytope, aligned_edges, dense_force_matrix, force_polytope
-from ...tolerances import FORCE_RANK, LP_FEASIBILITY, ZERO
+from ...tolerances import FORCE_INTERIOR, FORCE_RANK, LP_FEASIBILITY, ZERO
 from ..result import Range
 from .highs import solve_lp
 from .ranges import Bounds, linear_ranges, null_space, ranges_are_wide, rows_feasible, rows_in_row_space, value_ranges
@@ -227,7 +228,7 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     A = forces.A.toarray() if min(forces.A.shape) <= DENSE_MAX else forces.A.tocsc()
     if not isinstance(A, np.ndarray) and _fixed_by_equations(A, forces.fixed, None):
         return None
-    vary = _forces_vary(A, forces, _component_rows(edges)) if isinstance(A, np.ndarray) else None
+    vary = _forces_vary(A, forces, _component_rows(edges), problem.mu) if isinstance(A, np.ndarray) else None
     if vary is not None:
         return IndeterminateForces(None, work, forces) if vary else None
     ranges = work()
@@ -361,7 +362,7 @@ def _normal_ranges(forces: ForcesAtTwist, normal: np.ndarray) -> tuple[Range, ..
     return tuple(value_ranges(forces.A, forces.rhs, normal, np.zeros(forces.fixed.size)))
 
 
-def _forces_vary(A: np.ndarray, forces: ForcesAtTwist, components: np.ndarray) -> bool | None:
+def _forces_vary(A: np.ndarray, forces: ForcesAtTwist, components: np.ndarray, mu: np.ndarray) -> bool | None:
     """True: some force component provably spans more than ``LP_FEASIBILITY`` over the set; False: every
     component is constant on it; None: undecided. ``A``: ``forces.A``, dense (small sets only);
     ``components``: :func:`_component_rows`.
@@ -375,9 +376,11 @@ def _forces_vary(A: np.ndarray, forces: ForcesAtTwist, components: np.ndarray) -
     positive column reaches 0), so the component spans at least ``f . z (t_plus +
     t_minus)``, with ``z`` the projection of the unit ``f_P`` (the direction that
     moves it most per unit length); ``t`` also stops where ``A (x + t z)`` would
-    leave ``rhs`` by ``ZERO`` (the basis is a null space to ``FORCE_RANK``).
+    leave ``rhs`` by ``ZERO`` (the basis is a null space to ``FORCE_RANK``). Usually no LP is needed:
+    a point positive on every column not forced to zero is found by NNLS (:func:`_positive_point`),
+    and those columns are then ``P``.
     """
-    found = _relative_interior(A, forces.rhs, forces.fixed)
+    found = _positive_point(A, forces, mu) or _relative_interior(A, forces.rhs, forces.fixed)
     if found is None:
         return None
     x, support = found
@@ -400,6 +403,30 @@ def _forces_vary(A: np.ndarray, forces: ForcesAtTwist, components: np.ndarray) -
         if rate * reach > LP_FEASIBILITY:
             return True
     return None
+
+
+def _positive_point(A: np.ndarray, forces: ForcesAtTwist, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """A point of ``{x >= 0 : A x = rhs}`` at least ``FORCE_INTERIOR`` of the load on every column the rows do not
+    force to zero, by NNLS (``x = floor + y``, ``y >= 0``), and those columns; None when NNLS finds none (the LP decides).
+
+    Forced to zero: the held columns, and the edge forces and friction slack of a contact whose normal force is
+    held (open) or whose friction is zero (``mu cn - sum beta - slack = 0``).
+    """
+    p = forces.polytope
+    open_contact = forces.fixed[p.normal]
+    no_slack = open_contact | (mu <= 0.0)
+    support = ~forces.fixed & ~np.concatenate([open_contact, np.repeat(open_contact, p.K), no_slack])
+    columns = np.flatnonzero(support)
+    floor = FORCE_INTERIOR * float(np.max(np.abs(forces.rhs), initial=0.0))
+    if columns.size == 0 or floor <= 0.0:
+        return None
+    free = A[:, columns]
+    y, _ = nnls(free, forces.rhs - floor * free.sum(axis=1))
+    x = np.zeros(forces.fixed.size)
+    x[columns] = y + floor
+    if float(np.max(np.abs(A @ x - forces.rhs), initial=0.0)) > ZERO:
+        return None
+    return x, support
 
 
 def _relative_interior(A: np.ndarray, rhs: np.ndarray, fixed: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
