@@ -24,6 +24,7 @@ import quasistatic as qs
 from catalogue import BY_NAME, describe, laws_hold, matches, same, scale_of
 from quasistatic.solvers import Options
 from quasistatic.solvers.fast import solve_fast
+from quasistatic.solvers.numerics import lemke as lemke_module
 from quasistatic.solvers.numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION, lemke
 from quasistatic.tools.validation import load_cases, scene_data
 
@@ -33,7 +34,11 @@ TOL = 1e-11
 
 # --------------------------------------------------------------------------- Lemke's method
 
-LEMKE_VARIANTS = [pytest.param(lemke, id="compiled"), pytest.param(getattr(lemke, "py_func", lemke), id="python")]
+LEMKE_VARIANTS = [
+    pytest.param(lemke, id="compiled"),
+    pytest.param(getattr(lemke, "py_func", lemke), id="python"),
+    pytest.param(lemke_module._lemke_numpy, id="numpy-twin"),  # what runs without numba
+]
 
 
 def _solve_lcp(solver: Any, M: np.ndarray, q: np.ndarray, max_pivots: int = 1000) -> tuple[int, np.ndarray, int]:
@@ -522,7 +527,34 @@ def test_plain_python_twins_equal_the_compiled_kernels() -> None:
             strict=True,
         ):
             np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-15)
+        for got, want in zip(lcp._split_rows_numpy(data.J, data.b, data.mu, fr), blocks, strict=True):
+            np.testing.assert_array_equal(got, want)
+        offsets = rng.uniform(-1, 1, fr.shape[0])
+        np.testing.assert_allclose(
+            lcp._edges_numpy(data.base, offsets, scene.dimension - 1),
+            lcp._edges(data.base, offsets, scene.dimension - 1),
+            rtol=1e-14,
+            atol=1e-15,
+        )
         m, _, n = data.J.shape
+        z = rng.uniform(0.0, 1.0, 2 * n + m + fr.shape[0] * (edges.shape[1] + 1))
+        for got, want in zip(
+            lcp._motion_numpy(z, edges, fr, m, scene.dimension, n), lcp._motion(z, edges, fr, m, scene.dimension, n), strict=True
+        ):
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-15)
+        if scene.dimension == 3:
+            q = rng.normal(size=n)
+            for i in range(m):
+                np.testing.assert_allclose(
+                    lcp._contact_speeds_numpy(data.J, data.b, q, i), lcp._contact_speeds(data.J, data.b, q, i), rtol=1e-13, atol=1e-15
+                )
+        M, q_lcp = lcp._assemble(Jn, Jt, bn, bt, mu_f, data.g, edges, fr)
+        for got, want in zip(
+            lemke_module._lemke_numpy(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL),
+            lemke(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL),
+            strict=True,
+        ):
+            np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)  # the same pivots: status, point, count, basis
         kind = rng.integers(0, 3, m).astype(np.int64)  # separating, rolling and sliding contacts mixed
         column, size = fixed_modes.columns(kind, n, scene.dimension - 1)
         x = rng.normal(size=size)
