@@ -505,9 +505,9 @@ def _assemble_numpy(
     edges: np.ndarray,
     frictional: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Whole-array twin of :func:`_assemble` for plain Python (numba compiles the loops)."""
+    """Whole-array twin of :func:`_assemble` for plain Python: every block in one step (numba compiles the loops)."""
     m, n = Jn.shape
-    f, K, t = edges.shape
+    f, K, _ = edges.shape
     N = 2 * n + m + f * K + f
     cn0 = 2 * n
     b0 = cn0 + m
@@ -517,21 +517,18 @@ def _assemble_numpy(
     q[:n] = -g
     q[n : 2 * n] = g
     q[cn0:b0] = -bn
-    M[cn0:b0, :n] = Jn
-    M[cn0:b0, n : 2 * n] = -Jn
-    M[:n, cn0:b0] = -Jn.T
-    M[n : 2 * n, cn0:b0] = Jn.T
-    for a in range(f):
-        rows = slice(b0 + a * K, b0 + (a + 1) * K)
-        along = edges[a] @ Jt[a]  # (K, n): each edge's slip rows
-        q[rows] = -(edges[a] @ bt[a])
-        M[rows, :n] = along
-        M[rows, n : 2 * n] = -along
-        M[:n, rows] = -along.T
-        M[n : 2 * n, rows] = along.T
-        M[rows, l0 + a] = 1.0
-        M[l0 + a, rows] = -1.0
-        M[l0 + a, cn0 + frictional[a]] = mu[a]
+    along = np.matmul(edges, Jt).reshape(f * K, n)  # each edge's slip rows
+    q[b0:l0] = -np.matmul(edges, bt[:, :, None]).ravel()
+    rows = np.concatenate((Jn, along))  # (m + f K, n): normal rows, then edge rows
+    M[cn0:l0, :n] = rows
+    M[cn0:l0, n : 2 * n] = -rows
+    M[:n, cn0:l0] = -rows.T
+    M[n : 2 * n, cn0:l0] = rows.T
+    edge_rows = np.arange(b0, l0)
+    slack_cols = l0 + np.repeat(np.arange(f), K)
+    M[edge_rows, slack_cols] = 1.0
+    M[slack_cols, edge_rows] = -1.0
+    M[l0 + np.arange(f), cn0 + frictional] = mu
     return M, q
 
 
