@@ -517,13 +517,16 @@ def _assemble_numpy(
     q[:n] = -g
     q[n : 2 * n] = g
     q[cn0:b0] = -bn
-    along = np.matmul(edges, Jt).reshape(f * K, n)  # each edge's slip rows
-    q[b0:l0] = -np.matmul(edges, bt[:, :, None]).ravel()
-    rows = np.concatenate((Jn, along))  # (m + f K, n): normal rows, then edge rows
+    rows = Jn
+    if f:  # frictionless problems (the LP's small ones) skip the friction blocks' fixed cost
+        q[b0:l0] = -np.matmul(edges, bt[:, :, None]).ravel()
+        rows = np.concatenate((Jn, np.matmul(edges, Jt).reshape(f * K, n)))  # normal rows, then each edge's slip rows
     M[cn0:l0, :n] = rows
     M[cn0:l0, n : 2 * n] = -rows
     M[:n, cn0:l0] = -rows.T
     M[n : 2 * n, cn0:l0] = rows.T
+    if not f:
+        return M, q
     edge_rows = np.arange(b0, l0)
     slack_cols = l0 + np.repeat(np.arange(f), K)
     M[edge_rows, slack_cols] = 1.0
