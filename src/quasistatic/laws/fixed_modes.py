@@ -51,51 +51,69 @@ def columns(kind: IntArray, n: int, t: int) -> tuple[IntArray, int]:
 def _system_numpy(
     J: FloatArray, b: FloatArray, mu: FloatArray, g: FloatArray, x: FloatArray, kind: IntArray, column: IntArray, n: int
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Whole-array twin of :func:`system` for plain Python (numba compiles the loops)."""
+    """Whole-array twin of :func:`system` for plain Python: every contact of a mode at once (numba compiles the loops).
+
+    Without numba each numpy call costs about a microsecond whatever its size, so the
+    contacts are handled by mode in a fixed number of calls rather than one block per contact.
+    """
     m, d = J.shape[0], J.shape[1]
     t = d - 1
     size = x.shape[0]
     residual = np.zeros(size)
     jacobian = np.zeros((size, size))
     forces = np.zeros((m, d))
-    residual[:n] = g
-    q = x[:n]
-    for i in range(m):
-        if kind[i] == SEPARATING:
-            continue
-        rows = J[i]  # (d, n): the contact's tangent rows, then its normal row
-        velocity = rows @ q - b[i]
-        col = column[i]
-        cn = x[col]
-        forces[i, t] = cn
-        # Closed: no normal velocity; the normal force enters equilibrium.
-        residual[col] = velocity[t]
-        jacobian[col, :n] = rows[t]
-        jacobian[:n, col] += rows[t]
-        if kind[i] == ROLLING:
-            forces[i, :t] = x[col + 1 : col + 1 + t]
-            residual[col + 1 : col + 1 + t] = velocity[:t]
-            jacobian[col + 1 : col + 1 + t, :n] = rows[:t]
-            jacobian[:n, col + 1 : col + 1 + t] += rows[:t].T
-        elif mu[i] > 0.0:
-            _sliding_friction_numpy(rows[:t], mu[i], cn, col, velocity[:t], forces[i], jacobian)
-        residual[:n] += rows.T @ forces[i]
+    velocity = J.dot(x[:n]) - b  # (m, d): tangent slips, then normal velocity
+    closed = np.flatnonzero(kind != SEPARATING)
+    normal_col = column[closed]
+    forces[closed, t] = x[normal_col]
+    # Closed: no normal velocity; the normal force enters equilibrium.
+    residual[normal_col] = velocity[closed, t]
+    normal_rows = J[closed, t]  # (c, n)
+    jacobian[normal_col, :n] = normal_rows
+    jacobian[:n, normal_col] = normal_rows.T  # distinct columns, each written once
+    rolling = np.flatnonzero(kind == ROLLING)
+    if rolling.size:
+        tangent_col = (column[rolling, None] + 1 + np.arange(t)).ravel()
+        tangent_rows = J[rolling, :t].reshape(-1, J.shape[2])  # (r t, n)
+        forces[rolling, :t] = x[tangent_col].reshape(-1, t)
+        residual[tangent_col] = velocity[rolling, :t].ravel()
+        jacobian[tangent_col, :n] = tangent_rows
+        jacobian[:n, tangent_col] = tangent_rows.T
+    sliding = np.flatnonzero((kind == SLIDING) & (mu > 0.0))
+    if sliding.size:
+        _sliding_friction_numpy(
+            J[sliding, :t], mu[sliding], forces[sliding, t], column[sliding], velocity[sliding, :t], sliding, forces, jacobian
+        )
+    residual[:n] = g + forces[closed].ravel().dot(J[closed].reshape(-1, J.shape[2]))
     return residual, jacobian, forces
 
 
 def _sliding_friction_numpy(
-    tangent: FloatArray, mu: float, cn: float, col: int, slip: FloatArray, force: FloatArray, jacobian: FloatArray
+    tangent: FloatArray,
+    mu: FloatArray,
+    cn: FloatArray,
+    col: IntArray,
+    slip: FloatArray,
+    contacts: IntArray,
+    forces: FloatArray,
+    jacobian: FloatArray,
 ) -> None:
-    """Whole-array twin of :func:`_sliding_friction` for plain Python (numba compiles the loops)."""
-    t, n = tangent.shape
-    speed = np.sqrt(np.sum(slip * slip))
-    if speed <= 0.0:
-        return
-    e = slip / speed
-    force[:t] = -mu * cn * e
-    jacobian[:n, col] += -mu * (tangent.T @ e)
-    projector = (-mu * cn / speed) * (np.eye(t) - np.outer(e, e))
-    jacobian[:n, :n] += tangent.T @ projector @ tangent
+    """Whole-array twin of :func:`_sliding_friction` over the sliding contacts ``contacts`` (tangent rows (s, t, n), slips (s, t)).
+
+    The twist block ``sum_s k_s T_s^T (I - e_s e_s^T) T_s`` is summed as ``k T^T T - k a a^T`` with ``a = T^T e``.
+    """
+    speed = np.sqrt((slip * slip).sum(axis=1))
+    moving = speed > 0.0
+    if not moving.all():
+        tangent, mu, cn, col, slip, contacts, speed = (a[moving] for a in (tangent, mu, cn, col, slip, contacts, speed))
+    n = tangent.shape[2]
+    e = slip / speed[:, None]
+    forces[contacts, : slip.shape[1]] = -(mu * cn)[:, None] * e
+    along = np.matmul(e[:, None, :], tangent)[:, 0, :]  # (s, n): a = T^T e per contact
+    jacobian[:n, col] -= (mu[:, None] * along).T  # distinct columns: no index repeats
+    k = -(mu * cn) / speed
+    rows = tangent.reshape(-1, n)
+    jacobian[:n, :n] += (rows * np.repeat(k, tangent.shape[1])[:, None]).T.dot(rows) - (along * k[:, None]).T.dot(along)
 
 
 @njit(python=_system_numpy)

@@ -18,7 +18,9 @@ only if every inequality holds, else re-alignment goes on.
 
 What it proves: nothing. It finds one motion, or reports ``failed`` (Lemke
 ended on a secondary ray or hit its pivot cap, or the exact-cone refinement
-did not converge) so that the caller can fall back to the certified search. It never
+did not converge) so that the caller can fall back to the certified search. A ray is
+no proof that no motion exists: Lemke's path reaches only solutions of index +1
+(``sgn det M_SS``), and some scenes' motions all have index -1 (docs/performance.md). It never
 reports jammed, unstable or ambiguous, checks neither uniqueness nor force
 ranges, and cannot prescribe contact modes.
 
@@ -72,7 +74,8 @@ def solve_fast(problem: Problem, options: Options) -> BackendResult:
 def _failed(status: int, stage: int, pivots: int) -> BackendResult:
     when = " after re-aligning the pyramid edges" if stage else ""
     why = {
-        RAY: f"Lemke's method ended on a secondary ray{when} ({pivots} pivots): no motion found",
+        RAY: f"Lemke's method ended on a secondary ray{when} ({pivots} pivots): no motion found "
+        "(there may be none, or only motions its path cannot reach)",
         PIVOT_LIMIT: f"Lemke's method hit its pivot limit{when} ({pivots} pivots)",
         NOT_CONVERGED: "the pyramid's motion did not converge to one of the exact cones "
         "(edge re-alignment, then Newton's method with its contact modes)",

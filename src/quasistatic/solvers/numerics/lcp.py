@@ -22,6 +22,7 @@ uses the same kernel without edges.
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg.lapack import dgesv
 
 from ...jit import njit
 from ...laws import Problem
@@ -162,7 +163,15 @@ def solve_split_lcp(
         q, c = _motion(z, edges, frictional, m, d, n)
 
 
-@njit
+def _split_rows_numpy(
+    J: np.ndarray, b: np.ndarray, mu: np.ndarray, frictional: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Whole-array twin of :func:`_split_rows` for plain Python (numba compiles the loops)."""
+    d = J.shape[1]
+    return J[:, d - 1, :].copy(), b[:, d - 1].copy(), J[frictional, : d - 1, :], b[frictional, : d - 1], mu[frictional]
+
+
+@njit(python=_split_rows_numpy)
 def _split_rows(
     J: np.ndarray, b: np.ndarray, mu: np.ndarray, frictional: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -265,7 +274,13 @@ def _newton(
     return False, q, forces
 
 
-@njit
+def _contact_speeds_numpy(J: np.ndarray, b: np.ndarray, q: np.ndarray, i: int) -> tuple[float, float]:
+    """Whole-array twin of :func:`_contact_speeds` for plain Python (numba compiles the loops)."""
+    u = J[i].dot(q) - b[i]
+    return u[2], float(np.sqrt(u[0] ** 2 + u[1] ** 2))
+
+
+@njit(python=_contact_speeds_numpy)
 def _contact_speeds(J: np.ndarray, b: np.ndarray, q: np.ndarray, i: int) -> tuple[float, float]:
     """Normal velocity and slip speed of contact ``i`` at twist ``q``."""
     u = -b[i].copy()
@@ -338,7 +353,16 @@ def _newton_step(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
     return step
 
 
-@njit
+def _edges_numpy(base: np.ndarray, offsets: np.ndarray, t: int) -> np.ndarray:
+    """Whole-array twin of :func:`_edges` for plain Python (numba compiles the loops)."""
+    f, K = offsets.shape[0], base.shape[0]
+    if t == 1:
+        return np.broadcast_to(base[None, :, None], (f, K, 1)).copy()
+    angles = base[None, :] + offsets[:, None]
+    return np.stack((np.cos(angles), np.sin(angles)), axis=-1)
+
+
+@njit(python=_edges_numpy)
 def _edges(base: np.ndarray, offsets: np.ndarray, t: int) -> np.ndarray:
     """Edge directions (f, K, t): the 2-D signs, or 3-D angles ``base + offset`` per contact."""
     f, K = offsets.shape[0], base.shape[0]
@@ -353,7 +377,18 @@ def _edges(base: np.ndarray, offsets: np.ndarray, t: int) -> np.ndarray:
     return edges
 
 
-@njit
+def _motion_numpy(z: np.ndarray, edges: np.ndarray, frictional: np.ndarray, m: int, d: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Whole-array twin of :func:`_motion` for plain Python (numba compiles the loops)."""
+    f, K, t = edges.shape
+    q = z[:n] - z[n : 2 * n]
+    c = np.zeros((m, d))
+    c[:, d - 1] = z[2 * n : 2 * n + m]
+    beta = z[2 * n + m : 2 * n + m + f * K].reshape(f, K, 1)
+    c[frictional, :t] += (beta * edges).sum(axis=1)
+    return q, c
+
+
+@njit(python=_motion_numpy)
 def _motion(z: np.ndarray, edges: np.ndarray, frictional: np.ndarray, m: int, d: int, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Twist ``q`` (n,) and contact-frame forces ``c`` (m, d) of ``z = [q+, q-, cn, beta, lam]``."""
     f, K, t = edges.shape
@@ -405,25 +440,18 @@ def _basis_solution(M: np.ndarray, q: np.ndarray, basis: np.ndarray, tol: float)
 
 
 def _linear_solve_numpy(A: np.ndarray, rhs: np.ndarray) -> tuple[bool, np.ndarray]:
-    """Whole-array twin of :func:`_linear_solve` for plain Python (numba compiles the loops)."""
+    """Twin of :func:`_linear_solve` for plain Python: LAPACK's ``dgesv`` (the same partial pivoting, in one call).
+
+    Singular exactly when the kernel says so: when a pivot (a diagonal entry of ``U``) is within
+    the kernel's relative threshold of zero.
+    """
     n = rhs.shape[0]
-    U = A.copy()
-    x = rhs.copy()
-    tiny = 1e-14 * max(np.max(np.abs(U)) if n else 0.0, 1e-300)
-    for k in range(n):
-        p = k + int(np.argmax(np.abs(U[k:, k])))
-        if abs(U[p, k]) <= tiny:
-            return False, x
-        if p != k:
-            row = U[k].copy()
-            U[k] = U[p]
-            U[p] = row
-            x[k], x[p] = x[p], x[k]
-        factors = U[k + 1 :, k] / U[k, k]
-        U[k + 1 :, k:] -= np.outer(factors, U[k, k:])
-        x[k + 1 :] -= factors * x[k]
-    for k in range(n - 1, -1, -1):
-        x[k] = (x[k] - np.sum(U[k, k + 1 :] * x[k + 1 :])) / U[k, k]
+    if n == 0:
+        return True, rhs.copy()
+    lu, _, x, info = dgesv(A, rhs)
+    tiny = 1e-14 * max(np.abs(A).max(), 1e-300)
+    if info != 0 or np.abs(np.diagonal(lu)).min() <= tiny:
+        return False, rhs.copy()
     return True, x
 
 
@@ -477,9 +505,9 @@ def _assemble_numpy(
     edges: np.ndarray,
     frictional: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Whole-array twin of :func:`_assemble` for plain Python (numba compiles the loops)."""
+    """Whole-array twin of :func:`_assemble` for plain Python: every block in one step (numba compiles the loops)."""
     m, n = Jn.shape
-    f, K, t = edges.shape
+    f, K, _ = edges.shape
     N = 2 * n + m + f * K + f
     cn0 = 2 * n
     b0 = cn0 + m
@@ -489,21 +517,21 @@ def _assemble_numpy(
     q[:n] = -g
     q[n : 2 * n] = g
     q[cn0:b0] = -bn
-    M[cn0:b0, :n] = Jn
-    M[cn0:b0, n : 2 * n] = -Jn
-    M[:n, cn0:b0] = -Jn.T
-    M[n : 2 * n, cn0:b0] = Jn.T
-    for a in range(f):
-        rows = slice(b0 + a * K, b0 + (a + 1) * K)
-        along = edges[a] @ Jt[a]  # (K, n): each edge's slip rows
-        q[rows] = -(edges[a] @ bt[a])
-        M[rows, :n] = along
-        M[rows, n : 2 * n] = -along
-        M[:n, rows] = -along.T
-        M[n : 2 * n, rows] = along.T
-        M[rows, l0 + a] = 1.0
-        M[l0 + a, rows] = -1.0
-        M[l0 + a, cn0 + frictional[a]] = mu[a]
+    rows = Jn
+    if f:  # frictionless problems (the LP's small ones) skip the friction blocks' fixed cost
+        q[b0:l0] = -np.matmul(edges, bt[:, :, None]).ravel()
+        rows = np.concatenate((Jn, np.matmul(edges, Jt).reshape(f * K, n)))  # normal rows, then each edge's slip rows
+    M[cn0:l0, :n] = rows
+    M[cn0:l0, n : 2 * n] = -rows
+    M[:n, cn0:l0] = -rows.T
+    M[n : 2 * n, cn0:l0] = rows.T
+    if not f:
+        return M, q
+    edge_rows = np.arange(b0, l0)
+    slack_cols = l0 + np.repeat(np.arange(f), K)
+    M[edge_rows, slack_cols] = 1.0
+    M[slack_cols, edge_rows] = -1.0
+    M[l0 + np.arange(f), cn0 + frictional] = mu
     return M, q
 
 
