@@ -19,7 +19,7 @@ from importlib.util import find_spec
 
 import numpy as np
 
-from ...adapters import Box, ContactDetection, FrictionPair, Halfspace, Pose, ShapedMover, SolidBody, Sphere, World
+from ...adapters import AnyWorld, Box, ContactDetection, FrictionPair, Halfspace, Pose, ShapedMover, SolidBody, Sphere, World
 from ...errors import SceneError
 from ...laws import assemble
 from ...sim import Inputs, SimModel, State, StepOptions, advance, evaluate
@@ -90,7 +90,7 @@ def _row(case: str, world: World, steps: int, policy: str) -> PipelineRow:
     )  # fmt: skip
 
 
-def _split(world: World) -> tuple[float, float, float]:
+def _split(world: AnyWorld) -> tuple[float, float, float]:
     """One step's detection, assembly and solve, timed apart on the same state."""
     start = time.perf_counter()
     detection = world.detect()
