@@ -130,6 +130,8 @@ def _loaded(scene_file: Path) -> tuple[Scene, Detection | None]:
 
 def _loaded_world(scene_file: Path) -> tuple[Scene, Detection | None, World | None]:
     """As :func:`_loaded`, and the World of shapes the scene came from (None for a file that lists its contacts)."""
+    from .adapters import World  # adapters load only for scenes of shapes
+
     loaded = _guarded(lambda: load_world(scene_file))
     if isinstance(loaded, Scene):
         return loaded, None, None
@@ -443,6 +445,8 @@ def _view_trajectory(trajectory_file: Path, scene: Path | None, host: str, port:
 
 def _run_world(trajectory_file: Path, trajectory: Trajectory, scene: Path | None) -> World:
     """The World a run is drawn on: ``--scene``, or the scene file the trajectory names."""
+    from .adapters import World
+
     if scene is None:
         if not trajectory.scene_file:
             _fail(f"{str(trajectory_file)!r} names no scene file (it was run on a World built in Python): give --scene")

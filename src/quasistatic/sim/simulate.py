@@ -193,7 +193,8 @@ def _fall(before: Evaluation) -> str:
         if np.any(twist):
             dim = before.world.dimension
             v, w = twist[:dim], twist[dim:]
-            parts.append(f"{body.name!r} (its centre of mass was moving along {_unit(v)}, turning about {_unit(w)})")
+            turning = f"about {_unit(w)}" if dim == 3 else _sense(float(w[0]))
+            parts.append(f"{body.name!r} (its centre of mass was moving along {_unit(v)}, turning {turning})")
     return "; it falls as it last moved: " + ", ".join(parts) if parts else ""
 
 
@@ -213,6 +214,11 @@ def _blocking(evaluation: Evaluation) -> str:
         {f"{contacts[i].body}/{contacts[i].other}" for i in np.flatnonzero(weights > ZERO * max(float(weights.max()), 1e-300))}
     )
     return f"; blocking contacts: {', '.join(blocking)}" if blocking else ""
+
+
+def _sense(w: float) -> str:
+    """How a planar body turns."""
+    return "counter-clockwise" if w > 0 else "clockwise" if w < 0 else "not at all"
 
 
 def _unit(vector: np.ndarray) -> str:
