@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
-from typing import Any, TypeAlias
+from typing import Any, TypeAlias, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -172,7 +172,8 @@ PlanarShape: TypeAlias = Disk | Polygon | HalfPlane
 
 
 class PlanarLayout:
-    """What planar detection keeps while the shapes move: owners, shapes, and the pairs that may ever touch.
+    """What planar detection keeps while the shapes move: owners, shapes, each polygon's local faces, and the pairs
+    that may ever touch.
 
     ``free``: the names of free bodies; only pairs with one constrain a motion (two movers never do),
     and two colliders of one owner never touch.
@@ -181,6 +182,7 @@ class PlanarLayout:
     def __init__(self, owners: Sequence[str], shapes: Sequence[PlanarShape], free: Collection[str]) -> None:
         self.owners = list(owners)
         self.shapes = list(shapes)
+        self.outlines = [_Outline(s.vertices) if isinstance(s, Polygon) else None for s in shapes]
         self.radii = np.array([s.extent for s in shapes])
         self.sizes = np.array([s.extent if math.isfinite(s.extent) else 0.0 for s in shapes])
         pairs = [
@@ -194,21 +196,22 @@ class PlanarLayout:
         self.first = np.array([i for i, _ in pairs], dtype=int)
         self.second = np.array([j for _, j in pairs], dtype=int)
         self.kernels = [_kernel(shapes[i], shapes[j]) for i, j in pairs]
+        self.planes = np.array([isinstance(shapes[i], HalfPlane) or isinstance(shapes[j], HalfPlane) for i, j in pairs], dtype=bool)
+        self.tolerances = [DUPLICATE_POINT * min(self.sizes[i] or math.inf, self.sizes[j] or math.inf) for i, j in pairs]
 
     def detect(self, poses: FloatArray, margin: float) -> list[ContactPoint]:
         """Contact points of every pair within ``margin``; ``poses`` (n, 3): each collider's [x, y, angle]."""
-        placed = [_Placed(shape, pose) for shape, pose in zip(self.shapes, poses, strict=True)]
+        placed = self._placed(poses)
         found: list[ContactPoint] = []
-        for k in np.flatnonzero(self._near(poses, margin)):
+        for k in np.flatnonzero(self._near(poses, placed, margin)).tolist():
             i, j = int(self.first[k]), int(self.second[k])
-            tolerance = DUPLICATE_POINT * max(min(self.sizes[i] or math.inf, self.sizes[j] or math.inf), 0.0)
-            for point, normal, gap in self.kernels[k](placed[i], placed[j], margin, tolerance):
+            for point, normal, gap in self.kernels[k](placed[i], placed[j], margin, self.tolerances[k]):
                 found.append(ContactPoint(self.owners[i], self.owners[j], point, normal, gap))
         return found
 
     def nearest(self, poses: FloatArray, owners: Collection[str]) -> dict[str, tuple[str, float]]:
         """For each name in ``owners``: the nearest other owner it may touch and the gap (``("", inf)`` if none)."""
-        placed = [_Placed(shape, pose) for shape, pose in zip(self.shapes, poses, strict=True)]
+        placed = self._placed(poses)
         best: dict[str, tuple[str, float]] = {name: ("", math.inf) for name in owners}
         for k, (i, j) in enumerate(zip(self.first.tolist(), self.second.tolist(), strict=True)):
             for mine, theirs in ((i, j), (j, i)):
@@ -218,52 +221,74 @@ class PlanarLayout:
                         best[self.owners[mine]] = (self.owners[theirs], gap)
         return best
 
-    def _near(self, poses: FloatArray, margin: float) -> npt.NDArray[np.bool_]:
+    def _placed(self, poses: FloatArray) -> list[_Placed]:
+        return [_Placed(shape, outline, pose) for shape, outline, pose in zip(self.shapes, self.outlines, poses.tolist(), strict=True)]
+
+    def _near(self, poses: FloatArray, placed: list[_Placed], margin: float) -> npt.NDArray[np.bool_]:
         """Broad phase: bounding circles within ``margin``; against a halfplane, the circle's signed distance."""
         i, j = self.first, self.second
         centres = poses[:, :2]
         reach = np.where(np.isfinite(self.radii), self.radii, 0.0)
-        distance = np.linalg.norm(centres[i] - centres[j], axis=1)
-        near = distance <= reach[i] + reach[j] + margin
-        for k in np.flatnonzero(~np.isfinite(self.radii[i]) | ~np.isfinite(self.radii[j])):
-            plane, other = (i[k], j[k]) if not math.isfinite(self.radii[i[k]]) else (j[k], i[k])
-            normal, offset = _plane_line(self.shapes[plane], poses[plane])  # type: ignore[arg-type]
+        near = np.hypot(*(centres[i] - centres[j]).T) <= reach[i] + reach[j] + margin
+        for k in np.flatnonzero(self.planes).tolist():
+            plane, other = (int(i[k]), int(j[k])) if isinstance(self.shapes[i[k]], HalfPlane) else (int(j[k]), int(i[k]))
+            normal, offset = placed[plane].line()
             near[k] = float(normal @ centres[other]) - offset <= reach[other] + margin
         return near
 
 
-class _Placed:
-    """One shape at one pose, in world coordinates (vertices and outward face normals computed when asked)."""
+class _Outline:
+    """A convex polygon's faces in its own frame, kept while it moves: face k runs from vertex k to k+1."""
 
-    def __init__(self, shape: PlanarShape, pose: FloatArray) -> None:
-        self.shape = shape
-        self.pose = pose
+    def __init__(self, vertices: FloatArray) -> None:
+        self.vertices = vertices
+        self.edges = np.roll(vertices, -1, axis=0) - vertices
+        self.squared = np.einsum("ij,ij->i", self.edges, self.edges)
+        self.normals = np.column_stack([self.edges[:, 1], -self.edges[:, 0]]) / np.sqrt(self.squared)[:, None]  # outward
+        self.offsets = np.einsum("ij,ij->i", self.normals, vertices)
+
+    def closest(self, point: FloatArray) -> FloatArray:
+        """The point of the boundary nearest ``point`` (both in this frame)."""
+        t = np.clip(((point - self.vertices) * self.edges).sum(axis=1) / self.squared, 0.0, 1.0)
+        candidates = self.vertices + t[:, None] * self.edges
+        return np.asarray(candidates[np.argmin(np.hypot(*(candidates - point).T))])
+
+
+class _Placed:
+    """One shape at one pose; its world vertices and faces are worked out when first asked for."""
+
+    def __init__(self, shape: PlanarShape, outline: _Outline | None, pose: list[float]) -> None:
+        self.shape, self.outline = shape, outline
+        self.centre = np.array(pose[:2])
+        self.c, self.s = math.cos(pose[2]), math.sin(pose[2])
+        self._faces: tuple[FloatArray, FloatArray, FloatArray] | None = None
 
     @property
-    def centre(self) -> FloatArray:
-        return self.pose[:2]
+    def rotation_t(self) -> FloatArray:
+        """The transposed rotation: local row vectors times it are world row vectors."""
+        return np.array([[self.c, self.s], [-self.s, self.c]])
 
-    def vertices(self) -> FloatArray:
-        c, s = math.cos(self.pose[2]), math.sin(self.pose[2])
-        local = self.shape.vertices  # type: ignore[union-attr]
-        return np.asarray(local @ np.array([[c, s], [-s, c]]) + self.pose[:2])
+    def to_local(self, point: FloatArray) -> FloatArray:
+        dx, dy = float(point[0] - self.centre[0]), float(point[1] - self.centre[1])
+        return np.array([self.c * dx + self.s * dy, -self.s * dx + self.c * dy])
+
+    def to_world(self, vector: FloatArray) -> FloatArray:
+        """A local direction in the world (no translation)."""
+        return np.array([self.c * vector[0] - self.s * vector[1], self.s * vector[0] + self.c * vector[1]])
+
+    def faces(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """World vertices (k, 2), outward face normals (k, 2) and face offsets (k,) of a polygon."""
+        if self._faces is None:
+            outline, turn = cast(_Outline, self.outline), self.rotation_t
+            normals = outline.normals @ turn
+            self._faces = (outline.vertices @ turn + self.centre, normals, outline.offsets + normals @ self.centre)
+        return self._faces
 
     def line(self) -> tuple[FloatArray, float]:
-        return _plane_line(self.shape, self.pose)  # type: ignore[arg-type]
-
-
-def _plane_line(shape: HalfPlane, pose: FloatArray) -> tuple[FloatArray, float]:
-    """A placed halfplane's world normal and offset."""
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    normal = np.array([c * shape.normal[0] - s * shape.normal[1], s * shape.normal[0] + c * shape.normal[1]])
-    return normal, shape.offset + float(normal @ pose[:2])
-
-
-def _faces(vertices: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Outward unit normals (n, 2) of a counter-clockwise polygon's faces (face k from vertex k to k+1) and their offsets."""
-    edges = np.roll(vertices, -1, axis=0) - vertices
-    normals = np.column_stack([edges[:, 1], -edges[:, 0]]) / np.linalg.norm(edges, axis=1)[:, None]
-    return normals, np.einsum("ij,ij->i", normals, vertices)
+        """A halfplane's world normal and offset."""
+        plane = cast(HalfPlane, self.shape)
+        normal = self.to_world(plane.normal)
+        return normal, plane.offset + float(normal @ self.centre)
 
 
 Kernel = Callable[[_Placed, _Placed, float, float], Witnesses]
@@ -286,10 +311,14 @@ def _kernel(a: PlanarShape, b: PlanarShape) -> Kernel:
     return lambda p, q, margin, tolerance: [(x, -n, g) for x, n, g in swapped(q, p, margin, tolerance)]
 
 
+def _radius(placed: _Placed) -> float:
+    return cast(Disk, placed.shape).radius
+
+
 def _disk_disk(a: _Placed, b: _Placed, margin: float, tolerance: float) -> Witnesses:
-    ra, rb = a.shape.radius, b.shape.radius  # type: ignore[union-attr]
+    ra, rb = _radius(a), _radius(b)
     offset = a.centre - b.centre
-    distance = float(np.hypot(*offset))
+    distance = math.hypot(offset[0], offset[1])
     if distance - ra - rb > margin:
         return []
     normal = offset / distance if distance > 0 else np.array([0.0, 1.0])  # concentric: any direction separates them
@@ -299,7 +328,7 @@ def _disk_disk(a: _Placed, b: _Placed, margin: float, tolerance: float) -> Witne
 
 def _disk_plane(a: _Placed, b: _Placed, margin: float, tolerance: float) -> Witnesses:
     normal, offset = b.line()
-    radius = a.shape.radius  # type: ignore[union-attr]
+    radius = _radius(a)
     height = float(normal @ a.centre) - offset
     if height - radius > margin:
         return []
@@ -307,50 +336,43 @@ def _disk_plane(a: _Placed, b: _Placed, margin: float, tolerance: float) -> Witn
 
 
 def _disk_polygon(a: _Placed, b: _Placed, margin: float, tolerance: float) -> Witnesses:
-    radius = a.shape.radius  # type: ignore[union-attr]
-    vertices = b.vertices()
-    normals, offsets = _faces(vertices)
-    heights = normals @ a.centre - offsets
+    """In the polygon's frame: out through the nearest face when the centre is inside, else to the nearest boundary point."""
+    radius, outline = _radius(a), cast(_Outline, b.outline)
+    centre = b.to_local(a.centre)
+    heights = outline.normals @ centre - outline.offsets
     face = int(np.argmax(heights))
-    if heights[face] <= 0.0:  # the centre is inside: out through the nearest face
-        normal, distance, on_b = normals[face], float(heights[face]), a.centre - heights[face] * normals[face]
+    if heights[face] <= 0.0:
+        normal, distance = outline.normals[face], float(heights[face])
+        on_b = centre - distance * normal
     else:
-        on_b = _closest_on_boundary(vertices, a.centre)
-        offset = a.centre - on_b
-        distance = float(np.hypot(*offset))
-        normal = offset / distance
+        on_b = outline.closest(centre)
+        distance = math.hypot(centre[0] - on_b[0], centre[1] - on_b[1])
+        normal = (centre - on_b) / distance
     if distance - radius > margin:
         return []
-    on_a = a.centre - radius * normal
-    return [(0.5 * (on_a + on_b), normal, distance - radius)]
-
-
-def _closest_on_boundary(vertices: FloatArray, point: FloatArray) -> FloatArray:
-    """The point of a polygon's boundary nearest ``point``."""
-    edges = np.roll(vertices, -1, axis=0) - vertices
-    t = np.clip(np.einsum("ij,ij->i", point - vertices, edges) / np.einsum("ij,ij->i", edges, edges), 0.0, 1.0)
-    candidates = vertices + t[:, None] * edges
-    return np.asarray(candidates[np.argmin(np.linalg.norm(candidates - point, axis=1))])
+    world_normal = b.to_world(normal)
+    point = b.to_world(on_b + 0.5 * (distance - radius) * normal) + b.centre
+    return [(point, world_normal, distance - radius)]
 
 
 def _polygon_plane(a: _Placed, b: _Placed, margin: float, tolerance: float) -> Witnesses:
     """The extreme two vertices within the margin along the line (the corners of the support segment), each with its gap."""
     normal, offset = b.line()
-    vertices = a.vertices()
+    vertices = a.faces()[0]
     gaps = vertices @ normal - offset
     within = np.flatnonzero(gaps <= margin)
     if within.size == 0:
         return []
     along = vertices[within] @ np.array([-normal[1], normal[0]])
     ends = [int(within[np.argmin(along)]), int(within[np.argmax(along)])]
-    if float(np.ptp(along)) <= tolerance:
+    if float(along.max() - along.min()) <= tolerance:
         ends = ends[:1]
     return [(vertices[k] - 0.5 * gaps[k] * normal, normal, float(gaps[k])) for k in ends]
 
 
-def _separation(reference: FloatArray, incident: FloatArray) -> tuple[float, int]:
+def _separation(reference: _Placed, incident: FloatArray) -> tuple[float, int]:
     """The largest separation of ``incident``'s vertices from a face of ``reference``, and that face."""
-    normals, offsets = _faces(reference)
+    _, normals, offsets = reference.faces()
     heights = (incident @ normals.T - offsets).min(axis=0)
     face = int(np.argmax(heights))
     return float(heights[face]), face
@@ -359,42 +381,39 @@ def _separation(reference: FloatArray, incident: FloatArray) -> tuple[float, int
 def _polygon_polygon(a: _Placed, b: _Placed, margin: float, tolerance: float) -> Witnesses:
     """Reference face: the face of either polygon that separates them most; the other's most opposed edge, clipped to
     it, gives the contact points (the two ends of a face-on-face contact)."""
-    va, vb = a.vertices(), b.vertices()
-    along_b, face_b = _separation(vb, va)
-    along_a, face_a = _separation(va, vb)
+    along_b, face_b = _separation(b, a.faces()[0])
+    along_a, face_a = _separation(a, b.faces()[0])
     if max(along_a, along_b) > margin:
         return []
     # prefer b's face (normals then point from b into a) unless a's separates them clearly more
     if along_a > along_b + tolerance:
-        return [(x, -n, g) for x, n, g in _clipped(va, face_a, vb, margin, tolerance)]
-    return _clipped(vb, face_b, va, margin, tolerance)
+        return [(x, -n, g) for x, n, g in _clipped(a, face_a, b, margin, tolerance)]
+    return _clipped(b, face_b, a, margin, tolerance)
 
 
-def _clipped(reference: FloatArray, face: int, incident: FloatArray, margin: float, tolerance: float) -> Witnesses:
+def _clipped(reference: _Placed, face: int, incident: _Placed, margin: float, tolerance: float) -> Witnesses:
     """Points of the incident polygon's edge most opposed to the reference face, within the face's span and the margin;
     normals out of the reference polygon."""
-    normals, offsets = _faces(reference)
-    normal, start = normals[face], reference[face]
-    end = reference[(face + 1) % len(reference)]
-    incident_normals, _ = _faces(incident)
+    vertices, normals, _ = reference.faces()
+    normal, start = normals[face], vertices[face]
+    end = vertices[(face + 1) % len(vertices)]
+    corners, incident_normals, _ = incident.faces()
     edge = int(np.argmin(incident_normals @ normal))
-    ends = np.array([incident[edge], incident[(edge + 1) % len(incident)]])
-    tangent = (end - start) / float(np.hypot(*(end - start)))
-    length = float(tangent @ (end - start))
-    along = (ends - start) @ tangent
-    points: Witnesses = []
+    ends = np.array([corners[edge], corners[(edge + 1) % len(corners)]])
+    length = math.hypot(*(end - start))
+    along = (ends - start) @ ((end - start) / length)
     for bound, keep_below in ((0.0, False), (length, True)):  # clip the segment to 0 <= along <= length
         inside = along <= bound if keep_below else along >= bound
         if not inside.any():
             return []
         if not inside.all():
             t = (bound - along[0]) / (along[1] - along[0])
-            cut = ends[0] + t * (ends[1] - ends[0])
             outside = int(np.flatnonzero(~inside)[0])
-            ends[outside], along[outside] = cut, bound
+            ends[outside], along[outside] = ends[0] + t * (ends[1] - ends[0]), bound
+    points: Witnesses = []
     for point in ends:
         gap = float(normal @ (point - start))
-        if gap <= margin and not any(float(np.hypot(*(point - p))) <= tolerance for p, _, _ in points):
+        if gap <= margin and not any(math.hypot(*(point - p)) <= tolerance for p, _, _ in points):
             points.append((point - 0.5 * gap * normal, normal, gap))
     return points
 
@@ -402,12 +421,18 @@ def _clipped(reference: FloatArray, face: int, incident: FloatArray, margin: flo
 def _distance(kernel: Kernel, a: _Placed, b: _Placed) -> float:
     """The signed distance between two placed shapes (for bodies with no contact): the kernel with no margin limit,
     and for two polygons apart, their nearest vertex-to-edge distance."""
-    gaps = [g for _, _, g in kernel(a, b, math.inf, 0.0)]
-    gap = min(gaps, default=math.inf)
-    if gap > 0 and isinstance(a.shape, Polygon) and isinstance(b.shape, Polygon):
-        va, vb = a.vertices(), b.vertices()
-        gap = min(
-            min(float(np.hypot(*(p - _closest_on_boundary(vb, p)))) for p in va),
-            min(float(np.hypot(*(p - _closest_on_boundary(va, p)))) for p in vb),
-        )
+    gap = min((g for _, _, g in kernel(a, b, math.inf, 0.0)), default=math.inf)
+    if gap > 0 and a.outline is not None and b.outline is not None:
+        gap = min(_nearest_vertex(a, b), _nearest_vertex(b, a))
     return gap
+
+
+def _nearest_vertex(a: _Placed, b: _Placed) -> float:
+    """The least distance from a vertex of ``a`` to ``b``'s boundary."""
+    outline = cast(_Outline, b.outline)
+    distances = []
+    for vertex in a.faces()[0]:
+        local = b.to_local(vertex)
+        nearest = outline.closest(local)
+        distances.append(math.hypot(local[0] - nearest[0], local[1] - nearest[1]))
+    return min(distances)
