@@ -195,6 +195,29 @@ def test_millimetres_and_grams_give_the_same_contacts_and_answer() -> None:
     np.testing.assert_allclose(y.motion.twists["box"], x.motion.twists["box"] * [1000.0, 1000.0, 1.0], atol=1e-9)
 
 
+def test_listed_contacts_add_to_the_found_ones() -> None:
+    data = scene_data()
+    data["contacts"] = [{"body": "box", "other": "table", "point": [0.0, 0.0], "normal": [0.0, 1.0], "mu": 0.5}]
+    w = qs.load_world(data)
+    scene = w.scene()
+    assert len(scene.contacts) == 5 and scene.dimension == 2
+    np.testing.assert_allclose(scene.contacts[-1].point, [0.0, 0.0])  # after the 4 found ones
+    assert qs.solve(w).status == "solved"
+
+
+def test_a_planar_world_built_in_python() -> None:
+    w = qs.PlanarWorld(
+        bodies=(PlanarBody("box", 1.0, Rectangle([0.1, 0.1]), qs.planar_pose([0.0, 0.05])),),
+        movers=(PlanarMover("floor", FLOOR), PlanarMover("wall", HalfPlane([1.0, 0.0], 0.0), qs.planar_pose([0.05, 0.0], math.pi))),
+        detection=ContactDetection(mu=0.5),
+    )
+    found = [(c.other, tuple(np.round(c.normal, 12) + 0.0)) for c in w.detect().contacts]  # the wall turned by pi faces -x
+    assert sorted(found) == [("floor", (0.0, 1.0))] * 2 + [("wall", (-1.0, 0.0))] * 2
+    solution = qs.solve(w)
+    assert solution.status == "solved" and solution.certified  # at rest in the corner
+    np.testing.assert_allclose(solution.motion.twists["box"], 0.0, atol=1e-12)
+
+
 # --------------------------------------------------------------------------- the explicit twin
 
 
@@ -251,6 +274,13 @@ def test_simulate_a_planar_scene_from_the_command_line(tmp_path: Path) -> None:
     assert "every step certified" in result.stdout
     trajectory = qs.Trajectory.load(out)
     np.testing.assert_allclose(trajectory.positions("box")[-1], [0.005, 0.05, 0.0], atol=1e-12)
+
+
+def test_plot_draws_a_planar_world_as_its_scene(tmp_path: Path) -> None:
+    pytest.importorskip("matplotlib")
+    result = run("plot", str(PUSH), "--output", str(tmp_path / "push.png"))
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "push.png").stat().st_size > 0 and "solved" in result.stdout
 
 
 def write(tmp_path: Path, text: str) -> Path:
