@@ -167,7 +167,7 @@ def test_deferred_frictional_force_ranges_decide_indeterminacy_as_the_ranges_do(
             assert [hi for _, hi in ranges] == pytest.approx([hi for _, hi in eager], abs=1e-9)
 
 
-def _pushed_box(heights: tuple[float, ...], mu: float) -> qs.Scene:
+def _box_pushed_by_fingers(heights: tuple[float, ...], mu: float) -> qs.Scene:
     """A 2-D box sliding on two corners (friction ``mu``), pushed in +x by frictionless fingers at ``heights``."""
     box = qs.Body("box", mass=1.0, com=[0.0, 0.05])
     movers = [qs.Mover("table")] + [qs.Mover(f"finger{k}", twist=[0.01, 0.0, 0.0]) for k in range(len(heights))]
@@ -180,7 +180,7 @@ def _pushed_box(heights: tuple[float, ...], mu: float) -> qs.Scene:
 def test_sliding_2d_contacts_decide_indeterminacy_as_the_ranges_do(heights: tuple[float, ...], mu: float) -> None:
     """A 2-D box sliding on two corners: a sliding contact's force lies on one edge of its cone, so a balanced
     point decides "indeterminate" without an LP (two or more fingers); the ranges, built when read, are the LPs'."""
-    problem = qs.assemble(_pushed_box(heights, mu))
+    problem = qs.assemble(_box_pushed_by_fingers(heights, mu))
     edges = aligned_edges(problem, problem.friction.edges)
     raw = BACKENDS["certified"].solver(problem, Options())
     assert raw.status == "solved"
