@@ -18,7 +18,7 @@ from quasistatic.laws.polyhedral import aligned_edges, polyhedral_form
 from quasistatic.solvers import BACKENDS, Options
 from quasistatic.solvers.certify.cheap import kinematic_radius, seed_point
 from quasistatic.solvers.certify.search import enumerate_motions
-from quasistatic.solvers.numerics.forces import forces_at_twist, indeterminate_forces, measured_masks
+from quasistatic.solvers.numerics.forces import ForcesAtTwist, forces_at_twist, indeterminate_forces, measured_masks
 from quasistatic.solvers.numerics.highs import solve_lp
 from quasistatic.solvers.numerics.ranges import value_ranges
 from quasistatic.tolerances import LP_FEASIBILITY
@@ -178,6 +178,36 @@ def test_deferred_frictional_force_ranges_decide_indeterminacy_as_the_ranges_do(
             ranges = found.known if found.known is not None else found.lazy()
             assert [lo for lo, _ in ranges] == pytest.approx([lo for lo, _ in eager], abs=1e-9)
             assert [hi for _, hi in ranges] == pytest.approx([hi for _, hi in eager], abs=1e-9)
+
+
+def _box_pushed_by_fingers(heights: tuple[float, ...], mu: float) -> qs.Scene:
+    """A 2-D box sliding on two corners (friction ``mu``), pushed in +x by frictionless fingers at ``heights``."""
+    box = qs.Body("box", mass=1.0, com=[0.0, 0.05])
+    movers = [qs.Mover("table")] + [qs.Mover(f"finger{k}", twist=[0.01, 0.0, 0.0]) for k in range(len(heights))]
+    contacts = [qs.Contact("box", "table", point=[x, 0.0], normal=[0.0, 1.0], mu=mu) for x in (-0.05, 0.05)]
+    contacts += [qs.Contact("box", f"finger{k}", point=[-0.05, h], normal=[1.0, 0.0]) for k, h in enumerate(heights)]
+    return qs.Scene(bodies=[box], movers=movers, contacts=contacts, dimension=2)
+
+
+@pytest.mark.parametrize(("heights", "mu"), [((0.03, 0.07), 0.5), ((0.01, 0.09), 0.3), ((0.02, 0.05, 0.08), 0.8), ((0.04,), 0.5)])
+def test_sliding_2d_contacts_decide_indeterminacy_as_the_ranges_do(heights: tuple[float, ...], mu: float) -> None:
+    """A 2-D box sliding on two corners: a sliding contact's force lies on one edge of its cone, so a balanced
+    point decides "indeterminate" without an LP (two or more fingers); the ranges, built when read, are the LPs'."""
+    problem = qs.assemble(_box_pushed_by_fingers(heights, mu))
+    edges = aligned_edges(problem, problem.friction.edges)
+    raw = BACKENDS["certified"].solver(problem, Options())
+    assert raw.status == "solved"
+    q = raw.motions[0].q
+    eager = _eager_normal_ranges(problem, edges, q)
+    found = indeterminate_forces(problem, edges, q)
+    wide = any(hi is None or hi - lo > LP_FEASIBILITY for lo, hi in eager)
+    assert (found is not None) == wide == (len(heights) > 1)
+    if found is not None:
+        assert found.known is None and found.lazy is not None  # decided without working the ranges out
+        assert not isinstance(found.force_set, ForcesAtTwist)  # nor building the force set: no LP at all
+        ranges = found.lazy()
+        assert [lo for lo, _ in ranges] == pytest.approx([lo for lo, _ in eager], abs=1e-9)
+        assert [hi for _, hi in ranges] == pytest.approx([hi for _, hi in eager], abs=1e-9)
 
 
 def test_indeterminate_frictional_forces_are_reported_without_running_their_ranges() -> None:

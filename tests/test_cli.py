@@ -30,6 +30,7 @@ EXPECTED_STATUS = {
     "box_push_shapes.yaml": "ambiguous",
     "puck_push_3d.yaml": "solved",
     "push_up_slope.yaml": "solved",
+    "push_up_slope_shapes.yaml": "solved",
     "push_into_wall.yaml": "jammed",
     "compliant_grasp.yaml": "jammed",
     "robot_tip.json": "solved",
@@ -104,6 +105,7 @@ def test_packaged_demo_matches_the_copy_in_examples() -> None:
 EXPECTED_TWISTS = {
     "puck_push_3d.yaml": {"puck": [0.01 * np.cos(np.pi / 6), 0.005, 0.0, 0.0, 0.0, 0.0]},
     "push_up_slope.yaml": {"block": [0.01 * np.cos(np.radians(20.0)), 0.01 * np.sin(np.radians(20.0)), 0.0]},
+    "push_up_slope_shapes.yaml": {"block": [0.01 * np.cos(np.radians(20.0)), 0.01 * np.sin(np.radians(20.0)), 0.0]},
     "robot_tip.json": {"box": [-0.003, 0.003, 0.06]},
     "robot_tip.yaml": {"box": [-0.003, 0.003, 0.06]},
     "squeeze.yaml": {"box": [0.0, 0.0, 0.0]},

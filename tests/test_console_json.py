@@ -25,6 +25,7 @@ EXPECTED = {
     "robot_tip.json": "solved",
     "squeeze.yaml": "solved",
     "push_up_slope.yaml": "solved",
+    "push_up_slope_shapes.yaml": "solved",
     "puck_push_3d.yaml": "solved",
     "box_push_3d.yaml": "ambiguous",
     "box_push_shapes.yaml": "ambiguous",

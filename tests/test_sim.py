@@ -197,7 +197,9 @@ def test_inputs_naming_nothing_are_refused(inputs: Inputs, field: str) -> None:
 
 def test_bad_inputs_and_runs_are_refused() -> None:
     with pytest.raises(qs.SceneError, match="twist has 6 entries"):
-        Inputs(mover_twists={"finger": [1, 2, 3]})
+        Inputs(mover_twists={"finger": [1, 2]})
+    with pytest.raises(qs.SceneError, match="3-D world has 6 entries"):  # a planar twist, in a 3-D world
+        qs.simulate(TIP, duration=1.0, dt=0.5, inputs=Inputs(mover_twists={"finger": [1, 2, 3]}))
     with pytest.raises(qs.SceneError, match=r"inputs\.times"):
         InputTable((0.5, 1.0), (Inputs(), Inputs()))
     with pytest.raises(qs.SceneError, match="duration"):

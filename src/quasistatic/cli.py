@@ -132,12 +132,16 @@ def _loaded(scene_file: Path) -> tuple[Scene, Detection | None]:
 
 def _loaded_world(scene_file: Path) -> tuple[Scene, Detection | None, World | None]:
     """As :func:`_loaded`, and the World of shapes the scene came from (None for a file that lists its contacts)."""
+    from .adapters import World  # adapters load only for scenes of shapes
+
     loaded = _guarded(lambda: load_world(scene_file))
     if isinstance(loaded, Scene):
         return loaded, None, None
-    world: World = loaded
+    world = loaded
     detection = _guarded(world.detect)
-    return _guarded(lambda: world.scene(detection)), detection, world
+    scene = _guarded(lambda: world.scene(detection))
+    # pictures draw 3-D shapes only: a planar world is drawn as its 2-D scene (bodies through their contacts)
+    return scene, detection, world if isinstance(world, World) else None
 
 
 class _StatusLine:
@@ -443,13 +447,20 @@ def _view_trajectory(trajectory_file: Path, scene: Path | None, host: str, port:
 
 def _run_world(trajectory_file: Path, trajectory: Trajectory, scene: Path | None) -> World:
     """The World a run is drawn on: ``--scene``, or the scene file the trajectory names."""
+    from .adapters import World
+
     if scene is None:
         if not trajectory.scene_file:
             _fail(f"{str(trajectory_file)!r} names no scene file (it was run on a World built in Python): give --scene")
-        return _guarded(trajectory.scene_world)
+        world = _guarded(trajectory.scene_world)
+        if not isinstance(world, World):
+            _fail(f"{trajectory.scene_file!r}: runs of planar scenes of shapes are not drawn yet (their states are in the trajectory)")
+        return world
     loaded = _guarded(lambda: load_world(scene))
     if isinstance(loaded, Scene):
         _fail(f"--scene {str(scene)!r} lists its contacts: a trajectory is run on a scene of shapes")
+    if not isinstance(loaded, World):
+        _fail(f"--scene {str(scene)!r}: runs of planar scenes of shapes are not drawn yet (their states are in the trajectory)")
     return loaded
 
 

@@ -17,7 +17,7 @@ from .model import Scene
 from .model.io import read_scene_file, scene_from_file
 
 if TYPE_CHECKING:
-    from .adapters import World
+    from .adapters import AnyWorld
 
 __all__ = ["load_scene", "load_world"]
 
@@ -30,14 +30,15 @@ def load_scene(source: str | Path | Mapping[str, Any]) -> Scene:
     SceneError
         Naming the field and the value (a missing URDF or mesh included).
     BackendUnavailableError
-        For shapes or URDF robots without the ``robots`` extra installed.
+        For 3-D shapes or URDF robots without the ``robots`` extra installed (planar shapes need none).
     """
     loaded = load_world(source)
     return loaded if isinstance(loaded, Scene) else loaded.scene()
 
 
-def load_world(source: str | Path | Mapping[str, Any]) -> Scene | World:
-    """A file that lists its contacts as a Scene; one with shapes or URDF robots as a World (contacts not yet found)."""
+def load_world(source: str | Path | Mapping[str, Any]) -> Scene | AnyWorld:
+    """A file that lists its contacts as a Scene; one with shapes or URDF robots as a World, a planar one
+    (``dimension: 2``) as a PlanarWorld (contacts not yet found)."""
     parsed, folder = read_scene_file(source)
     if not parsed.is_geometric:
         return scene_from_file(parsed)

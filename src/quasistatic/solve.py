@@ -16,7 +16,7 @@ from functools import partial
 
 import numpy as np
 
-from .adapters import Detection, World
+from .adapters import AnyWorld, Detection, PlanarWorld, World
 from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion, audited_step
 from .derivative import SolvedScene
 from .errors import QuasistaticError, SolverError
@@ -34,7 +34,7 @@ _MODE_NAMES = ("rolling", "sliding", "separating")
 
 
 def solve(
-    scene: Scene | Problem | World,
+    scene: Scene | Problem | AnyWorld,
     method: str = "auto",
     *,
     certify: bool = True,
@@ -49,7 +49,7 @@ def solve(
 
     Parameters
     ----------
-    scene : Scene, Problem or World
+    scene : Scene, Problem, World or PlanarWorld
         A validated scene (or one already assembled, to solve it again cheaply), or a
         World of shapes and robots, whose contacts are found first (the answer's message
         then says when a body touches nothing, and how far the nearest surface is).
@@ -85,7 +85,7 @@ def solve(
     Solution
         Every motion in it has been audited on the original scene data.
     """
-    if isinstance(scene, World):
+    if isinstance(scene, World | PlanarWorld):
         detection = scene.detect()
         solution = solve(
             scene.scene(detection),

@@ -5,6 +5,8 @@
 - ``robot``: URDF robots through Pinocchio: forward kinematics, collision geometry, point Jacobians.
 - ``world``: a :class:`World` of shapes and robots, and the Scene it gives at this instant.
 - ``world_file``: a scene file with shapes and robots read into a World.
+- ``planar``, ``planar_world``: planar shapes (disk, box, convex polygon, halfplane), their contacts in NumPy, and
+  the :class:`PlanarWorld` a ``dimension: 2`` scene of shapes is read into (no coal needed).
 
 Rules:
 
@@ -20,12 +22,29 @@ Rules:
 """
 
 from .detect import Collider, ContactPoint, Layout, candidate_pairs, detect
+from .planar import Disk, HalfPlane, PlanarLayout, PlanarShape, Polygon, Rectangle, planar_pose, pose_angle
+from .planar_world import PlanarBody, PlanarMover, PlanarWorld
 from .robot import ROBOTS_INSTALL_HINT, RobotVisual, UrdfRobot
 from .shapes import Box, Capsule, Convex, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere, shape_from_coal
 from .world import ContactDetection, Detection, FrictionPair, ShapedMover, SolidBody, StiffnessPair, World
 from .world_file import world_from_file
 
+AnyWorld = World | PlanarWorld
+"""A world of shapes in space or in the plane: what ``solve``, the command line and a simulation accept."""
+
 __all__ = [
+    "AnyWorld",
+    "Disk",
+    "HalfPlane",
+    "PlanarBody",
+    "PlanarLayout",
+    "PlanarMover",
+    "PlanarShape",
+    "PlanarWorld",
+    "Polygon",
+    "Rectangle",
+    "planar_pose",
+    "pose_angle",
     "ROBOTS_INSTALL_HINT",
     "Box",
     "Capsule",

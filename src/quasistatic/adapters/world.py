@@ -227,6 +227,11 @@ class World:
         )
 
     @property
+    def dimension(self) -> int:
+        """3: shapes, URDF robots and their contacts live in space (:class:`~.planar_world.PlanarWorld` is the 2-D one)."""
+        return 3
+
+    @property
     def contact_margin(self) -> float:
         """Gaps up to this count as contacts [length]: ``detection.margin``, or the default relative to the bodies' size."""
         return self._margin()
@@ -322,7 +327,7 @@ class World:
         """The first friction pair naming ``body`` and ``other`` (or a robot link's whole robot), else the default."""
         table: dict[tuple[str, str], float] = self._kept("mu", dict)
         if (body, other) not in table:
-            pair = _first_pair(self.detection.pairs, body, self._others(other))
+            pair = first_pair(self.detection.pairs, body, self._others(other))
             table[body, other] = self.detection.mu if pair is None else pair.mu
         return table[body, other]
 
@@ -330,7 +335,7 @@ class World:
         """The first stiffness pair naming ``body`` and ``other`` (or a robot link's whole robot), else the detection's default."""
         table: dict[tuple[str, str], Stiffness | None] = self._kept("stiffness", dict)
         if (body, other) not in table:
-            pair = _first_pair(self.detection.stiffness_pairs, body, self._others(other))
+            pair = first_pair(self.detection.stiffness_pairs, body, self._others(other))
             table[body, other] = self.detection.stiffness if pair is None else pair.stiffness
         return table[body, other]
 
@@ -338,7 +343,8 @@ class World:
 _Pair = TypeVar("_Pair", FrictionPair, StiffnessPair)
 
 
-def _first_pair(pairs: tuple[_Pair, ...], body: str, others: set[str]) -> _Pair | None:
+def first_pair(pairs: tuple[_Pair, ...], body: str, others: set[str]) -> _Pair | None:
+    """The first pair naming ``body`` and one of ``others`` (either way round), or None."""
     for pair in pairs:
         a, b = pair.between
         if (a == body and b in others) or (b == body and a in others):

@@ -31,6 +31,8 @@ from ..model.io import (
     stiffness_of,
 )
 from ..tolerances import MAX_FRICTION
+from .planar import Disk, HalfPlane, PlanarShape, Polygon, Rectangle, planar_pose
+from .planar_world import PlanarBody, PlanarMover, PlanarWorld
 from .robot import UrdfRobot
 from .shapes import Box, Capsule, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere
 from .world import ContactDetection, FrictionPair, ShapedMover, SolidBody, StiffnessPair, World
@@ -38,12 +40,13 @@ from .world import ContactDetection, FrictionPair, ShapedMover, SolidBody, Stiff
 __all__ = ["world_from_file"]
 
 _SHAPE_KINDS = ("box", "sphere", "cylinder", "capsule", "halfspace", "mesh")
+_PLANAR_KINDS = ("disk", "box", "polygon", "halfplane")
 
 
-def world_from_file(parsed: SceneFile, folder: Path) -> World:
-    """The World a checked scene file describes; relative paths start from ``folder``."""
-    if parsed.dimension != 3:
-        raise SceneError("dimension", parsed.dimension, "shapes and URDF robots are 3-D; give dimension 3 (the default)")
+def world_from_file(parsed: SceneFile, folder: Path) -> World | PlanarWorld:
+    """The World a checked scene file describes (a PlanarWorld for ``dimension: 2``); relative paths start from ``folder``."""
+    if parsed.dimension == 2:
+        return _planar_world(parsed)
     urdf_robots = {name: r for name, r in parsed.robots.items() if r.urdf is not None}
     plain_robots = {name: r for name, r in parsed.robots.items() if r.urdf is None}
     return World(
@@ -128,6 +131,9 @@ def _plain_robot(name: str, entry: RobotFile) -> Robot:
 
 
 def _shape(entry: ShapeFile, folder: Path, field: str) -> Shape:
+    planar = [kind for kind in _PLANAR_KINDS if kind != "box" and getattr(entry, kind) is not None]
+    if planar:
+        raise SceneError(f"{field}.{planar[0]}", getattr(entry, planar[0]), "a planar shape: give the scene dimension: 2")
     given = [kind for kind in _SHAPE_KINDS if getattr(entry, kind) is not None]
     if len(given) != 1:
         reason = f"give exactly one of {', '.join(_SHAPE_KINDS)}" + (f" (given: {', '.join(given)})" if given else "")
@@ -161,6 +167,8 @@ def _built_shape(entry: ShapeFile, kind: str, folder: Path) -> Shape:
 def _pose(entry: PoseFile | None, field: str) -> Pose:
     if entry is None:
         return Pose()
+    if entry.angle is not None:
+        raise SceneError(f"{field}.angle", entry.angle, "an angle places a planar shape (dimension: 2); in 3-D give a rotation")
     position = _vector(entry.position, f"{field}.position")
     rotation = entry.rotation
     if rotation is None:
@@ -234,3 +242,76 @@ def _contact(entry: ContactFile, index: int) -> Contact:
             return Contact(entry.body, entry.other, entry.point, entry.normal, entry.mu, entry.jacobian, stiffness)
         except SceneError as exc:
             raise SceneError(exc.field.removeprefix("contact."), exc.value, exc.reason) from None
+
+
+# --------------------------------------------------------------------------- planar scenes (dimension: 2)
+
+
+def _planar_world(parsed: SceneFile) -> PlanarWorld:
+    """The PlanarWorld of a ``dimension: 2`` file: planar shapes and poses, no URDF robots."""
+    for name, robot in parsed.robots.items():
+        if robot.urdf is not None:
+            raise SceneError(f"robots.{name}.urdf", robot.urdf, "URDF robots are 3-D; a planar scene (dimension: 2) takes shapes only")
+    return PlanarWorld(
+        bodies=tuple(_planar_body(name, b) for name, b in parsed.bodies.items()),
+        movers=tuple(_planar_mover(name, m) for name, m in parsed.movers.items()),
+        explicit_robots=tuple(_plain_robot(name, r) for name, r in parsed.robots.items()),
+        contacts=tuple(_contact(c, index) for index, c in enumerate(parsed.contacts)),
+        detection=_detection(parsed.contact_detection),
+        gravity=parsed.gravity,
+        friction=parsed.friction,
+        stiffness=stiffness_of(parsed.stiffness, "stiffness"),
+        closing_time=parsed.closing_time,
+    )
+
+
+def _planar_body(name: str, entry: BodyFile) -> PlanarBody:
+    field = f"bodies.{name}"
+    shape = None if entry.shape is None else _planar_shape(entry.shape, f"{field}.shape")
+    pose = _planar_pose(entry.pose, f"{field}.pose")
+    com = [0.0, 0.0] if entry.com is None else entry.com
+    if len(com) != 2 or not np.all(np.isfinite(com)):
+        raise SceneError(f"{field}.com", com, "expected [x, y], finite, in a planar scene")
+    return PlanarBody(name, entry.mass, shape, pose, np.array(com, dtype=float), entry.wrench)
+
+
+def _planar_mover(name: str, entry: MoverFile | None) -> PlanarMover:
+    field = f"movers.{name}"
+    if entry is None:
+        return PlanarMover(name)
+    if entry.robot is not None or entry.origin is not None:
+        key = "robot" if entry.robot is not None else "origin"
+        reason = "in a planar scene of shapes, a mover's twist [vx, vy, w] is about its pose's position"
+        raise SceneError(f"{field}.{key}", getattr(entry, key), reason)
+    shape = None if entry.shape is None else _planar_shape(entry.shape, f"{field}.shape")
+    return PlanarMover(name, shape, _planar_pose(entry.pose, f"{field}.pose"), entry.twist)
+
+
+def _planar_shape(entry: ShapeFile, field: str) -> PlanarShape:
+    given = [kind for kind in (*_PLANAR_KINDS, *_SHAPE_KINDS[1:]) if getattr(entry, kind) is not None]
+    if given and given[0] not in _PLANAR_KINDS:
+        reason = "a 3-D shape; a planar scene takes disk, box, polygon or halfplane"
+        raise SceneError(f"{field}.{given[0]}", getattr(entry, given[0]), reason)
+    if len(given) != 1:
+        raise SceneError(field, given or None, f"give exactly one of {', '.join(_PLANAR_KINDS)}")
+    if entry.scale is not None:
+        raise SceneError(f"{field}.scale", entry.scale, "only a mesh takes a scale (3-D)")
+    kind = given[0]
+    path = f"{field}.{kind}"
+    if entry.disk is not None:
+        return Disk(entry.disk, path)
+    if entry.box is not None:
+        return Rectangle(entry.box, path)
+    if entry.polygon is not None:
+        return Polygon(entry.polygon, path)
+    assert entry.halfplane is not None
+    return HalfPlane(entry.halfplane.normal, entry.halfplane.offset, path)
+
+
+def _planar_pose(entry: PoseFile | None, field: str) -> Pose:
+    if entry is None:
+        return planar_pose()
+    if entry.rotation is not None:
+        raise SceneError(f"{field}.rotation", "rotation", "a planar pose turns by an angle: {position: [x, y], angle: theta}")
+    position = entry.position if "position" in entry.model_fields_set else [0.0, 0.0]
+    return planar_pose(position, 0.0 if entry.angle is None else entry.angle, field)

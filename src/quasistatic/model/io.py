@@ -65,10 +65,12 @@ class _FileModel(pydantic.BaseModel):
 
 
 class PoseFile(_FileModel):
-    """``{position: [x, y, z], rotation: {rpy: [...]} | {quaternion: [w, x, y, z]} | {matrix: [[...], ...]}}``."""
+    """``{position: [x, y, z], rotation: {rpy: [...]} | {quaternion: [w, x, y, z]} | {matrix: [[...], ...]}}``;
+    in a planar scene (``dimension: 2``) ``{position: [x, y], angle: theta}`` (radians, counter-clockwise)."""
 
     position: list[_Number] = [0.0, 0.0, 0.0]
     rotation: RotationFile | None = None
+    angle: _Number | None = None
 
 
 class RotationFile(_FileModel):
@@ -93,7 +95,8 @@ class HalfspaceFile(_FileModel):
 
 class ShapeFile(_FileModel):
     """Exactly one shape: ``box`` (3 full edge lengths), ``sphere`` (radius), ``cylinder``/``capsule`` (along the local z
-    axis), ``halfspace``, or ``mesh`` (a file path, relative to the scene file) with an optional ``scale``."""
+    axis), ``halfspace``, or ``mesh`` (a file path, relative to the scene file) with an optional ``scale``.
+    In a planar scene: ``disk`` (radius), ``box`` ([width, height]), ``polygon`` (convex, [[x, y], ...]) or ``halfplane``."""
 
     box: list[_Number] | None = None
     sphere: _Number | None = None
@@ -102,6 +105,9 @@ class ShapeFile(_FileModel):
     halfspace: HalfspaceFile | None = None
     mesh: str | None = None
     scale: _Number | list[_Number] | None = None
+    disk: _Number | None = None
+    polygon: list[list[_Number]] | None = None
+    halfplane: HalfspaceFile | None = None
 
 
 class BodyFile(_FileModel):

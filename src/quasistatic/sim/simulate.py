@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..adapters import World
+from ..adapters import AnyWorld, PlanarWorld, World
 from ..errors import SceneError
 from ..loading import load_world
 from ..model import Scene
@@ -28,7 +28,7 @@ Signature = tuple[str, tuple[tuple[tuple[str, str], tuple[str, ...]], ...]]
 
 
 def simulate(
-    scene: World | Scene | str | Path | dict[str, Any],
+    scene: AnyWorld | Scene | str | Path | dict[str, Any],
     duration: float,
     dt: float = 0.01,
     inputs: InputSource = None,
@@ -91,9 +91,9 @@ def simulate(
     return Trajectory(tuple(states), tuple(steps), status, message, scene_file)
 
 
-def _world(scene: World | Scene | str | Path | dict[str, Any]) -> World:
+def _world(scene: AnyWorld | Scene | str | Path | dict[str, Any]) -> AnyWorld:
     world = load_world(scene) if isinstance(scene, str | Path | dict) else scene
-    if not isinstance(world, World):
+    if not isinstance(world, World | PlanarWorld):
         raise SceneError(
             "bodies", "listed contacts", "a simulation needs a scene of shapes or URDF robots, whose contacts it finds again at every step"
         )
@@ -192,8 +192,10 @@ def _fall(before: Evaluation) -> str:
     for body in before.world.bodies:
         twist = before.twist(body.name)
         if np.any(twist):
-            v, w = twist[:3], twist[3:]
-            parts.append(f"{body.name!r} (its centre of mass was moving along {_unit(v)}, turning about {_unit(w)})")
+            dim = before.world.dimension
+            v, w = twist[:dim], twist[dim:]
+            turning = f"about {_unit(w)}" if dim == 3 else _sense(float(w[0]))
+            parts.append(f"{body.name!r} (its centre of mass was moving along {_unit(v)}, turning {turning})")
     return "; it falls as it last moved: " + ", ".join(parts) if parts else ""
 
 
@@ -218,6 +220,11 @@ def _blocking(evaluation: Evaluation) -> str:
         {f"{contacts[i].body}/{contacts[i].other}" for i in np.flatnonzero(weights > ZERO * max(float(weights.max()), 1e-300))}
     )
     return f"; blocking contacts: {', '.join(blocking)}" if blocking else ""
+
+
+def _sense(w: float) -> str:
+    """How a planar body turns."""
+    return "counter-clockwise" if w > 0 else "clockwise" if w < 0 else "not at all"
 
 
 def _unit(vector: np.ndarray) -> str:

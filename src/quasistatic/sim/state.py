@@ -12,18 +12,19 @@ import bisect
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
-from typing import TypeAlias
+from typing import TypeAlias, TypeVar, cast
 
 import numpy as np
 import numpy.typing as npt
 
-from ..adapters import Pose, World
+from ..adapters import AnyWorld, PlanarWorld, Pose, World
 from ..errors import SceneError
 from ..model import checked_array, checked_number
 
 __all__ = ["State", "Inputs", "InputTable", "InputSource", "inputs_at"]
 
 FloatArray = npt.NDArray[np.float64]
+W = TypeVar("W", bound=World | PlanarWorld)  # applied to a World, a state gives a World; to a PlanarWorld, a PlanarWorld
 
 
 def _frozen(mapping: Mapping[str, object]) -> Mapping[str, object]:
@@ -40,7 +41,7 @@ class State:
     robots: Mapping[str, FloatArray]
 
     @classmethod
-    def of(cls, world: World, time: float = 0.0) -> State:
+    def of(cls, world: AnyWorld, time: float = 0.0) -> State:
         """The state a World describes."""
         return cls(
             time,
@@ -49,9 +50,9 @@ class State:
             _frozen({r.name: np.array(r.q, dtype=float) for r in world.robots}),  # type: ignore[arg-type]
         )
 
-    def applied(self, world: World) -> World:
+    def applied(self, world: W) -> W:
         """``world`` at this state: the same shapes and parsed models (and detection layout), placed here."""
-        return world.moved(self.bodies, self.robots, mover_poses=self.movers)
+        return cast(W, world.moved(self.bodies, self.robots, mover_poses=self.movers))
 
 
 @dataclass(frozen=True)
@@ -59,7 +60,7 @@ class Inputs:
     """What the user commands at one instant: joint velocities per robot, twists per mover.
 
     A mover's twist is [velocity of its pose origin, angular velocity] in the world frame, as in
-    a scene file. Robots and movers not named keep the velocities of the scene.
+    a scene file: 6 entries in space, 3 ([vx, vy, w]) in a planar world. Robots and movers not named keep the velocities of the scene.
     """
 
     joint_velocities: Mapping[str, FloatArray]
@@ -71,19 +72,21 @@ class Inputs:
         velocities = {n: checked_array(v, f"inputs.joint_velocities.{n}") for n, v in (joint_velocities or {}).items()}
         twists = {n: checked_array(t, f"inputs.mover_twists.{n}") for n, t in (mover_twists or {}).items()}
         for name, twist in twists.items():
-            if twist.shape != (6,):
-                raise SceneError(f"inputs.mover_twists.{name}", twist.tolist(), "a twist has 6 entries: [vx, vy, vz, wx, wy, wz]")
+            if twist.shape not in ((6,), (3,)):
+                reason = "a twist has 6 entries, [vx, vy, vz, wx, wy, wz] (3 in a planar world: [vx, vy, w])"
+                raise SceneError(f"inputs.mover_twists.{name}", twist.tolist(), reason)
         object.__setattr__(self, "joint_velocities", _frozen(velocities))
         object.__setattr__(self, "mover_twists", _frozen(twists))
 
     @classmethod
-    def of(cls, world: World) -> Inputs:
+    def of(cls, world: AnyWorld) -> Inputs:
         """The velocities a World's scene describes."""
-        twists = {m.name: np.zeros(6) if m.twist is None else np.asarray(m.twist, dtype=float) for m in world.movers}
+        size = 3 if world.dimension == 2 else 6
+        twists = {m.name: np.zeros(size) if m.twist is None else np.asarray(m.twist, dtype=float) for m in world.movers}
         return cls({r.name: r.joint_velocities for r in world.robots}, twists)
 
-    def check(self, world: World) -> None:
-        """Every name is a robot or mover of ``world``, with the right number of joint velocities."""
+    def check(self, world: AnyWorld) -> None:
+        """Every name is a robot or mover of ``world``, with the right number of joint velocities and twist entries."""
         robots = {r.name: r for r in world.robots}
         movers = {m.name for m in world.movers}
         for name, velocities in self.joint_velocities.items():
@@ -92,13 +95,17 @@ class Inputs:
             count = len(robots[name].joint_names)
             if velocities.shape != (count,):
                 raise SceneError(f"inputs.joint_velocities.{name}", velocities.tolist(), f"needs {count} values, one per joint")
-        for name in self.mover_twists:
+        size = 3 if world.dimension == 2 else 6
+        for name, twist in self.mover_twists.items():
             if name not in movers:
                 raise SceneError("inputs.mover_twists", name, f"names no mover of the scene (movers: {sorted(movers)})")
+            if twist.shape != (size,):
+                reason = f"a twist in this {world.dimension}-D world has {size} entries"
+                raise SceneError(f"inputs.mover_twists.{name}", twist.tolist(), reason)
 
-    def applied(self, world: World) -> World:
+    def applied(self, world: W) -> W:
         """``world`` with these velocities; what is not named keeps the scene's."""
-        return world.moved(joint_velocities=self.joint_velocities, mover_twists=self.mover_twists)
+        return cast(W, world.moved(joint_velocities=self.joint_velocities, mover_twists=self.mover_twists))
 
 
 @dataclass(frozen=True)

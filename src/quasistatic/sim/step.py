@@ -18,7 +18,7 @@ from typing import Literal, cast
 import numpy as np
 import numpy.typing as npt
 
-from ..adapters import Detection, World
+from ..adapters import AnyWorld, Detection
 from ..errors import SceneError
 from ..model import Contact
 from ..solution import Mode, Motion, Solution, Status
@@ -60,7 +60,7 @@ class StepOptions:
 class SimModel:
     """What does not change over a run: the World (shapes, masses, parsed robots, friction) and the step options."""
 
-    world: World
+    world: AnyWorld
     options: StepOptions = field(default_factory=StepOptions)
 
     @cached_property
@@ -69,12 +69,12 @@ class SimModel:
         return self.world.contact_margin
 
     @cached_property
-    def detecting(self) -> World:
+    def detecting(self) -> AnyWorld:
         """The World searching the look-ahead band too: built once, so every step reuses its detection layout."""
         band = self.margin + SIM_LOOKAHEAD * self.world.size
         return replace(self.world, detection=replace(self.world.detection, margin=band))
 
-    def found_at(self, state: State, world: World) -> Detection:
+    def found_at(self, state: State, world: AnyWorld) -> Detection:
         """``world.detect()``, ``world`` being the look-ahead World placed at ``state``; the contacts found at the
         state a step ended on (:func:`advance` looks for drifted contacts there) serve the next step, which
         starts on that very State. Detection reads poses and joint positions only, never the inputs."""
@@ -118,7 +118,7 @@ class Evaluation:
 
     state: State  # after any penetration was corrected
     inputs: Inputs
-    world: World  # at this state, detecting over the look-ahead band
+    world: AnyWorld  # at this state, detecting over the look-ahead band
     margin: float  # the contact margin [length]
     detection: Detection
     near: tuple[tuple[Contact, float], ...]  # surfaces within the look-ahead band, not yet touching, and their gaps
@@ -137,9 +137,9 @@ class Evaluation:
         return self.solution.certified
 
     def twist(self, body: str) -> FloatArray:
-        """The body's twist [v of its centre of mass, w]; zero for a body the motion does not move."""
+        """The body's twist [v of its centre of mass, w] ([vx, vy, w] in the plane); zero for a body the motion does not move."""
         if self.motion is None or body not in self.motion.twists:
-            return np.zeros(6)
+            return np.zeros(_twist_size(self.world))
         return np.asarray(self.motion.twists[body], dtype=float)
 
     def contact_records(self) -> tuple[ContactRecord, ...]:
@@ -147,7 +147,7 @@ class Evaluation:
         contacts = self.detection.contacts
         if self.motion is None:
             return tuple(
-                ContactRecord(c.body, c.other, c.point, c.normal, g, np.zeros(3), None)
+                ContactRecord(c.body, c.other, c.point, c.normal, g, np.zeros(len(c.normal)), None)
                 for c, g in zip(contacts, self.detection.gaps, strict=True)
             )
         forces, slips = self.motion.forces_and_slips()  # no force ranges: a run records the forces taken
@@ -226,7 +226,7 @@ def evaluate(model: SimModel, state: State, inputs: Inputs) -> Evaluation:
     return Evaluation(state, inputs, world, margin, detection, near, solution, motion, choice, penetration, model)
 
 
-def _isolated(world: World, found: Detection, touching: list[int]) -> Mapping[str, tuple[str, float]]:
+def _isolated(world: AnyWorld, found: Detection, touching: list[int]) -> Mapping[str, tuple[str, float]]:
     """Bodies with no contact: the nearest surface the wider search saw, else what detection said."""
     touched = {found.contacts[i].body for i in touching} | {found.contacts[i].other for i in touching}
     isolated = dict(found.isolated)
@@ -255,7 +255,9 @@ def _chosen(solution: Solution, policy: AmbiguityPolicy) -> tuple[Motion | None,
 # --------------------------------------------------------------------------- penetration
 
 
-def _corrected(model: SimModel, state: State, inputs: Inputs, world: World, found: Detection) -> tuple[State, World, Detection, float]:
+def _corrected(
+    model: SimModel, state: State, inputs: Inputs, world: AnyWorld, found: Detection
+) -> tuple[State, AnyWorld, Detection, float]:
     """Move the free bodies out of any penetration deeper than the tolerance, by the least motion (twice at most)."""
     depth = max((-g for g in found.gaps), default=0.0)
     first_depth = max(depth, 0.0)
@@ -269,28 +271,40 @@ def _corrected(model: SimModel, state: State, inputs: Inputs, world: World, foun
     return state, world, found, first_depth
 
 
-def _pushed_out(state: State, world: World, deep: list[tuple[Contact, float]]) -> State:
-    """Least-norm body displacements (6 per body, rotations scaled by the body's size) that close each gap."""
+def _pushed_out(state: State, world: AnyWorld, deep: list[tuple[Contact, float]]) -> State:
+    """Least-norm body displacements (a twist's entries per body, rotations scaled by the body's size) that close each gap."""
     bodies = {b.name: b for b in world.bodies}
     names = sorted({c.body for c, _ in deep} | {c.other for c, _ in deep if c.other in bodies})
-    column = {name: 6 * i for i, name in enumerate(names)}
+    width, dim = _twist_size(world), world.dimension
+    column = {name: width * i for i, name in enumerate(names)}
     size = world.size
-    rows = np.zeros((len(deep), 6 * len(names)))
+    rows = np.zeros((len(deep), width * len(names)))
     for row, (contact, _) in enumerate(deep):
         for name, sign in ((contact.body, 1.0), (contact.other, -1.0)):
             if name in column:
                 com = bodies[name].body().com
                 j = column[name]
-                rows[row, j : j + 3] = sign * contact.normal
-                rows[row, j + 3 : j + 6] = sign * np.cross(contact.point - com, contact.normal) / size
+                rows[row, j : j + dim] = sign * contact.normal
+                rows[row, j + dim : j + width] = sign * _moment(contact.point - com, contact.normal) / size
     closing = np.array([-g for _, g in deep])
     displacement = np.linalg.lstsq(rows, closing, rcond=None)[0]
     poses = dict(state.bodies)
     for name in names:
-        d = displacement[column[name] : column[name] + 6]
+        d = displacement[column[name] : column[name] + width]
         com = bodies[name].body().com
-        poses[name] = advance_pose(poses[name], np.concatenate([d[:3], d[3:] / size]), com, 1.0)
+        poses[name] = advance_pose(poses[name], np.concatenate([d[:dim], d[dim:] / size]), com, 1.0)
     return replace(state, bodies=poses)
+
+
+def _moment(arm: FloatArray, force: FloatArray) -> FloatArray:
+    """``arm x force``: a 3-vector in space, a 1-vector (its z part) in the plane."""
+    if len(arm) == 2:
+        return np.array([arm[0] * force[1] - arm[1] * force[0]])
+    return np.cross(arm, force)
+
+
+def _twist_size(world: AnyWorld) -> int:
+    return 3 if world.dimension == 2 else 6
 
 
 # --------------------------------------------------------------------------- advance
@@ -304,7 +318,8 @@ def advance(evaluation: Evaluation, h: float) -> State:
     """
     state, world = evaluation.state, evaluation.world
     bodies = {b.name: advance_pose(state.bodies[b.name], evaluation.twist(b.name), b.body().com, h) for b in world.bodies}
-    movers = {m.name: advance_pose(state.movers[m.name], _mover_twist(m.twist), m.pose.position, h) for m in world.movers}
+    size = _twist_size(world)
+    movers = {m.name: advance_pose(state.movers[m.name], _mover_twist(m.twist, size), m.pose.position, h) for m in world.movers}
     robots = {r.name: state.robots[r.name] + h * np.asarray(r.joint_velocities, dtype=float) for r in world.robots}
     return _reclosed(evaluation, State(state.time + h, bodies, movers, robots))
 
@@ -346,8 +361,8 @@ def _was_closed(before: list[tuple[Contact, Mode]], contact: Contact, band: floa
     return distance <= band and mode in ("rolling", "sliding")
 
 
-def _mover_twist(twist: npt.ArrayLike | None) -> FloatArray:
-    return np.zeros(6) if twist is None else np.asarray(twist, dtype=float)
+def _mover_twist(twist: npt.ArrayLike | None, size: int) -> FloatArray:
+    return np.zeros(size) if twist is None else np.asarray(twist, dtype=float)
 
 
 def step(model: SimModel, state: State, inputs: Inputs, h: float | None = None) -> tuple[State, StepResult]:
@@ -389,25 +404,26 @@ def _velocity(evaluation: Evaluation, name: str, contact: Contact) -> FloatArray
             return point_velocity(evaluation.twist(name), body.body().com, contact.point)
     for mover in world.movers:
         if mover.name == name:
-            return point_velocity(_mover_twist(mover.twist), mover.pose.position, contact.point)
+            return point_velocity(_mover_twist(mover.twist, _twist_size(world)), mover.pose.position, contact.point)
     if contact.jacobian is not None:  # a robot link
         robot = next(r for r in world.robots if contact.other.startswith(f"{r.name}/"))
         return np.asarray(contact.jacobian @ robot.joint_velocities, dtype=float)
-    return np.zeros(3)
+    return np.zeros(world.dimension)
 
 
 def _fastest_point(evaluation: Evaluation) -> float:
     """An upper bound on the speed of any point of a body, mover or robot link near the bodies."""
     world = evaluation.world
+    dim = world.dimension
     reach = world.size + max((float(np.linalg.norm(b.body().com)) for b in world.bodies), default=0.0)
     speeds = [0.0]
     for body in world.bodies:
         twist = evaluation.twist(body.name)
-        speeds.append(float(np.linalg.norm(twist[:3]) + np.linalg.norm(twist[3:]) * world.size))
+        speeds.append(float(np.linalg.norm(twist[:dim]) + np.linalg.norm(twist[dim:]) * world.size))
     for mover in world.movers:
-        twist = _mover_twist(mover.twist)
+        twist = _mover_twist(mover.twist, _twist_size(world))
         extent = mover.shape.extent if mover.shape is not None and math.isfinite(mover.shape.extent) else reach
-        speeds.append(float(np.linalg.norm(twist[:3]) + np.linalg.norm(twist[3:]) * extent))
+        speeds.append(float(np.linalg.norm(twist[:dim]) + np.linalg.norm(twist[dim:]) * extent))
     for robot in world.robots:
         rates = np.asarray(robot.joint_velocities, dtype=float)
         if not rates.any():

@@ -10,7 +10,7 @@ from typing import Any, Literal, cast
 import numpy as np
 import numpy.typing as npt
 
-from ..adapters import Pose, World
+from ..adapters import AnyWorld, PlanarWorld, Pose, World
 from ..errors import QuasistaticError, SceneError
 from ..loading import load_world
 from ..solution import Status
@@ -71,7 +71,7 @@ class Trajectory:
         """The body's (or mover's) rotation matrix at every state, (n, 3, 3)."""
         return np.array([_pose(s, body).rotation for s in self.states])
 
-    def scene_world(self) -> World:
+    def scene_world(self) -> AnyWorld:
         """The World of :attr:`scene_file`, read again (to draw the run on: the states place it).
 
         Raises :class:`SceneError` when the trajectory names no scene file (it was run on a World built in
@@ -80,7 +80,7 @@ class Trajectory:
         if not self.scene_file:
             raise SceneError("scene", "", "the trajectory names no scene file (it was run on a World built in Python): give the World")
         world = load_world(self.scene_file)
-        if not isinstance(world, World):
+        if not isinstance(world, World | PlanarWorld):
             raise SceneError("scene", self.scene_file, "lists its contacts: a trajectory is run on a scene of shapes")
         return world
 
@@ -93,6 +93,8 @@ class Trajectory:
             world, why = self.scene_world(), ""
         except (QuasistaticError, OSError) as error:
             world, why = None, str(error)
+        if isinstance(world, PlanarWorld):
+            world, why = None, "runs of planar scenes of shapes are not drawn yet"
         return trajectory_html(self, world, why)
 
     def joint_positions(self, robot: str) -> FloatArray:

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..adapters import World
+from ..errors import SceneError
 from ..sim import State, StepResult, Trajectory
 from .animation import check_run_names, frame_indices
 from .geometry import VIEWS
@@ -244,6 +245,8 @@ def view_trajectory(
         When viser (the ``viewer`` extra) is not installed.
     """
     source = trajectory.scene_world() if world is None else world
+    if not isinstance(source, World):
+        raise SceneError("scene", trajectory.scene_file, "runs of planar scenes of shapes are not drawn yet")
     check_run_names(trajectory, source)
     if camera not in VIEWS:
         raise ValueError(f"view: {camera!r} is not one of {', '.join(VIEWS)}")

@@ -25,7 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import nnls
 
-from ...laws import ModeMasks, Problem, slips
+from ...laws import ForceSet, ModeMasks, Problem, slips
 from ...laws.polyhedral import ForcePolytope, aligned_edges, dense_force_matrix, force_polytope
 from ...tolerances import FORCE_INTERIOR, FORCE_RANK, LP_FEASIBILITY, ZERO
 from ..result import Range
@@ -200,7 +200,7 @@ class IndeterminateForces:
 
     known: tuple[Range, ...] | None
     lazy: Callable[[], tuple[Range, ...]] | None
-    force_set: ForcesAtTwist
+    force_set: ForceSet
 
 
 def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> IndeterminateForces | None:
@@ -210,7 +210,8 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     pulled sideways, has fixed normal forces but a free split of the pull between its supports): no
     component varies by more than ``LP_FEASIBILITY`` over the set (:func:`~.ranges.ranges_are_wide`).
     A segment of consistent forces through a balanced point found by least squares that moves some
-    force component by more than that: indeterminate, without an LP (:func:`_wide_through_balanced_point`).
+    force component by more than that: indeterminate, without an LP (:func:`_wide_through_balanced_point`),
+    and the force set and its ranges are built only when read.
     Free columns of full rank: one force distribution, None. Every force component a combination of
     the equations (only the edge intensities vary, as both edges of a 2-D contact that sticks): None.
     Otherwise one LP decides (:func:`_forces_vary`), and the ranges wait until they are read; where it
@@ -221,10 +222,11 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     normal = np.arange(m)  # the polytope's first columns
     if min(problem.n_dof + m, m * (K + 2)) <= DENSE_MAX and _forces_fixed(problem, edges, q, masks, _component_rows(edges)):
         return None  # decided densely, before any sparse matrix is built (~0.5 ms on a grasp)
+    if _wide_through_balanced_point(problem, masks, K, q):
+        later = _LaterForces(problem, edges, q, masks)  # a simulation step never reads them (~1.2 ms on a planar push)
+        return IndeterminateForces(None, partial(later.normal_ranges, normal), later)
     forces = forces_at_twist(problem, edges, q, masks)
     work = partial(_normal_ranges, forces, normal)
-    if _wide_through_balanced_point(problem, masks, forces.polytope.K):
-        return IndeterminateForces(None, work, forces)
     A = forces.A.toarray() if min(forces.A.shape) <= DENSE_MAX else forces.A.tocsc()
     if not isinstance(A, np.ndarray) and _fixed_by_equations(A, forces.fixed, None):
         return None
@@ -267,10 +269,32 @@ def _tangent_rows(edges: np.ndarray, contacts: np.ndarray) -> np.ndarray:
     return rows
 
 
-def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count: int) -> bool:
+class _LaterForces:
+    """:func:`forces_at_twist`, built when first read: a :class:`~quasistatic.laws.ForceSet` and the normal ranges."""
+
+    def __init__(self, problem: Problem, edges: np.ndarray, q: np.ndarray, masks: ModeMasks) -> None:
+        self.problem, self.edges, self.q, self.masks = problem, edges, q, masks
+
+    @cached_property
+    def forces(self) -> ForcesAtTwist:
+        return forces_at_twist(self.problem, self.edges, self.q, self.masks)
+
+    def normal_ranges(self, normal: np.ndarray) -> tuple[Range, ...]:
+        return _normal_ranges(self.forces, normal)
+
+    def ranges(self, functionals: np.ndarray) -> list[Bounds]:
+        return self.forces.ranges(functionals)
+
+    def feasible(self, functionals: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
+        return self.forces.feasible(functionals, lower, upper)
+
+
+def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count: int, q: np.ndarray) -> bool:
     """True when a segment of forces consistent with the modes moves some force component by more than ``LP_FEASIBILITY``.
 
-    Only where no frictional contact slides. Every closed contact may then carry a force in its
+    In 3-D, only where no frictional contact slides; in 2-D a sliding contact's force is ``cn (n - mu s)``,
+    ``s`` its slip's direction (the modes hold it on that edge of its cone): one column, ``cn >= 0``, as a
+    frictionless contact's normal force. Every other closed contact may carry a force in its
     ``edge_count``-gon cone (frictionless ones a normal force alone), and that cone holds the disc cone
     ``|c_t| <= rho cn`` with ``rho = mu cos(pi / edge_count)`` (its inscribed circle; in 2-D the cone itself). A balanced point
     ``c`` (least squares over the closed contacts; a contact whose force leaves its disc cone is dropped,
@@ -281,24 +305,27 @@ def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count:
     in :func:`_forces_vary`): that component spans at least ``2 t z_j``.
     """
     closed, mu = masks.closed, problem.mu
-    if np.any(closed & masks.sliding & (mu > 0.0)):
+    sliding = closed & masks.sliding & (mu > 0.0)
+    if np.any(sliding) and problem.dimension != 2:
         return False
+    single = (mu <= 0.0) | sliding  # one force coordinate: the normal force, along the (tilted) normal
+    tilt = _sliding_tilt(problem, q, sliding)
     inradius = _inradius(problem.dimension, edge_count)
-    rho = np.where(mu > 0.0, mu * inradius, 1.0)  # frictionless: its normal force >= 0
+    rho = np.where(single, 1.0, mu * inradius)  # one coordinate: its normal force >= 0
     kept = np.flatnonzero(closed)
     for _ in range(problem.n_contacts + 1):
-        wrenches = _wrench_columns(problem, kept)
+        wrenches = _wrench_columns(problem, kept, single, tilt)
         c = np.linalg.lstsq(wrenches, -problem.g, rcond=None)[0] if kept.size else np.zeros(0)
         if float(np.max(np.abs(wrenches @ c + problem.g), initial=0.0)) > ZERO:
             return False
-        tangent, cn = _per_contact(problem, kept, c)
+        tangent, cn = _per_contact(problem, kept, c, single)
         margin = rho[kept] * cn - np.linalg.norm(tangent, axis=1)
         if np.all(margin >= 0.0):
             break
         kept = kept[margin >= 0.0]
     inner = margin > 0.0
     kept, margin = kept[inner], margin[inner]
-    wrenches = _wrench_columns(problem, kept)
+    wrenches = _wrench_columns(problem, kept, single, tilt)
     if kept.size == 0:
         return False
     basis = null_space(wrenches, FORCE_RANK)
@@ -306,7 +333,7 @@ def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count:
         z = basis @ basis[j]
         if z[j] <= 0.0:
             continue
-        moved_tangent, moved_normal = _per_contact(problem, kept, z)
+        moved_tangent, moved_normal = _per_contact(problem, kept, z, single)
         rate = np.linalg.norm(moved_tangent, axis=1) + rho[kept] * np.abs(moved_normal)
         reach = float(np.min(margin[rate > 0.0] / rate[rate > 0.0], initial=np.inf))
         drift = float(np.max(np.abs(wrenches @ z), initial=0.0))
@@ -324,19 +351,29 @@ def _inradius(dimension: int, edge_count: int) -> float:
     return float(np.cos(np.pi / edge_count)) if edge_count >= 3 else 0.0
 
 
-def _wrench_columns(problem: Problem, contacts: np.ndarray) -> np.ndarray:
-    """The wrench of each force coordinate of ``contacts`` on the bodies (k n, f): tangents and normal if frictional."""
-    columns = [problem.J[i].T if problem.mu[i] > 0.0 else problem.Jn[i][:, None] for i in contacts.tolist()]
+def _sliding_tilt(problem: Problem, q: np.ndarray, sliding: np.ndarray) -> np.ndarray:
+    """Per contact (m, d - 1): the friction per unit normal force of a sliding contact, ``-mu s`` (zero elsewhere)."""
+    tilt = np.zeros((problem.n_contacts, problem.dimension - 1))
+    if sliding.any():
+        slip = slips(problem, q)[sliding]
+        tilt[sliding] = -problem.mu[sliding, None] * slip / np.linalg.norm(slip, axis=1, keepdims=True)
+    return tilt
+
+
+def _wrench_columns(problem: Problem, contacts: np.ndarray, single: np.ndarray, tilt: np.ndarray) -> np.ndarray:
+    """The wrench of each force coordinate of ``contacts`` on the bodies (k n, f): tangents and normal for a cone,
+    one column for a ``single`` contact (frictionless, or sliding: its normal tilted by its friction ``tilt``)."""
+    columns = [(problem.J[i].T @ np.r_[tilt[i], 1.0])[:, None] if single[i] else problem.J[i].T for i in contacts.tolist()]
     return np.hstack(columns) if columns else np.zeros((problem.n_dof, 0))
 
 
-def _per_contact(problem: Problem, contacts: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``x`` in the coordinates of :func:`_wrench_columns` as tangent forces (k, d - 1) and normal forces (k,)."""
+def _per_contact(problem: Problem, contacts: np.ndarray, x: np.ndarray, single: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``x`` in the coordinates of :func:`_wrench_columns` as free tangent forces (k, d - 1) and normal forces (k,)."""
     d = problem.dimension
     tangent, normal = np.zeros((contacts.size, d - 1)), np.zeros(contacts.size)
     at = 0
     for k, i in enumerate(contacts.tolist()):
-        if problem.mu[i] > 0.0:
+        if not single[i]:
             tangent[k], at = x[at : at + d - 1], at + d - 1
         normal[k], at = x[at], at + 1
     return tangent, normal
