@@ -91,3 +91,50 @@ def test_the_command_draws_a_planar_example_with_its_shapes(scene: Path, tmp_pat
     assert pixels.std() > 0.05  # not blank
     grey = np.array(matplotlib.colors.to_rgb(MOVER_FILL))
     assert np.sum(np.all(np.abs(pixels - grey) < 0.02, axis=-1)) > 50  # the fingertip disks are filled in
+
+
+@pytest.fixture(scope="module")
+def push_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("run") / "push.npz"
+    result = run("simulate", str(PUSH), "--duration", "2", "--dt", "0.1", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    return out
+
+
+def test_animate_draws_a_planar_run_frame_by_frame(push_run: Path, tmp_path: Path) -> None:
+    image_module = pytest.importorskip("PIL.Image")
+    from matplotlib.colors import to_rgb
+
+    from quasistatic.viz.style import MOVER_FILL
+
+    gif = tmp_path / "push.gif"
+    result = run("animate", str(push_run), "-o", str(gif))
+    assert result.returncode == 0, result.stderr
+    trajectory = qs.Trajectory.load(push_run)
+    with image_module.open(gif) as image:
+        assert image.n_frames == len(trajectory.states)
+        first = np.asarray(image.convert("RGB"), dtype=float) / 255
+        image.seek(image.n_frames - 1)
+        last = np.asarray(image.convert("RGB"), dtype=float) / 255
+    assert last.std() > 0.05  # not blank
+    grey = np.array(to_rgb(MOVER_FILL))
+    assert np.sum(np.all(np.abs(last - grey) < 0.03, axis=-1)) > 50  # the fingertip disks
+    below_title = slice(first.shape[0] // 8, None)  # the title's time changes in every frame
+    moved = np.any(np.abs(first[below_title] - last[below_title]) > 0.1, axis=-1)
+    assert moved.sum() > 2000  # the box (about 170 px tall) and the fingers have moved 2 cm (about 30 px) to the right
+
+
+def test_a_planar_run_shows_itself_in_a_notebook(push_run: Path) -> None:
+    pytest.importorskip("PIL.Image")
+    page = qs.Trajectory.load(push_run)._repr_html_()
+    assert '<img alt="the run on its scene" src="data:image/gif;base64,' in page
+    assert "not drawn" not in page
+
+
+def test_the_3d_viewer_refuses_a_planar_run_in_one_line(push_run: Path, tmp_path: Path) -> None:
+    pytest.importorskip("viser")
+    result = run("view", str(push_run), "--export", str(tmp_path / "push.html"))
+    lines = result.stderr.strip().splitlines()
+    assert result.returncode == 2 and len(lines) == 1 and lines[0].startswith("error:"), result.stderr
+    assert "planar" in lines[0] and "animate" in lines[0]
+    assert not (tmp_path / "push.html").exists()

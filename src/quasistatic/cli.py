@@ -345,7 +345,7 @@ def animate(
     trajectory_file: Annotated[Path, typer.Argument(metavar="TRAJECTORY", help="A trajectory saved by `simulate --out` (.npz or .jsonl).")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The animation: .gif, or .mp4 when ffmpeg is installed.")],
     scene: Annotated[Path | None, typer.Option(help="The scene file it was run on (default: the one the trajectory names).")] = None,
-    view: Annotated[str, typer.Option(help="How the scene is seen: iso, xy, xz or yz.")] = "iso",
+    view: Annotated[str, typer.Option(help="How a 3-D scene is seen: iso, xy, xz or yz (a planar one: its plane).")] = "iso",
     fps: Annotated[int, typer.Option(help="Frames per second.", min=1, max=120)] = 20,
 ) -> None:
     """Draw a simulated trajectory as an animation: shapes, robot links, contacts by mode, forces to scale."""
@@ -356,12 +356,8 @@ def animate(
     if view not in VIEWS:
         _fail(f"--view {view!r} is not one of {', '.join(VIEWS)}")
     _guarded(require_matplotlib)
-    from .adapters import World
-
     trajectory = _guarded(lambda: Trajectory.load(trajectory_file))
     world = _run_world(trajectory_file, trajectory, scene)
-    if not isinstance(world, World):
-        _fail(f"{str(trajectory_file)!r}: runs of planar scenes of shapes are not drawn yet (their states are in the trajectory)")
     try:
         _guarded(lambda: draw(trajectory, world, output, view=view, fps=fps))
     except OSError as exc:
