@@ -283,15 +283,6 @@ def test_plot_draws_a_planar_world_as_its_scene(tmp_path: Path) -> None:
     assert (tmp_path / "push.png").stat().st_size > 0 and "solved" in result.stdout
 
 
-def test_animating_a_planar_run_says_not_yet_in_one_line(tmp_path: Path) -> None:
-    pytest.importorskip("matplotlib")
-    out = tmp_path / "push.npz"
-    assert run("simulate", str(PUSH), "--duration", "0.1", "--dt", "0.05", "--out", str(out)).returncode == 0
-    result = run("animate", str(out), "--output", str(tmp_path / "push.gif"))
-    lines = result.stderr.strip().splitlines()
-    assert result.returncode == 2 and len(lines) == 1 and lines[0].startswith("error:") and "not drawn yet" in lines[0]
-
-
 def write(tmp_path: Path, text: str) -> Path:
     path = tmp_path / "scene.yaml"
     path.write_text("quasistatic: 1\ndimension: 2\n" + text)

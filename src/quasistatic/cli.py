@@ -34,7 +34,7 @@ from .report import make_console, render_contacts, render_solution, render_traje
 from .solution import Mode, Solution
 
 if TYPE_CHECKING:
-    from .adapters import Detection, World
+    from .adapters import AnyWorld, Detection
     from .sim import Trajectory
     from .solvers import SearchProgress
     from .sweeps import SweepResult
@@ -130,18 +130,15 @@ def _loaded(scene_file: Path) -> tuple[Scene, Detection | None]:
     return scene, detection
 
 
-def _loaded_world(scene_file: Path) -> tuple[Scene, Detection | None, World | None]:
-    """As :func:`_loaded`, and the World of shapes the scene came from (None for a file that lists its contacts)."""
-    from .adapters import World  # adapters load only for scenes of shapes
-
+def _loaded_world(scene_file: Path) -> tuple[Scene, Detection | None, AnyWorld | None]:
+    """As :func:`_loaded`, and the world of shapes the scene came from (None for a file that lists its contacts)."""
     loaded = _guarded(lambda: load_world(scene_file))
     if isinstance(loaded, Scene):
         return loaded, None, None
     world = loaded
     detection = _guarded(world.detect)
     scene = _guarded(lambda: world.scene(detection))
-    # pictures draw 3-D shapes only: a planar world is drawn as its 2-D scene (bodies through their contacts)
-    return scene, detection, world if isinstance(world, World) else None
+    return scene, detection, world
 
 
 class _StatusLine:
@@ -348,7 +345,7 @@ def animate(
     trajectory_file: Annotated[Path, typer.Argument(metavar="TRAJECTORY", help="A trajectory saved by `simulate --out` (.npz or .jsonl).")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The animation: .gif, or .mp4 when ffmpeg is installed.")],
     scene: Annotated[Path | None, typer.Option(help="The scene file it was run on (default: the one the trajectory names).")] = None,
-    view: Annotated[str, typer.Option(help="How the scene is seen: iso, xy, xz or yz.")] = "iso",
+    view: Annotated[str, typer.Option(help="How a 3-D scene is seen: iso, xy, xz or yz (a planar one: its plane).")] = "iso",
     fps: Annotated[int, typer.Option(help="Frames per second.", min=1, max=120)] = 20,
 ) -> None:
     """Draw a simulated trajectory as an animation: shapes, robot links, contacts by mode, forces to scale."""
@@ -420,7 +417,10 @@ def view(
         return
     if scene is not None:
         _fail(f"--scene {str(scene)!r}: only a trajectory (.npz, .jsonl) is drawn on another scene file")
-    answered, detection, world = _loaded_world(scene_file)
+    from .adapters import World
+
+    answered, detection, loaded = _loaded_world(scene_file)
+    world = loaded if isinstance(loaded, World) else None  # the 3-D viewer draws a planar world as its 2-D scene
     solution = _solved(answered, detection, method=method)
     viewer = _guarded(
         lambda: show(solution, world or answered, host=host, port=0 if export is not None else port, method=method, camera=view)
@@ -435,32 +435,28 @@ _TRAJECTORY_FORMATS = (".npz", ".jsonl")
 
 def _view_trajectory(trajectory_file: Path, scene: Path | None, host: str, port: int, export: Path | None, camera: str) -> None:
     """`view` of a trajectory: its states on the scene file it names (or --scene), with a timeline."""
+    from .adapters import World
     from .sim import Trajectory
     from .viz import view_trajectory
 
     trajectory = _guarded(lambda: Trajectory.load(trajectory_file))
     world = _run_world(trajectory_file, trajectory, scene)
+    if not isinstance(world, World):
+        _fail(f"{str(trajectory_file)!r}: the 3-D viewer does not draw runs of planar scenes of shapes yet; `quasistatic animate` does")
     viewer = _guarded(lambda: view_trajectory(trajectory, world, host=host, port=0 if export is not None else port, camera=camera))
     summary = f"{len(trajectory.states)} states, {trajectory.status}" + ("" if trajectory.certified else ", NOT proven")
     _serve_or_export(viewer, export, summary)
 
 
-def _run_world(trajectory_file: Path, trajectory: Trajectory, scene: Path | None) -> World:
-    """The World a run is drawn on: ``--scene``, or the scene file the trajectory names."""
-    from .adapters import World
-
+def _run_world(trajectory_file: Path, trajectory: Trajectory, scene: Path | None) -> AnyWorld:
+    """The world a run is drawn on: ``--scene``, or the scene file the trajectory names."""
     if scene is None:
         if not trajectory.scene_file:
             _fail(f"{str(trajectory_file)!r} names no scene file (it was run on a World built in Python): give --scene")
-        world = _guarded(trajectory.scene_world)
-        if not isinstance(world, World):
-            _fail(f"{trajectory.scene_file!r}: runs of planar scenes of shapes are not drawn yet (their states are in the trajectory)")
-        return world
+        return _guarded(trajectory.scene_world)
     loaded = _guarded(lambda: load_world(scene))
     if isinstance(loaded, Scene):
         _fail(f"--scene {str(scene)!r} lists its contacts: a trajectory is run on a scene of shapes")
-    if not isinstance(loaded, World):
-        _fail(f"--scene {str(scene)!r}: runs of planar scenes of shapes are not drawn yet (their states are in the trajectory)")
     return loaded
 
 

@@ -93,8 +93,6 @@ class Trajectory:
             world, why = self.scene_world(), ""
         except (QuasistaticError, OSError) as error:
             world, why = None, str(error)
-        if isinstance(world, PlanarWorld):
-            world, why = None, "runs of planar scenes of shapes are not drawn yet"
         return trajectory_html(self, world, why)
 
     def joint_positions(self, robot: str) -> FloatArray:

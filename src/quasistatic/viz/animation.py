@@ -1,8 +1,9 @@
 """A Trajectory as a moving picture (GIF, or MP4 when ffmpeg is installed): matplotlib, headless.
 
 Each frame draws the World at one state of the run (its shapes and URDF links, from
-``State.applied``) with the contacts recorded at that step: dots in the colour of their mode,
-force arrows on one scale for the whole run. The camera is fixed over the run.
+``State.applied``; a planar world's shapes in their plane, :mod:`.planar`) with the
+contacts recorded at that step: dots in the colour of their mode, force arrows on one
+scale for the whole run. The camera is fixed over the run.
 """
 
 from __future__ import annotations
@@ -16,11 +17,12 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 import numpy.typing as npt
 
-from ..adapters import Halfspace, World
+from ..adapters import AnyWorld, Halfspace, PlanarWorld, World
 from ..errors import SceneError
 from ..sim.state import State
 from ..sim.step import StepResult
 from .geometry import Projection, plane_patch, shape_outline
+from .planar import draw_planar_parts
 from .style import BODY_FILL, EDGE_COLOUR, FORCE_COLOUR, MODE_COLOURS, MOVER_FILL, NO_MOTION_COLOUR, ROBOT_FILL, require_matplotlib, styled
 
 if TYPE_CHECKING:
@@ -57,9 +59,12 @@ class _Camera:
     size: float
 
 
-def animate(trajectory: Run, world: World, output: str | Path, *, view: str = "iso", fps: int = 20, max_frames: int = MAX_FRAMES) -> Path:
+def animate(
+    trajectory: Run, world: AnyWorld, output: str | Path, *, view: str = "iso", fps: int = 20, max_frames: int = MAX_FRAMES
+) -> Path:
     """Write ``trajectory`` (a Trajectory run on ``world``) as an animation; ``.gif`` always, ``.mp4`` with ffmpeg on
-    the PATH. A run of more than ``max_frames`` states is drawn at that many even times."""
+    the PATH. A run of more than ``max_frames`` states is drawn at that many even times. A planar world is drawn in
+    its plane (``view`` is for 3-D worlds)."""
     require_matplotlib()
     output = Path(output)
     suffix = output.suffix.lower()
@@ -69,12 +74,12 @@ def animate(trajectory: Run, world: World, output: str | Path, *, view: str = "i
         raise SceneError("output", str(output), "an .mp4 needs ffmpeg on the PATH (apt-get install ffmpeg); write a .gif instead")
     check_run_names(trajectory, world)
     frames = frame_indices(trajectory, max_frames)
-    camera = _camera(trajectory, world, Projection.of(3, view))
+    camera = _camera(trajectory, world, Projection.of(world.dimension, view))
     _write(trajectory, world, frames, camera, output, fps)
     return output
 
 
-def check_run_names(trajectory: Run, world: World) -> None:
+def check_run_names(trajectory: Run, world: AnyWorld) -> None:
     """Raise :class:`SceneError` unless ``world`` has the trajectory's bodies, movers and robots: the scene it was run on."""
     state = trajectory.states[0]
     for kind, names, known in (
@@ -98,7 +103,7 @@ def frame_indices(trajectory: Run, limit: int) -> list[int]:
     return [int(i) for i in np.searchsorted(times, wanted, side="right") - 1]
 
 
-def _camera(trajectory: Run, world: World, projection: Projection) -> _Camera:
+def _camera(trajectory: Run, world: AnyWorld, projection: Projection) -> _Camera:
     """Bounds that hold every body and mover over the run, and one force scale for every frame."""
     size = world.size
     points = [
@@ -110,7 +115,7 @@ def _camera(trajectory: Run, world: World, projection: Projection) -> _Camera:
     return _Camera(projection, low, high, FORCE_LENGTH * size / largest if largest > 0 else 0.0, size)
 
 
-def _write(trajectory: Run, world: World, frames: list[int], camera: _Camera, output: Path, fps: int) -> None:
+def _write(trajectory: Run, world: AnyWorld, frames: list[int], camera: _Camera, output: Path, fps: int) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -132,11 +137,29 @@ def _write(trajectory: Run, world: World, frames: list[int], camera: _Camera, ou
         movie.save(str(output), writer=writer)
 
 
-def _draw_state(ax: Axes, world: World, step: StepResult, camera: _Camera) -> None:
+def _draw_state(ax: Axes, world: AnyWorld, step: StepResult, camera: _Camera) -> None:
+    centre = np.mean([b.pose.position for b in world.bodies], axis=0) if world.bodies else np.zeros(3)
+    if isinstance(world, PlanarWorld):
+        reach = float(np.linalg.norm(camera.high - camera.low))  # the centre is in view: a strip this long crosses it
+        draw_planar_parts(ax, world.bodies, world.movers, centre, reach)
+    else:
+        _draw_world(ax, world, centre, camera)
+    _draw_contacts(ax, step, camera)
+    ax.set_xlim(camera.low[0], camera.high[0])
+    ax.set_ylim(camera.low[1], camera.high[1])
+    ax.set_aspect("equal")
+    ax.set_xticks([])
+    ax.set_yticks([])
+    events = ", ".join(sorted({e.kind for e in step.events}))
+    proof = "" if step.certified else ", NOT certified"
+    ax.set_title(f"t = {step.time:.4g} s: {step.status}{proof}" + (f" ({events})" if events else ""))
+
+
+def _draw_world(ax: Axes, world: World, centre: FloatArray, camera: _Camera) -> None:
+    """A 3-D world's robot links and shapes, projected."""
     from matplotlib.patches import Polygon
 
     projection = camera.projection
-    centre = np.mean([b.pose.position for b in world.bodies], axis=0) if world.bodies else np.zeros(3)
     for collider in (c for r in world.robots for c in r.colliders):
         outline = shape_outline(collider.shape, collider.pose, projection)
         if outline is not None:
@@ -150,15 +173,6 @@ def _draw_state(ax: Axes, world: World, step: StepResult, camera: _Camera) -> No
             outline = shape_outline(part.shape, part.pose, projection)
             if outline is not None:
                 ax.add_patch(Polygon(outline, closed=True, facecolor=fill, edgecolor=EDGE_COLOUR, linewidth=0.8, zorder=1))
-    _draw_contacts(ax, step, camera)
-    ax.set_xlim(camera.low[0], camera.high[0])
-    ax.set_ylim(camera.low[1], camera.high[1])
-    ax.set_aspect("equal")
-    ax.set_xticks([])
-    ax.set_yticks([])
-    events = ", ".join(sorted({e.kind for e in step.events}))
-    proof = "" if step.certified else ", NOT certified"
-    ax.set_title(f"t = {step.time:.4g} s: {step.status}{proof}" + (f" ({events})" if events else ""))
 
 
 def _draw_contacts(ax: Axes, step: StepResult, camera: _Camera) -> None:

@@ -14,11 +14,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..adapters import Halfspace, ShapedMover, SolidBody, World
+from ..adapters import Halfspace, PlanarBody, PlanarMover, PlanarWorld, ShapedMover, SolidBody, World
 from ..model import Scene
 from ..solution import Motion, Solution
 from .chart import summary_figure
 from .geometry import VIEWS, FloatArray, Projection, convex_hull, lifted, plane_patch, shape_outline
+from .planar import draw_planar_parts, planar_extent
 from .style import (
     BODY_FILL,
     EDGE_COLOUR,
@@ -55,7 +56,7 @@ class _Frame:
     """What every panel of one figure shares: the scene, the view and the arrow scales."""
 
     scene: Scene
-    world: World | None
+    world: World | PlanarWorld | None
     projection: Projection
     centre: FloatArray  # world point at the middle of the scene [length]
     size: float  # the drawing's size on the page [length]
@@ -77,15 +78,15 @@ class _Legend:
             self.handles[label] = Line2D([], [], label=label, **line)
 
 
-def plot(solution: Solution, scene: Scene | World | None = None, ax: Axes | None = None, view: str = "iso") -> Figure:
+def plot(solution: Solution, scene: Scene | World | PlanarWorld | None = None, ax: Axes | None = None, view: str = "iso") -> Figure:
     """Draw a solution on its scene and return the matplotlib Figure (nothing is shown or saved).
 
     Parameters
     ----------
     solution : Solution
         The answer to draw: contact modes, forces, slips and twists.
-    scene : Scene or World, optional
-        The scene it answers (a World of shapes: its shapes are drawn too). Without one,
+    scene : Scene, World or PlanarWorld, optional
+        The scene it answers (a world of shapes: its shapes are drawn too, a planar one in its plane). Without one,
         a Solution has no geometry: each contact's normal force is drawn as a bar instead.
     ax : matplotlib Axes, optional
         Draw into this axes (one panel: an ambiguous answer's first motion) instead of a new figure.
@@ -122,9 +123,9 @@ def _motions(solution: Solution) -> list[Motion]:
     return list(solution.solutions) or ([solution.motion] if solution.motion is not None else [])
 
 
-def _frame(solution: Solution, scene: Scene | World, view: str) -> _Frame:
-    world = scene if isinstance(scene, World) else None
-    plain = scene.scene() if isinstance(scene, World) else scene
+def _frame(solution: Solution, scene: Scene | World | PlanarWorld, view: str) -> _Frame:
+    world = scene if isinstance(scene, World | PlanarWorld) else None
+    plain = scene if isinstance(scene, Scene) else scene.scene()
     projection = Projection.of(plain.dimension, view)
     world_points = np.array([lifted(p) for p in [*(c.point for c in plain.contacts), *(b.com for b in plain.bodies)]])
     page = [projection(world_points), *[o for o in _shape_outlines(world, projection) if o is not None]]
@@ -206,6 +207,8 @@ def _draw_parts(ax: Axes, frame: _Frame, page: list[FloatArray]) -> None:
     shaped = set() if frame.world is None else {b.name for b in frame.world.bodies if b.shape is not None}
     for outline in _robot_links(frame):  # behind everything, and left out of the page: an arm would dwarf the part
         ax.add_patch(Polygon(outline, closed=True, facecolor=ROBOT_FILL, edgecolor=EDGE_COLOUR, linewidth=0.5, alpha=0.6, zorder=0.5))
+    if isinstance(frame.world, PlanarWorld):
+        page += draw_planar_parts(ax, frame.world.bodies, frame.world.movers, frame.centre, 3.0 * frame.size)
     for outline, fill in [*_world_parts(frame), *_contact_outlines(frame, shaped)]:
         ax.add_patch(Polygon(outline, closed=True, facecolor=fill, edgecolor=EDGE_COLOUR, linewidth=0.8, zorder=1))
         page.append(outline)
@@ -219,7 +222,7 @@ def _draw_parts(ax: Axes, frame: _Frame, page: list[FloatArray]) -> None:
 
 
 def _world_parts(frame: _Frame) -> list[tuple[FloatArray, str]]:
-    if frame.world is None:
+    if not isinstance(frame.world, World):
         return []
     parts: list[tuple[SolidBody | ShapedMover, str]] = [(p, MOVER_FILL) for p in frame.world.movers]
     parts += [(p, BODY_FILL) for p in frame.world.bodies]
@@ -236,13 +239,16 @@ def _world_parts(frame: _Frame) -> list[tuple[FloatArray, str]]:
 
 def _robot_links(frame: _Frame) -> list[FloatArray]:
     """The collision shapes of every URDF robot's links at its configuration, projected."""
-    if frame.world is None:
+    if not isinstance(frame.world, World):
         return []
     outlines = [shape_outline(c.shape, c.pose, frame.projection) for r in frame.world.robots for c in r.colliders]
     return [o for o in outlines if o is not None]
 
 
-def _shape_outlines(world: World | None, projection: Projection) -> list[FloatArray | None]:
+def _shape_outlines(world: World | PlanarWorld | None, projection: Projection) -> list[FloatArray | None]:
+    if isinstance(world, PlanarWorld):
+        planar: list[PlanarBody | PlanarMover] = [*world.bodies, *world.movers]
+        return [planar_extent(p.shape, p.pose) for p in planar if p.shape is not None]
     parts: list[SolidBody | ShapedMover] = [] if world is None else [*world.bodies, *world.movers]
     return [shape_outline(p.shape, p.pose, projection) for p in parts if p.shape is not None and not isinstance(p.shape, Halfspace)]
 

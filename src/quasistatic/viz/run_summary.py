@@ -13,7 +13,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from ..adapters import World
+from ..adapters import AnyWorld
 from ..errors import BackendUnavailableError, QuasistaticError
 from .animation import animate
 from .style import FIGURES_INSTALL_HINT, require_matplotlib
@@ -24,7 +24,7 @@ NOTEBOOK_FRAMES = 24  # frames of a notebook's GIF (a longer run is drawn at thi
 _FPS = 8  # its frames per second: the run plays in about 3 s
 
 
-def trajectory_html(trajectory: Any, world: World | None, no_world: str = "") -> str:
+def trajectory_html(trajectory: Any, world: AnyWorld | None, no_world: str = "") -> str:
     """The run's verdict, proof, length and events, and its GIF on ``world`` (``no_world``: why there is none)."""
     parts = [
         f"<p><b>{html.escape(trajectory.status)}</b>: {html.escape(trajectory.message)}</p>",
@@ -57,7 +57,7 @@ def _events_table(trajectory: Any) -> str:
     return f"<table><tr><th>time [s]</th><th>event</th><th>between</th><th>what</th></tr>{rows}</table>"
 
 
-def _picture(trajectory: Any, world: World | None, no_world: str) -> str:
+def _picture(trajectory: Any, world: AnyWorld | None, no_world: str) -> str:
     """The run as a GIF (``viz.animate``), or one line saying why it is not drawn."""
     try:
         require_matplotlib()

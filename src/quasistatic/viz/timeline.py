@@ -246,7 +246,9 @@ def view_trajectory(
     """
     source = trajectory.scene_world() if world is None else world
     if not isinstance(source, World):
-        raise SceneError("scene", trajectory.scene_file, "runs of planar scenes of shapes are not drawn yet")
+        raise SceneError(
+            "scene", trajectory.scene_file, "the 3-D viewer does not draw runs of planar scenes of shapes yet (viz.animate does)"
+        )
     check_run_names(trajectory, source)
     if camera not in VIEWS:
         raise ValueError(f"view: {camera!r} is not one of {', '.join(VIEWS)}")
