@@ -276,7 +276,7 @@ def test_simulate_a_planar_scene_from_the_command_line(tmp_path: Path) -> None:
     np.testing.assert_allclose(trajectory.positions("box")[-1], [0.005, 0.05, 0.0], atol=1e-12)
 
 
-def test_plot_draws_a_planar_world_as_its_scene(tmp_path: Path) -> None:
+def test_plot_draws_a_planar_world(tmp_path: Path) -> None:
     pytest.importorskip("matplotlib")
     result = run("plot", str(PUSH), "--output", str(tmp_path / "push.png"))
     assert result.returncode == 0, result.stderr
