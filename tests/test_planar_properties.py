@@ -9,9 +9,12 @@ into the free body. Nothing here needs coal.
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import subprocess
 import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,7 +25,7 @@ from hypothesis import strategies as st
 
 from quasistatic.adapters import ContactDetection, Disk, HalfPlane, PlanarBody, PlanarMover, PlanarWorld, Polygon, Rectangle, planar_pose
 from quasistatic.adapters.planar import PlanarShape
-from quasistatic.tolerances import DUPLICATE_POINT
+from quasistatic.tolerances import DUPLICATE_POINT, MAX_MAGNITUDE, MAX_POLYGON_VERTICES, MAX_VALUES
 
 SCRIPT = Path(sys.executable).with_name("quasistatic")
 EXAMPLES = settings(max_examples=int(os.environ.get("PLANAR_EXAMPLES", "150")), deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -329,3 +332,82 @@ def test_every_normal_is_a_unit_vector_into_the_body(pair: Pair) -> None:
         assert body_lowest - other_highest <= gap + tolerance
         if apart:
             assert body_lowest - other_highest >= -tolerance, (body_lowest - other_highest, gap)
+
+
+# --------------------------------------------------------------------------- hostile planar scene files
+
+PLANAR = "quasistatic: 1\ndimension: 2\n"
+FLOOR = "movers: {floor: {shape: {halfplane: {normal: [0, 1]}}}}\n"
+HANG = 10.0  # [s] a process still running after this has hung
+FAST = 5.0  # [s] a rejection, the process's imports included (~0.7 s measured on the 2-core dev machine)
+
+
+def body(shape: str, pose: str = "") -> str:
+    return PLANAR + f"bodies: {{a: {{mass: 1, shape: {{{shape}}}{', pose: {' + pose + '}' if pose else ''}}}}}\n" + FLOOR
+
+
+def circle(count: int) -> list[list[float]]:
+    return [[math.cos(2 * math.pi * k / count), math.sin(2 * math.pi * k / count)] for k in range(count)]
+
+
+def huge_polygon_json(count: int) -> str:
+    """A polygon of ``count`` vertices on a circle, to 2 decimals (a million of them stay under the file size limit)."""
+    shape = {"polygon": [[round(x, 2), round(y, 2)] for x, y in circle(count)]}
+    return json.dumps({"quasistatic": 1, "dimension": 2, "bodies": {"a": {"mass": 1, "shape": shape}}})
+
+
+POLYGON = "bodies.a.shape.polygon"
+# case -> (file name, its text, the field the error names, fragments of the error line)
+HOSTILE: dict[str, tuple[str, str, str, tuple[str, ...]]] = {
+    "polygon-1e6-vertices": ("a.json", huge_polygon_json(1_000_000), POLYGON, (f"{MAX_VALUES:,} values",)),
+    "polygon-2000-vertices": ("a.json", huge_polygon_json(2000), POLYGON, (f"at most {MAX_POLYGON_VERTICES:,} vertices", "2,000")),
+    "xy-1e308": ("a.yaml", body("disk: 0.1", "position: [1.0e+308, 0.1]"), "bodies.a.pose.position", (f"{MAX_MAGNITUDE:g}", "1e+308")),
+    "vertex-1e308": ("a.yaml", body("polygon: [[0, 0], [1.0e+308, 0], [0, 1]]"), POLYGON, (f"{MAX_MAGNITUDE:g}", "1e+308")),
+    "angle-nan": ("a.yaml", body("disk: 0.1", "position: [0, 0.1], angle: .nan"), "bodies.a.pose.angle", ("finite", "nan")),
+    "disk-radius-0": ("a.yaml", body("disk: 0"), "bodies.a.shape.disk", ("> 0", "0.0")),
+    "disk-radius-negative": ("a.yaml", body("disk: -0.1"), "bodies.a.shape.disk", ("> 0", "-0.1")),
+    "polygon-2-vertices": ("a.yaml", body("polygon: [[0, 0], [1, 0]]"), POLYGON, ("at least 3",)),
+    "polygon-bow-tie": ("a.yaml", body("polygon: [[0, 0], [1, 1], [1, 0], [0, 1]]"), POLYGON, ("edges that cross",)),
+    "polygon-crossing": ("a.yaml", body("polygon: [[0, 0], [2, 2], [2, 0], [0, 1]]"), POLYGON, ("not convex",)),
+    "polygon-star": ("a.yaml", body(f"polygon: {[circle(5)[k % 5] for k in range(0, 10, 2)]}"), POLYGON, ("star",)),
+    "duplicate-key": ("a.yaml", body("disk: 0.1, disk: 0.2"), "bodies.a.shape.disk", ("given twice",)),
+    "box-3-numbers": ("a.yaml", body("box: [0.1, 0.1, 0.1]"), "bodies.a.shape.box", ("[width, height]", "[0.1, 0.1, 0.1]")),
+    "sphere-in-2d": ("a.yaml", body("sphere: 0.1"), "bodies.a.shape.sphere", ("a 3-D shape", "disk")),
+    "disk-in-3d": ("a.yaml", "quasistatic: 1\nbodies: {a: {mass: 1, shape: {disk: 0.1}}}\n", "bodies.a.shape.disk", ("dimension: 2",)),
+    "halfplane-in-3d": (
+        "a.yaml",
+        "quasistatic: 1\nbodies: {a: {mass: 1, shape: {sphere: 0.1}}}\nmovers: {floor: {shape: {halfplane: {normal: [0, 1]}}}}\n",
+        "movers.floor.shape.halfplane",
+        ("dimension: 2", "{'normal': [0.0, 1.0], 'offset': 0.0}"),
+    ),
+}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def hostile_files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    root = tmp_path_factory.mktemp("planar-hostile")
+    files = {}
+    for case, (name, text, _, _) in HOSTILE.items():
+        (root / case).mkdir()
+        files[case] = root / case / name
+        files[case].write_text(text)
+    return files
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE))
+def test_a_hostile_planar_file_is_one_error_line(hostile_files: dict[str, Path], case: str) -> None:
+    _, _, field, fragments = HOSTILE[case]
+    started = time.perf_counter()
+    try:
+        result = subprocess.run([str(SCRIPT), "solve", str(hostile_files[case])], capture_output=True, text=True, timeout=HANG, check=False)
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"quasistatic solve still ran after {HANG} s")
+    elapsed = time.perf_counter() - started
+    assert "Traceback" not in result.stderr, result.stderr[-2000:]
+    assert (result.returncode, result.stdout) == (2, ""), result.stderr[-2000:]
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {field}"), result.stderr[-2000:]
+    for fragment in fragments:
+        assert fragment in lines[0], (fragment, lines[0])
+    assert "File(" not in lines[0] and len(lines[0]) < 400  # the file's words, not a class's; bounded
+    assert elapsed < FAST, f"{elapsed:.1f} s"
