@@ -25,7 +25,7 @@ from hypothesis import strategies as st
 
 from quasistatic.adapters import ContactDetection, Disk, HalfPlane, PlanarBody, PlanarMover, PlanarWorld, Polygon, Rectangle, planar_pose
 from quasistatic.adapters.planar import PlanarShape
-from quasistatic.tolerances import DUPLICATE_POINT, MAX_MAGNITUDE, MAX_POLYGON_VERTICES, MAX_VALUES
+from quasistatic.tolerances import DUPLICATE_POINT, MAX_MAGNITUDE, MAX_POLYGON_VERTICES, MAX_VALUES, SMALLEST_LENGTH
 
 SCRIPT = Path(sys.executable).with_name("quasistatic")
 EXAMPLES = settings(max_examples=int(os.environ.get("PLANAR_EXAMPLES", "150")), deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -366,6 +366,8 @@ HOSTILE: dict[str, tuple[str, str, str, tuple[str, ...]]] = {
     "angle-nan": ("a.yaml", body("disk: 0.1", "position: [0, 0.1], angle: .nan"), "bodies.a.pose.angle", ("finite", "nan")),
     "disk-radius-0": ("a.yaml", body("disk: 0"), "bodies.a.shape.disk", ("> 0", "0.0")),
     "disk-radius-negative": ("a.yaml", body("disk: -0.1"), "bodies.a.shape.disk", ("> 0", "-0.1")),
+    "disk-radius-1e-300": ("a.yaml", body("disk: 1.0e-300"), "bodies.a.shape.disk", (f"at least {SMALLEST_LENGTH:g}",)),
+    "box-width-1e-300": ("a.yaml", body("box: [1.0e-300, 1]"), "bodies.a.shape.box.width", (f"at least {SMALLEST_LENGTH:g}",)),
     "polygon-2-vertices": ("a.yaml", body("polygon: [[0, 0], [1, 0]]"), POLYGON, ("at least 3",)),
     "polygon-bow-tie": ("a.yaml", body("polygon: [[0, 0], [1, 1], [1, 0], [0, 1]]"), POLYGON, ("edges that cross",)),
     "polygon-crossing": ("a.yaml", body("polygon: [[0, 0], [2, 2], [2, 0], [0, 1]]"), POLYGON, ("not convex",)),

@@ -29,7 +29,7 @@ import numpy.typing as npt
 
 from ..errors import SceneError
 from ..model import checked_array, checked_number
-from ..tolerances import DUPLICATE_POINT, MAX_POLYGON_VERTICES, NORMAL_LENGTH
+from ..tolerances import DUPLICATE_POINT, MAX_POLYGON_VERTICES, NORMAL_LENGTH, SMALLEST_LENGTH
 from .detect import ContactPoint
 from .shapes import FloatArray, Pose
 
@@ -57,6 +57,8 @@ def _size(value: Any, path: str) -> float:
     number = checked_number(value, path)
     if number <= 0.0:
         raise SceneError(path, value, "must be > 0 (a size)")
+    if number < SMALLEST_LENGTH:  # below it the scene's length scale cannot be formed: every tolerance would be off
+        raise SceneError(path, value, f"must be at least {SMALLEST_LENGTH:g} (a size; choose other units)")
     return number
 
 
@@ -138,6 +140,8 @@ class Rectangle(Polygon):
         values = checked_array(size, field)
         if values.shape != (2,) or np.any(values <= 0.0):
             raise SceneError(field, values.tolist(), "expected [width, height], both > 0, in a planar scene")
+        for k, side in enumerate(("width", "height")):
+            _size(values[k], f"{field}.{side}")
         w, h = float(values[0]) / 2.0, float(values[1]) / 2.0
         object.__setattr__(self, "width", 2.0 * w)
         object.__setattr__(self, "height", 2.0 * h)
