@@ -65,6 +65,7 @@ __all__ = [
     "MAX_PYRAMID_EDGES",
     "MAX_NAME_LENGTH",
     "MAX_DEPTH",
+    "MAX_POLYGON_VERTICES",
     "MAX_VALUES",
     "MAX_FILE_BYTES",
     "DETECTION_MARGIN",
@@ -330,6 +331,12 @@ and compared for "did you mean" hints, whose cost grows with their length.
 MAX_DEPTH = 64
 """Most levels of nested lists and mappings in a scene: the format needs 5 (the scene, its contacts, a
 contact, its jacobian, a row); deeper input is rejected before anything recursive walks it.
+"""
+
+MAX_POLYGON_VERTICES = 1024
+"""Most vertices of one planar polygon: polygon-polygon detection compares every vertex of one with every face
+of the other, (n, m) arrays per pair and step (1024 x 1024: 8 MiB). A convex polygon cannot hold many more
+corners anyway: a regular 4,400-gon's corners lie within :data:`DUPLICATE_POINT` of its edges (a disk is a ``disk``).
 """
 
 MAX_VALUES = 1_000_000

@@ -29,7 +29,7 @@ import numpy.typing as npt
 
 from ..errors import SceneError
 from ..model import checked_array, checked_number
-from ..tolerances import DUPLICATE_POINT, NORMAL_LENGTH
+from ..tolerances import DUPLICATE_POINT, MAX_POLYGON_VERTICES, NORMAL_LENGTH, SMALLEST_LENGTH
 from .detect import ContactPoint
 from .shapes import FloatArray, Pose
 
@@ -57,6 +57,8 @@ def _size(value: Any, path: str) -> float:
     number = checked_number(value, path)
     if number <= 0.0:
         raise SceneError(path, value, "must be > 0 (a size)")
+    if number < SMALLEST_LENGTH:  # below it the scene's length scale cannot be formed: every tolerance would be off
+        raise SceneError(path, value, f"must be at least {SMALLEST_LENGTH:g} (a size; choose other units)")
     return number
 
 
@@ -81,7 +83,8 @@ class Polygon:
 
     ``vertices`` (n, 2) may be given in either winding order, but in order around the boundary; they are kept
     counter-clockwise. Every vertex must be a corner: a repeated point, one on the segment between its
-    neighbours (within :data:`DUPLICATE_POINT` of the size) or a reflex corner is rejected.
+    neighbours (within :data:`DUPLICATE_POINT` of the size) or a reflex corner is rejected, and so is a polygon of more
+    than :data:`MAX_POLYGON_VERTICES` vertices.
     """
 
     vertices: FloatArray
@@ -90,6 +93,9 @@ class Polygon:
         points = checked_array(vertices, field, ndim=2)
         if points.ndim != 2 or points.shape[1] != 2 or points.shape[0] < 3:
             raise SceneError(field, points.tolist(), "expected a list of at least 3 [x, y] vertices")
+        if points.shape[0] > MAX_POLYGON_VERTICES:
+            reason = f"at most {MAX_POLYGON_VERTICES:,} vertices (detection compares every vertex with every face)"
+            raise SceneError(field, f"{points.shape[0]:,} vertices", reason)
         object.__setattr__(self, "vertices", _convex_ccw(points, field))
 
     @property
@@ -110,7 +116,7 @@ def _convex_ccw(points: FloatArray, field: str) -> FloatArray:
     # the turn at vertex k+1 as the distance of that corner from the line of edge k, relative to the size
     bent = turns / np.maximum(lengths, 1e-300) / max(size, 1e-300)
     if size <= 0.0 or abs(area) <= (DUPLICATE_POINT * size) ** 2:
-        raise SceneError(field, points.tolist(), "degenerate polygon: its vertices enclose no area")
+        raise SceneError(field, points.tolist(), "degenerate polygon: its vertices enclose no area (on one line, or edges that cross)")
     if np.any(lengths <= DUPLICATE_POINT * size) or np.any(bent <= DUPLICATE_POINT):
         corner = ordered[(int(np.argmin(np.minimum(bent, lengths / size))) + 1) % len(ordered)].tolist()
         reason = f"not convex at vertex {corner}: give the corners of a convex polygon in order around it (either way round)"
@@ -134,6 +140,8 @@ class Rectangle(Polygon):
         values = checked_array(size, field)
         if values.shape != (2,) or np.any(values <= 0.0):
             raise SceneError(field, values.tolist(), "expected [width, height], both > 0, in a planar scene")
+        for k, side in enumerate(("width", "height")):
+            _size(values[k], f"{field}.{side}")
         w, h = float(values[0]) / 2.0, float(values[1]) / 2.0
         object.__setattr__(self, "width", 2.0 * w)
         object.__setattr__(self, "height", 2.0 * h)
@@ -356,18 +364,26 @@ def _disk_polygon(a: _Placed, b: _Placed, margin: float, tolerance: float) -> Wi
 
 
 def _polygon_plane(a: _Placed, b: _Placed, margin: float, tolerance: float) -> Witnesses:
-    """The extreme two vertices within the margin along the line (the corners of the support segment), each with its gap."""
+    """The extreme two vertices within the margin along the line (the corners of the support segment) and the deepest
+    one (a polygon standing on a corner whose neighbours are within the margin touches at that corner), each with its
+    gap; of vertices at one place along the line, the deepest."""
     normal, offset = b.line()
     vertices = a.faces()[0]
     gaps = vertices @ normal - offset
     within = np.flatnonzero(gaps <= margin)
     if within.size == 0:
         return []
-    along = vertices[within] @ np.array([-normal[1], normal[0]])
-    ends = [int(within[np.argmin(along)]), int(within[np.argmax(along)])]
-    if float(along.max() - along.min()) <= tolerance:
-        ends = ends[:1]
-    return [(vertices[k] - 0.5 * gaps[k] * normal, normal, float(gaps[k])) for k in ends]
+    along = vertices @ np.array([-normal[1], normal[0]])
+
+    def deepest(near: float) -> int:  # the deepest vertex within the margin at ``near`` along the line
+        there = within[np.abs(along[within] - near) <= tolerance]
+        return int(there[np.argmin(gaps[there])])
+
+    kept: list[int] = []
+    for k in (int(within[np.argmin(gaps[within])]), deepest(along[within].min()), deepest(along[within].max())):
+        if all(abs(along[k] - along[j]) > tolerance for j in kept):
+            kept.append(k)
+    return [(vertices[k] - 0.5 * gaps[k] * normal, normal, float(gaps[k])) for k in sorted(kept, key=lambda k: along[k])]
 
 
 def _separation(reference: _Placed, incident: FloatArray) -> tuple[float, int]:
@@ -387,8 +403,49 @@ def _polygon_polygon(a: _Placed, b: _Placed, margin: float, tolerance: float) ->
         return []
     # prefer b's face (normals then point from b into a) unless a's separates them clearly more
     if along_a > along_b + tolerance:
-        return [(x, -n, g) for x, n, g in _clipped(a, face_a, b, margin, tolerance)]
-    return _clipped(b, face_b, a, margin, tolerance)
+        points = [(x, -n, g) for x, n, g in _clipped(a, face_a, b, margin, tolerance)]
+        face_normal = -a.faces()[1][face_a]
+    else:
+        points = _clipped(b, face_b, a, margin, tolerance)
+        face_normal = b.faces()[1][face_b]
+    if max(along_a, along_b) >= 0.0 and _corner_nearer(a, b, points, tolerance):
+        # the incident edge lies beyond the face's ends, wholly or in part: the nearest points are corner to corner
+        return _corner(a, b, margin, tolerance, face_normal)
+    return points
+
+
+def _corner_nearer(a: _Placed, b: _Placed, points: Witnesses, tolerance: float) -> bool:
+    """Whether two separate polygons are nearer each other than every clipped point's gap says."""
+    return not points or _nearest_points(a, b)[2] < min(g for _, _, g in points) - tolerance
+
+
+def _corner(a: _Placed, b: _Placed, margin: float, tolerance: float, face_normal: FloatArray) -> Witnesses:
+    """Two separate polygons whose nearest points are a corner of one and a corner or edge of the other: one point
+    midway between them, the normal along their line (from b into a), the gap their distance. Corners touching
+    (closer than ``tolerance``) have no such line: the separating face's normal stands in."""
+    on_a, on_b, distance = _nearest_points(a, b)
+    offset = on_a - on_b
+    if distance > margin:
+        return []
+    normal = offset / distance if distance > tolerance else face_normal
+    return [(0.5 * (on_a + on_b), normal, distance)]
+
+
+def _nearest_points(a: _Placed, b: _Placed) -> tuple[FloatArray, FloatArray, float]:
+    """The nearest points (on a, on b) of two separate polygons, a vertex of one and the other's nearest boundary
+    point, and their distance: every vertex against every edge, both ways."""
+    best: tuple[FloatArray, FloatArray, float] = (a.centre, b.centre, math.inf)
+    for mine, theirs, swap in ((a, b, False), (b, a, True)):
+        vertices, corners = mine.faces()[0], theirs.faces()[0]
+        edges = np.roll(corners, -1, axis=0) - corners
+        t = np.einsum("nmk,mk->nm", vertices[:, None, :] - corners[None], edges) / np.einsum("mk,mk->m", edges, edges)
+        nearest = corners[None] + np.clip(t, 0.0, 1.0)[..., None] * edges[None]
+        distances = np.hypot(*(vertices[:, None, :] - nearest).transpose(2, 0, 1))
+        i, j = np.unravel_index(int(np.argmin(distances)), distances.shape)
+        if distances[i, j] < best[2]:
+            pair = (nearest[i, j], vertices[i]) if swap else (vertices[i], nearest[i, j])
+            best = (pair[0], pair[1], float(distances[i, j]))
+    return best
 
 
 def _clipped(reference: _Placed, face: int, incident: _Placed, margin: float, tolerance: float) -> Witnesses:

@@ -20,6 +20,7 @@ from ..model.io import (
     BodyFile,
     ContactFile,
     DetectionFile,
+    HalfspaceFile,
     MoverFile,
     PoseFile,
     RobotFile,
@@ -133,7 +134,9 @@ def _plain_robot(name: str, entry: RobotFile) -> Robot:
 def _shape(entry: ShapeFile, folder: Path, field: str) -> Shape:
     planar = [kind for kind in _PLANAR_KINDS if kind != "box" and getattr(entry, kind) is not None]
     if planar:
-        raise SceneError(f"{field}.{planar[0]}", getattr(entry, planar[0]), "a planar shape: give the scene dimension: 2")
+        value = getattr(entry, planar[0])
+        value = value.model_dump() if isinstance(value, HalfspaceFile) else value  # the file's words, not the class's
+        raise SceneError(f"{field}.{planar[0]}", value, "a planar shape: give the scene dimension: 2")
     given = [kind for kind in _SHAPE_KINDS if getattr(entry, kind) is not None]
     if len(given) != 1:
         reason = f"give exactly one of {', '.join(_SHAPE_KINDS)}" + (f" (given: {', '.join(given)})" if given else "")

@@ -528,6 +528,7 @@ class _SceneYamlLoader(yaml.composer.Composer, yaml.constructor.SafeConstructor,
         self._events: Iterator[Any] = yaml.parse(text, Loader=_YAML_EVENTS)
         self._next: Any = None
         self._sizes: dict[Any, int] = {}  # node -> values it holds, aliases expanded; absent while it is composed
+        self._composed = 0  # values composed so far: past MAX_VALUES the file is refused before its collection closes
         self._path: list[Any] = []
 
     def load(self) -> Any:
@@ -568,13 +569,17 @@ class _SceneYamlLoader(yaml.composer.Composer, yaml.constructor.SafeConstructor,
                 raise SceneError(_format_path(self._path), f"*{event.anchor}", "an alias cannot refer to a value that contains it")
             return node
         start = event.start_mark.index
+        self._composed += 1
+        if self._composed > MAX_VALUES:
+            reason = f"the file holds more than {MAX_VALUES:,} values by this point; a scene needs far fewer"
+            raise SceneError(_format_path(self._path), _snippet(self._text, start), reason)
         collection = isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent))
         if collection and len(self._path) >= MAX_DEPTH:
             raise SceneError(_format_path(self._path), _snippet(self._text, start), f"nested deeper than {MAX_DEPTH} levels")
         node = super().compose_node(parent, index)
         size = 1 + sum(self._sizes[child] for child in _yaml_children(node))
         if size > MAX_VALUES:
-            reason = f"holds more than {MAX_VALUES:,} values once its aliases are expanded; a scene needs far fewer"
+            reason = f"holds more than {MAX_VALUES:,} values, counting what its aliases expand to; a scene needs far fewer"
             raise SceneError(_format_path(self._path), _snippet(self._text, start), reason)
         self._sizes[node] = size
         if isinstance(node, yaml.MappingNode):
