@@ -23,13 +23,12 @@ from ..tolerances import DETECTION_MARGIN
 from .detect import ContactPoint
 from .planar import HalfPlane, PlanarLayout, PlanarShape, planar_pose, pose_angle
 from .shapes import Pose
-from .world import ContactDetection, Detection, first_pair
+from .world import ContactDetection, Detection, moved_parts
 
 __all__ = ["PlanarBody", "PlanarMover", "PlanarWorld"]
 
 FloatArray = npt.NDArray[np.float64]
 T = TypeVar("T")
-P = TypeVar("P", "PlanarBody", "PlanarMover")
 
 
 @dataclass(frozen=True)
@@ -88,15 +87,7 @@ class PlanarWorld:
             if isinstance(body.shape, HalfPlane):
                 reason = "a free body needs a bounded shape; a halfplane is for movers"
                 raise SceneError(f"bodies.{body.name}.shape.halfplane", "halfplane", reason)
-        known = {b.name for b in self.bodies} | {m.name for m in self.movers}
-        named = [("friction.pairs", p.between) for p in self.detection.pairs]
-        named += [("stiffness.pairs", p.between) for p in self.detection.stiffness_pairs]
-        counts: dict[str, int] = {}
-        for key, between in named:
-            index = counts[key] = counts.get(key, -1) + 1
-            for name in between:
-                if name not in known:
-                    raise SceneError(f"contact_detection.{key}[{index}].between", name, "names no body or mover of the scene")
+        self.detection.check_names({b.name for b in self.bodies} | {m.name for m in self.movers}, "body or mover")
 
     def __getstate__(self) -> dict[str, Any]:
         return {key: value for key, value in self.__dict__.items() if key != "_fixed"}
@@ -124,8 +115,8 @@ class PlanarWorld:
         for argument, given in (("robot_q", robot_q), ("joint_velocities", joint_velocities)):
             if given:
                 raise SceneError(argument, sorted(given), "a planar world has no URDF robots")
-        bodies = _moved_parts(self.bodies, body_poses, "body_poses")
-        movers = _moved_parts(self.movers, mover_poses, "mover_poses")
+        bodies = moved_parts(self.bodies, body_poses, "body_poses")
+        movers = moved_parts(self.movers, mover_poses, "mover_poses")
         if mover_twists:
             unknown = set(mover_twists) - {m.name for m in movers}
             if unknown:
@@ -208,26 +199,11 @@ class PlanarWorld:
     def _mu(self, body: str, other: str) -> float:
         table: dict[tuple[str, str], float] = self._kept("mu", dict)
         if (body, other) not in table:
-            pair = first_pair(self.detection.pairs, body, {other})
-            table[body, other] = self.detection.mu if pair is None else pair.mu
+            table[body, other] = self.detection.mu_between(body, {other})
         return table[body, other]
 
     def _spring(self, body: str, other: str) -> Stiffness | None:
         table: dict[tuple[str, str], Stiffness | None] = self._kept("stiffness", dict)
         if (body, other) not in table:
-            pair = first_pair(self.detection.stiffness_pairs, body, {other})
-            table[body, other] = self.detection.stiffness if pair is None else pair.stiffness
+            table[body, other] = self.detection.stiffness_between(body, {other})
         return table[body, other]
-
-
-def _moved_parts(parts: tuple[P, ...], poses: Mapping[str, Pose] | None, field: str) -> tuple[P, ...]:
-    """``parts`` with the poses named in ``poses`` replaced (an unknown name or a non-Pose is a SceneError)."""
-    if not poses:
-        return parts
-    known = {p.name for p in parts}
-    for name, pose in poses.items():
-        if name not in known:
-            raise SceneError(f"{field}.{name}", name, f"no such part; the known ones are {', '.join(sorted(known)) or 'none'}")
-        if not isinstance(pose, Pose):
-            raise SceneError(f"{field}.{name}", pose, "expected a Pose (quasistatic.adapters.planar_pose)")
-    return tuple(replace(p, pose=poses[p.name]) if p.name in poses else p for p in parts)

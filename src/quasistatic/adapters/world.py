@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, TypeVar, cast
+from typing import Any, ClassVar, Protocol, TypeVar, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -28,11 +28,10 @@ from .detect import Collider, ContactPoint, Layout, nearest_gaps
 from .robot import JointValues, UrdfRobot, link_owner
 from .shapes import Pose, Shape
 
-__all__ = ["SolidBody", "ShapedMover", "FrictionPair", "ContactDetection", "Detection", "World"]
+__all__ = ["SolidBody", "ShapedMover", "FrictionPair", "ContactDetection", "Detection", "World", "moved_parts"]
 
 FloatArray = npt.NDArray[np.float64]
 T = TypeVar("T")
-P = TypeVar("P", "SolidBody", "ShapedMover")
 
 
 @dataclass(frozen=True)
@@ -97,6 +96,27 @@ class ContactDetection:
     stiffness: Stiffness | None = None
     stiffness_pairs: tuple[StiffnessPair, ...] = ()
 
+    def mu_between(self, body: str, others: set[str]) -> float:
+        """The first friction pair naming ``body`` and one of ``others``, else the default ``mu``."""
+        pair = first_pair(self.pairs, body, others)
+        return self.mu if pair is None else pair.mu
+
+    def stiffness_between(self, body: str, others: set[str]) -> Stiffness | None:
+        """The first stiffness pair naming ``body`` and one of ``others``, else the default ``stiffness``."""
+        pair = first_pair(self.stiffness_pairs, body, others)
+        return self.stiffness if pair is None else pair.stiffness
+
+    def check_names(self, known: set[str], kinds: str) -> None:
+        """Every name a pair gives is one of ``known`` (else a SceneError naming the pair and ``kinds``)."""
+        named = [("friction.pairs", p.between) for p in self.pairs]
+        named += [("stiffness.pairs", p.between) for p in self.stiffness_pairs]
+        counts: dict[str, int] = {}
+        for key, between in named:
+            index = counts[key] = counts.get(key, -1) + 1
+            for name in between:
+                if name not in known:
+                    raise SceneError(f"contact_detection.{key}[{index}].between", name, f"names no {kinds} of the scene")
+
 
 @dataclass(frozen=True)
 class Detection:
@@ -141,15 +161,7 @@ class World:
     def __post_init__(self) -> None:
         parts: list[SolidBody | ShapedMover] = [*self.bodies, *self.movers]
         known = {p.name for p in parts} | {r.name for r in self.robots} | set(self._robot_links())
-        named = [("friction.pairs", p.between) for p in self.detection.pairs]
-        named += [("stiffness.pairs", p.between) for p in self.detection.stiffness_pairs]
-        counts: dict[str, int] = {}
-        for key, between in named:
-            index = counts[key] = counts.get(key, -1) + 1
-            for name in between:
-                if name not in known:
-                    field = f"contact_detection.{key}[{index}].between"
-                    raise SceneError(field, name, "names no body, mover, robot or robot link (robot/link) of the scene")
+        self.detection.check_names(known, "body, mover, robot or robot link (robot/link)")
 
     def __getstate__(self) -> dict[str, Any]:
         # The kept layout holds coal objects: rebuilt where it is needed, not pickled.
@@ -187,8 +199,8 @@ class World:
         the parsed robots, the shapes and their coal geometries, the detection layout, the margin, the
         friction of each pair. Names are checked; poses must be :class:`Pose` values (validated when built).
         """
-        bodies = _moved_parts(self.bodies, body_poses, "body_poses")
-        movers = _moved_parts(self.movers, mover_poses, "mover_poses")
+        bodies = moved_parts(self.bodies, body_poses, "body_poses")
+        movers = moved_parts(self.movers, mover_poses, "mover_poses")
         if mover_twists:
             _check_names(mover_twists, {m.name for m in movers}, "mover_twists", "mover")
             movers = tuple(replace(m, twist=mover_twists[m.name]) if m.name in mover_twists else m for m in movers)
@@ -327,16 +339,14 @@ class World:
         """The first friction pair naming ``body`` and ``other`` (or a robot link's whole robot), else the default."""
         table: dict[tuple[str, str], float] = self._kept("mu", dict)
         if (body, other) not in table:
-            pair = first_pair(self.detection.pairs, body, self._others(other))
-            table[body, other] = self.detection.mu if pair is None else pair.mu
+            table[body, other] = self.detection.mu_between(body, self._others(other))
         return table[body, other]
 
     def _stiffness(self, body: str, other: str) -> Stiffness | None:
         """The first stiffness pair naming ``body`` and ``other`` (or a robot link's whole robot), else the detection's default."""
         table: dict[tuple[str, str], Stiffness | None] = self._kept("stiffness", dict)
         if (body, other) not in table:
-            pair = first_pair(self.detection.stiffness_pairs, body, self._others(other))
-            table[body, other] = self.detection.stiffness if pair is None else pair.stiffness
+            table[body, other] = self.detection.stiffness_between(body, self._others(other))
         return table[body, other]
 
 
@@ -352,14 +362,29 @@ def first_pair(pairs: tuple[_Pair, ...], body: str, others: set[str]) -> _Pair |
     return None
 
 
-def _moved_parts(parts: tuple[P, ...], poses: Mapping[str, Pose] | None, field: str) -> tuple[P, ...]:
+class Placed(Protocol):
+    """A part with a name and a pose: a body or mover of a World or a PlanarWorld (a frozen dataclass)."""
+
+    __dataclass_fields__: ClassVar[dict[str, Any]]
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def pose(self) -> Pose: ...
+
+
+P = TypeVar("P", bound=Placed)
+
+
+def moved_parts(parts: tuple[P, ...], poses: Mapping[str, Pose] | None, field: str) -> tuple[P, ...]:
     """``parts`` with the poses named in ``poses`` replaced (an unknown name or a non-Pose is a SceneError)."""
     if not poses:
         return parts
     _check_names(poses, {p.name for p in parts}, field, "part")
     for name, pose in poses.items():
         if not isinstance(pose, Pose):
-            raise SceneError(f"{field}.{name}", pose, "expected a Pose")
+            raise SceneError(f"{field}.{name}", pose, "expected a Pose (quasistatic.Pose; in the plane, quasistatic.planar_pose)")
     return tuple(replace(p, pose=poses[p.name]) if p.name in poses else p for p in parts)
 
 

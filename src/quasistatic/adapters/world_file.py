@@ -89,10 +89,8 @@ def _mover(name: str, entry: MoverFile | None, folder: Path) -> ShapedMover:
     field = f"movers.{name}"
     if entry is None:
         return ShapedMover(name)
-    if entry.robot is not None or entry.origin is not None:
-        key = "robot" if entry.robot is not None else "origin"
-        reason = "in a scene with shapes, a mover's twist is about its pose's position, and robot links come from the urdf"
-        raise SceneError(f"{field}.{key}", getattr(entry, key), reason)
+    reason = "in a scene with shapes, a mover's twist is about its pose's position, and robot links come from the urdf"
+    _refuse_robot_and_origin(entry, field, reason)
     with _within(field):
         shape = None if entry.shape is None else _shape(entry.shape, folder, f"{field}.shape")
         return ShapedMover(name, shape, _pose(entry.pose, f"{field}.pose"), entry.twist)
@@ -282,12 +280,16 @@ def _planar_mover(name: str, entry: MoverFile | None) -> PlanarMover:
     field = f"movers.{name}"
     if entry is None:
         return PlanarMover(name)
-    if entry.robot is not None or entry.origin is not None:
-        key = "robot" if entry.robot is not None else "origin"
-        reason = "in a planar scene of shapes, a mover's twist [vx, vy, w] is about its pose's position"
-        raise SceneError(f"{field}.{key}", getattr(entry, key), reason)
+    _refuse_robot_and_origin(entry, field, "in a planar scene of shapes, a mover's twist [vx, vy, w] is about its pose's position")
     shape = None if entry.shape is None else _planar_shape(entry.shape, f"{field}.shape")
     return PlanarMover(name, shape, _planar_pose(entry.pose, f"{field}.pose"), entry.twist)
+
+
+def _refuse_robot_and_origin(entry: MoverFile, field: str, reason: str) -> None:
+    """A mover of a scene of shapes takes neither ``robot`` nor ``origin`` (its twist is about its pose's position)."""
+    if entry.robot is not None or entry.origin is not None:
+        key = "robot" if entry.robot is not None else "origin"
+        raise SceneError(f"{field}.{key}", getattr(entry, key), reason)
 
 
 def _planar_shape(entry: ShapeFile, field: str) -> PlanarShape:
