@@ -253,6 +253,14 @@ point this close to the segment between its neighbours is on an edge, not a vert
 a line along the normal through a patch corner that misses a shape by less than this still meets it [-].
 """
 
+GRAZING_FACE = 1e-3
+"""A face of a shape whose normal is within this of perpendicular to a contact's normal (their cosine) runs along
+the line through a patch corner, rather than crossing it [-]. The corner lies on that face's edge only to coal's
+round-off (7e-11 of a 0.25 box, measured), which a crossing divides by the cosine: a box tilted 1e-5 rad on a block
+had its corners' gaps off by 7e-6 (3e-5 of its size, swapped between corners). At 1e-3 round-off moves a gap by
+1e-7 of the size, below :data:`DUPLICATE_POINT`, and a face this steep spans a thousandth of the shape across.
+"""
+
 CURVED_PATCH_POINTS = 8
 """Vertices of the regular polygon inscribed in a curved flat contact (a cylinder standing on its end face) [-].
 An inscribed polygon keeps the support region inside the true disc, so a stability verdict stays on the

@@ -35,9 +35,9 @@ import numpy.typing as npt
 
 from ..errors import SceneError, SolverError
 from ..jit import HAVE_NUMBA, njit
-from ..tolerances import CONTACT_SEPARATION, CURVED_PATCH_POINTS, DUPLICATE_POINT, NORMAL_LENGTH, PATCH_THICKNESS
+from ..tolerances import CONTACT_SEPARATION, CURVED_PATCH_POINTS, DUPLICATE_POINT, GRAZING_FACE, NORMAL_LENGTH, PATCH_THICKNESS
 from ._coal import import_coal
-from .polygon import halfspace_polygon, polytope_vertices
+from .polygon import contact_corners, halfspace_polygon, plane_basis, polytope_faces, polytope_vertices
 from .shapes import Box, Capsule, Convex, Cylinder, FloatArray, Halfspace, IntArray, Mesh, Pose, Shape, Sphere, shape_from_coal
 
 BoolArray = npt.NDArray[np.bool_]
@@ -408,9 +408,14 @@ class _Query:
 
     @property
     def moved_request(self) -> Any:
-        """A request for pairs moved apart (its margin is set per pair); made when a pair first needs it."""
+        """A request for pairs moved apart (its margin is set per pair); made when a pair first needs it.
+
+        GJK stops on the duality gap: its default test stops at once when its first direction, the one the pair
+        was moved along (EPA's, off by ~1e-6 rad), already meets faces that are parallel, and returns that direction.
+        """
         if self._moved_request is None:
             self._moved_request = _request(self.coal, self.margin)
+            self._moved_request.gjk_convergence_criterion = self.coal.GJKConvergenceCriterion.DualityGap
         return self._moved_request
 
     def transform(self, index: int) -> Any:
@@ -471,6 +476,8 @@ def _pair_contacts(query: _Query, a: Collider, b: Collider, i: int, j: int) -> l
     if rough is None:
         return []
     direction, gap = rough
+    if direction is not None and gap < -max(margin, CONTACT_SEPARATION * size):
+        direction, gap = _checked_overlap(a, b, direction, gap, DUPLICATE_POINT * size)
     if direction is not None and _exact_normal(a, b, gap):
         return _one_point(query, a, b, direction, size)
     result = query.result
@@ -488,13 +495,28 @@ def _pair_contacts(query: _Query, a: Collider, b: Collider, i: int, j: int) -> l
         request.security_margin = margin + 2.0 * shift
         result.clear()
         coal.collide(ga, moved, gb, tb, request, result)
-        if not result.isCollision() or _unit(result.getContact(0).normal) is None:
+        to_b = _unit(result.getContact(0).normal) if result.isCollision() else None
+        if to_b is None:
             raise SolverError("coal", f"no finite contact normal between {a.owner!r} and {b.owner!r}, even moved apart")
+        # Again, moved along GJK's exact normal where EPA's was off (1e-6 to 1e-4 rad): a's patch and witness points,
+        # moved back, would sit beside b's by that error times the shift (3e-8 of a 0.25 box), and the line between
+        # them miss the corner its gap is measured at, by more than a steep face forgives (beside by less, the gap
+        # moves by less than GRAZING_FACE * DUPLICATE_POINT of the size).
+        beside = float(np.linalg.norm(to_b + direction)) * shift
+        if beside > GRAZING_FACE**2 * DUPLICATE_POINT * size:
+            direction = -to_b
+            moved = _transform(coal, a.pose, direction * shift)
+            result.clear()
+            coal.collide(ga, moved, gb, tb, request, result)
+            if not result.isCollision():
+                raise SolverError("coal", f"{a.owner!r} and {b.owner!r} moved apart along their normal no longer touch")
     thickness = max(margin - gap, 0.0) + PATCH_THICKNESS * size
     patch_request = coal.ContactPatchRequest(1, CURVED_PATCH_POINTS, thickness)
     patches = coal.ContactPatchResult(patch_request)
     coal.computeContactPatch(ga, moved, gb, tb, result, patch_request, patches)
-    return _patch_points(a, b, patches.getContactPatch(0), direction * shift, margin, size)
+    nearest = result.getContact(0)
+    witness = np.array([nearest.getNearestPoint1(), nearest.getNearestPoint2()], dtype=float).reshape(2, 3)
+    return _patch_points(a, b, patches.getContactPatch(0), witness, direction * shift, margin, size)
 
 
 def _halfspace_polygon(query: _Query, a: Collider, b: Collider, size: float) -> list[ContactPoint] | None:
@@ -502,13 +524,13 @@ def _halfspace_polygon(query: _Query, a: Collider, b: Collider, size: float) -> 
     plane, solid, sign = (b, a, 1.0) if isinstance(b.shape, Halfspace) else (a, b, -1.0)
     if not isinstance(plane.shape, Halfspace):
         return None
-    local = polytope_vertices(solid.shape)
-    if local is None:
+    local, faces = polytope_vertices(solid.shape), polytope_faces(solid.shape)
+    if local is None or faces is None:
         return None
     normal = plane.pose.rotation @ plane.shape.normal
     offset = plane.shape.offset + float(normal @ plane.pose.position)
     reach, tolerance = query.margin + PATCH_THICKNESS * size, DUPLICATE_POINT * size
-    points, gaps = halfspace_polygon(local, solid.pose.rotation, solid.pose.position, normal, offset, reach, tolerance)
+    points, gaps = halfspace_polygon(local, faces, solid.pose.rotation, solid.pose.position, normal, offset, reach, tolerance)
     into_first = sign * normal  # from the second collider into the first
     into_first.setflags(write=False)
     points.setflags(write=False)
@@ -538,14 +560,27 @@ def _one_point(query: _Query, a: Collider, b: Collider, direction: FloatArray, s
     return [ContactPoint(a.owner, b.owner, _frozen(np.array([(ax + bx) / 2.0, (ay + by) / 2.0, (az + bz) / 2.0])), direction, gap)]
 
 
-def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margin: float, size: float) -> list[ContactPoint]:
-    """The patch's vertices within the margin, ``a``'s witness points moved back by ``shift``."""
+def _patch_points(
+    a: Collider, b: Collider, patch: Any, witness: FloatArray, shift: FloatArray, margin: float, size: float
+) -> list[ContactPoint]:
+    """The patch's vertices within the margin, and the points inside it where the shapes come nearer than at its
+    corners; ``a``'s points moved back by ``shift``.
+
+    ``witness`` (2, 3): coal's nearest points of the pair (on a, on b). The patch is a polygon of the two shapes'
+    surfaces within its thickness; where they are not flat against each other (a box standing on a corner, a plate
+    tilted on a block, a hull resting on a face with others within the margin), the deepest point and a polytope's
+    vertices on its faces turned to the other shape can lie inside that polygon, lower than its corners around
+    them: they are added (each measured like the corners), the witness where it is deeper than every other point.
+    """
     to_b = _unit(patch.getNormal())  # coal's normal points from a to b
     if to_b is None:
         raise SolverError("coal", f"contact patch without a finite normal between {a.owner!r} and {b.owner!r}")
     count = patch.size()
-    on_a = np.array([patch.getPointShape1(k) for k in range(count)], dtype=float).reshape(-1, 3) - shift
-    on_b = np.array([patch.getPointShape2(k) for k in range(count)], dtype=float).reshape(-1, 3)
+    on_a = np.array([patch.getPointShape1(k) for k in range(count)] + [witness[0]], dtype=float).reshape(-1, 3) - shift
+    on_b = np.array([patch.getPointShape2(k) for k in range(count)] + [witness[1]], dtype=float).reshape(-1, 3)
+    depth = float((on_b[count] - on_a[count]) @ -to_b) + margin + PATCH_THICKNESS * size  # below the deepest gap
+    vertices = np.vstack([_facing_vertices(a, to_b, on_a[count], depth), _facing_vertices(b, -to_b, on_b[count], depth)])
+    on_a, on_b = np.vstack([on_a, vertices]), np.vstack([on_b, vertices])
     # coal puts every patch point on one plane, at the pair's deepest gap: find each one's own
     # surfaces along the normal, so a face tilted within the margin gets its true gaps.
     slack = DUPLICATE_POINT * size
@@ -556,11 +591,44 @@ def _patch_points(a: Collider, b: Collider, patch: Any, shift: FloatArray, margi
     on_a[both], on_b[both] = mid[both] - enter[both, None] * to_b, mid[both] - leave[both, None] * to_b
     gaps = (on_b - on_a) @ to_b
     within = (gaps <= margin + PATCH_THICKNESS * size) & np.isfinite(on_a + on_b).all(axis=1)
-    points, gaps = ((on_a + on_b) / 2.0)[within], gaps[within]
+    within[count:] &= both[count:]  # the points added must lie on both shapes
+    points = (on_a + on_b) / 2.0
     points.setflags(write=False)  # each contact's point is a (read-only) row of it
     normal = -to_b
     normal.setflags(write=False)
-    return [ContactPoint(a.owner, b.owner, points[k], normal, float(gaps[k])) for k in _polygon_vertices(points, DUPLICATE_POINT * size)]
+    rows = np.flatnonzero(within[:count])[_polygon_vertices(points[:count][within[:count]], slack)].tolist()
+    added = (np.flatnonzero(within[count + 1 :]) + count + 1).tolist()
+    if added:
+        rows = _lowest_corners(points, gaps, rows + added, normal, slack)
+    lowest = min((float(gaps[k]) for k in rows), default=math.inf)
+    if within[count] and both[count] and gaps[count] < lowest - slack:
+        rows.append(count)
+    return [ContactPoint(a.owner, b.owner, points[k], normal, float(gaps[k])) for k in rows]
+
+
+def _facing_vertices(collider: Collider, toward: FloatArray, anchor: FloatArray, depth: float) -> FloatArray:
+    """A polytope's world vertices (k, 3) on its faces turned ``toward`` (unit, world), at most ``depth`` behind
+    ``anchor`` along it; none for other shapes."""
+    local, faces = polytope_vertices(collider.shape), polytope_faces(collider.shape)
+    if local is None or faces is None:
+        return np.empty((0, 3))
+    rotation, position = collider.pose.rotation, collider.pose.position
+    turned = rotation.T @ toward
+    face_normals, members = faces
+    facing = np.zeros(len(local), dtype=bool)
+    facing[members[face_normals @ turned > 0.0]] = True
+    near = facing & ((local - rotation.T @ (anchor - position)) @ turned >= -depth)
+    placed: FloatArray = local[near] @ rotation.T + position
+    return placed
+
+
+def _lowest_corners(points: FloatArray, gaps: FloatArray, rows: list[int], normal: FloatArray, slack: float) -> list[int]:
+    """Of ``rows`` of ``points`` (on one contact plane of ``normal``), those that carry a constraint: the corners of
+    their hull seen along the normal and the lower points inside it (:func:`.polygon.contact_corners`)."""
+    u, v = (np.array(axis) for axis in plane_basis(normal.tolist()))
+    chosen = points[rows]
+    flat = list(zip((chosen @ u).tolist(), (chosen @ v).tolist(), strict=True))
+    return [rows[k] for k in contact_corners(flat, gaps[rows].tolist(), slack)]
 
 
 def _polygon_vertices(points: FloatArray, tolerance: float) -> list[int]:
@@ -623,7 +691,7 @@ def _spans(collider: Collider, origins: FloatArray, direction: FloatArray, slack
         leave = np.max([np.where(hit, high, -math.inf) for _, high, hit in pieces], axis=0)
         return enter, leave, np.any([hit for _, _, hit in pieces], axis=0)
     normals, offsets = shape.derived("planes", _planes)
-    return _in_planes(normals, offsets, q, u, slack, shape.extent)
+    return _in_planes(normals, offsets, q, u, slack)
 
 
 def _planes(shape: Shape) -> tuple[FloatArray, FloatArray]:
@@ -641,21 +709,28 @@ def _planes(shape: Shape) -> tuple[FloatArray, FloatArray]:
 
 
 def _in_planes(
-    normals: FloatArray, offsets: FloatArray, q: FloatArray, u: FloatArray, slack: float, length: float
+    normals: FloatArray, offsets: FloatArray, q: FloatArray, u: FloatArray, slack: float
 ) -> tuple[FloatArray, FloatArray, BoolArray]:
-    """Where ``q[k] + t u`` satisfies ``normals @ x <= offsets`` (unit normals).
+    """Where ``q[k] + t u`` satisfies ``normals @ x <= offsets`` (unit normals): ``(t_in, t_out, hit)``.
 
-    A plane the line comes nearer to by less than ``slack`` over the shape's ``length`` counts as
-    parallel to it: the line through a corner along the contact normal runs along the side faces, and
-    their bounds ``room / rate`` would be round-off divided by round-off, anything at all.
+    A plane within :data:`GRAZING_FACE` of parallel to the line bounds neither end: the line through a patch
+    corner along the contact normal runs along the side faces at that corner, and their bounds ``room / rate``
+    would be round-off (coal's, on the corner) divided by a small rate, anything at all. The line still misses
+    the shape where such a plane leaves it outside by more than ``slack`` all the way between the ends.
     """
     rate, room = normals @ u, offsets - q @ normals.T  # (m,), (k, m)
-    parallel = np.abs(rate) <= slack / length  # rate 0 included (length may be inf: a halfspace)
-    entering, leaving = (rate < 0.0) & ~parallel, (rate > 0.0) & ~parallel
+    steep = np.abs(rate) <= GRAZING_FACE
+    entering, leaving = (rate < 0.0) & ~steep, (rate > 0.0) & ~steep
     low = (room[:, entering] / rate[entering]).max(axis=1, initial=-math.inf)
     high = (room[:, leaving] / rate[leaving]).min(axis=1, initial=math.inf)
-    outside = (room[:, parallel] < -slack).any(axis=1)  # along a plane, outside it
-    return low, high, ~outside & (low <= high + slack)
+    # the steep planes, each moved out by slack: t * rate <= room + slack
+    loose, steep_rate = room[:, steep] + slack, rate[steep]
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        reach = loose / steep_rate  # a bound on t where rate != 0 (infinite where it is round-off)
+    first = np.where(steep_rate < 0.0, reach, -math.inf).max(axis=1, initial=-math.inf)
+    last = np.where(steep_rate > 0.0, reach, math.inf).min(axis=1, initial=math.inf)
+    along = ((steep_rate == 0.0) & (loose < 0.0)).any(axis=1)  # exactly along a plane, outside it
+    return low, high, ~along & (np.maximum(low, first) <= np.minimum(high, last) + slack)
 
 
 def _in_ball(q: FloatArray, u: FloatArray, radius: float, slack: float) -> tuple[FloatArray, FloatArray, BoolArray]:
@@ -669,7 +744,7 @@ def _in_ball(q: FloatArray, u: FloatArray, radius: float, slack: float) -> tuple
 def _in_tube(q: FloatArray, u: FloatArray, radius: float, half_length: float, slack: float) -> tuple[FloatArray, FloatArray, BoolArray]:
     """Where ``q[k] + t u`` (u unit) is within ``radius`` of the z axis and ``half_length`` of the xy plane."""
     slab = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]), np.array([half_length, half_length])
-    low, high, hit = _in_planes(*slab, q, u, slack, 2.0 * max(radius, half_length))
+    low, high, hit = _in_planes(*slab, q, u, slack)
     across, off_axis = float(u[0] ** 2 + u[1] ** 2), q[:, 0] ** 2 + q[:, 1] ** 2
     if across == 0.0:  # along the axis: the slab, where the line is within the radius
         return low, high, hit & (off_axis <= (radius + slack) ** 2)
@@ -767,6 +842,13 @@ def _least_overlap(a: Collider, b: Collider) -> tuple[FloatArray, float]:
     overlaps = [_support(b, d) + _support(a, -d) for d in candidates]
     best = int(np.argmin(overlaps))
     return np.asarray(candidates[best], dtype=float), -float(overlaps[best])
+
+
+def _checked_overlap(a: Collider, b: Collider, direction: FloatArray, gap: float, slack: float) -> tuple[FloatArray, float]:
+    """coal's answer for a deep overlap, or :func:`_least_overlap`'s where that finds the shapes apart by more: coal's
+    box-box test says a 6 cm box 1 um above a 4 m block overlaps it by 1.1 m, its normal reversed (coal 3.0.3)."""
+    other, separation = _least_overlap(a, b)
+    return (other, separation) if separation > gap + slack else (direction, gap)
 
 
 def _centre(collider: Collider) -> FloatArray:

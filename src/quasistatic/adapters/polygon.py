@@ -1,15 +1,17 @@
-"""The contact polygon of a polytope near a halfspace, from the polytope's vertices.
+"""The contact points of a polytope near a halfspace, from the polytope's vertices.
 
-A convex polytope's points nearest a plane include its vertices, and the part
-of it within a distance ``h`` of the plane projects onto the plane as the
-convex hull of the projections of its vertices within ``h`` and of the points
-where its edges cross the height ``h``. Those crossing points lie at the
-margin itself, and detection keeps only points within the margin (plus a
-patch thickness of round-off): what remains are the vertices within reach,
-each with its own distance, and of them the corners of their hull. This is
-what coal's contact patch gives for the pair, measured point by point
-(:mod:`.detect`), in a few array operations instead of a patch computation
-and a line-against-shape test per point.
+A convex polytope stays out of a halfspace exactly when its vertices do, so the
+contact constraints of the pair are those of its vertices within reach (the
+margin plus a patch thickness of round-off), each with its own distance. Of
+them only the vertices on the polytope's lower surface (on a face turned
+towards the halfspace) carry a constraint the others do not imply: a vertex
+above them is held up by those below it. Kept are the corners of their hull
+seen along the normal, and any vertex inside that hull, which lies lower than
+the hull's corners around it (a part standing on a corner whose neighbours
+are within the margin touches at that corner first). Flat on its face, that is
+the face's corners, what coal's contact patch gives for the pair, in a few
+array operations instead of a patch computation and a line-against-shape test
+per point.
 """
 
 from __future__ import annotations
@@ -18,9 +20,9 @@ import math
 
 import numpy as np
 
-from .shapes import Box, Convex, FloatArray, Mesh, Shape
+from .shapes import Box, Convex, FloatArray, IntArray, Mesh, Shape
 
-__all__ = ["polytope_vertices", "halfspace_polygon"]
+__all__ = ["contact_corners", "halfspace_polygon", "plane_basis", "polytope_faces", "polytope_vertices"]
 
 
 def polytope_vertices(shape: Shape) -> FloatArray | None:
@@ -34,29 +36,70 @@ def polytope_vertices(shape: Shape) -> FloatArray | None:
     return None
 
 
+def polytope_faces(shape: Shape) -> tuple[FloatArray, IntArray] | None:
+    """Outward unit normals (m, 3) of a box's or convex hull's faces in its frame, and each face's vertices (m, k) as
+    indices into :func:`polytope_vertices`, kept with the shape; None for other shapes."""
+    if isinstance(shape, Box):
+        return shape.derived("faces", _box_faces)
+    if isinstance(shape, Mesh):
+        shape = shape.convex
+    if isinstance(shape, Convex):
+        return shape.derived("faces", _hull_faces)
+    return None
+
+
+_SIGNS = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
+
+
 def _box_corners(box: Box) -> FloatArray:
-    signs = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
-    corners: FloatArray = signs * (box.size / 2.0)
+    corners: FloatArray = _SIGNS * (box.size / 2.0)
     return corners
 
 
-def halfspace_polygon(
-    vertices: FloatArray, rotation: FloatArray, position: FloatArray, normal: FloatArray, offset: float, reach: float, tolerance: float
-) -> tuple[FloatArray, FloatArray]:
-    """Contact points (k, 3) and their gaps (k,) of a polytope, ``vertices`` (n, 3) in its frame placed at ``rotation``,
-    ``position``, and the halfspace ``normal . x <= offset`` (``normal`` unit, world).
+def _box_faces(box: Box) -> tuple[FloatArray, IntArray]:
+    normals = np.vstack([np.eye(3), -np.eye(3)])
+    members = np.array([np.flatnonzero(_SIGNS @ normal > 0.0) for normal in normals], dtype=np.int64)  # 4 corners each
+    return normals, members
 
-    A vertex at gap ``normal . v - offset <= reach`` is within reach; its point is the midpoint of the vertex
-    and its foot on the plane. Of those, the corners of their hull seen along the normal are kept: no point
-    within ``tolerance`` [length] of another (the lower one stays) or of the segment between its neighbours.
-    In plain floats past the one product over all vertices: a contact has a few points, where each numpy call
-    costs more than their arithmetic.
+
+def _hull_faces(convex: Convex) -> tuple[FloatArray, IntArray]:
+    a, b, c = (convex.vertices[convex.triangles[:, k]] for k in range(3))
+    normals = np.cross(b - a, c - a)  # the triangles turn counter-clockwise seen from outside
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    return normals, np.asarray(convex.triangles, dtype=np.int64)
+
+
+def halfspace_polygon(
+    vertices: FloatArray,
+    faces: tuple[FloatArray, IntArray],
+    rotation: FloatArray,
+    position: FloatArray,
+    normal: FloatArray,
+    offset: float,
+    reach: float,
+    tolerance: float,
+) -> tuple[FloatArray, FloatArray]:
+    """Contact points (k, 3) and their gaps (k,) of a polytope, ``vertices`` (n, 3) and ``faces`` (outward normals
+    (m, 3), vertex indices (m, j)) in its frame placed at ``rotation``, ``position``, and the halfspace
+    ``normal . x <= offset`` (``normal`` unit, world).
+
+    A vertex at gap ``normal . v - offset <= reach`` on a face turned towards the halfspace, or the deepest vertex,
+    is within reach; its point is the midpoint of the vertex and its foot on the plane. Of those, kept are the
+    corners of their hull seen along the normal and the points inside it: no point within ``tolerance`` [length] of
+    another (the lower one stays), or of the segment between two hull corners unless it lies lower than them.
+    In plain floats past the products over all vertices and faces: a contact has a few points, where each numpy
+    call costs more than their arithmetic.
     """
     r, p, n = rotation.tolist(), position.tolist(), normal.tolist()
     up = [r[0][j] * n[0] + r[1][j] * n[1] + r[2][j] * n[2] for j in range(3)]  # the normal in the polytope's frame
     base = p[0] * n[0] + p[1] * n[1] + p[2] * n[2] - offset
-    gaps = [height + base for height in (vertices @ np.array(up)).tolist()]
-    near = [k for k, gap in enumerate(gaps) if gap <= reach]
+    heights = vertices @ np.array(up)
+    lower = np.zeros(len(vertices), dtype=bool)
+    face_normals, members = faces
+    lower[members[face_normals @ np.array(up) < 0.0]] = True  # on a face turned towards the halfspace
+    lower[int(np.argmin(heights))] = True  # always: a needle's tip has faces all but parallel to the normal
+    gaps = [height + base for height in heights.tolist()]
+    near = [k for k in np.flatnonzero(lower).tolist() if gaps[k] <= reach]
     points = []
     for k in near:
         x, y, z = vertices[k].tolist()
@@ -66,14 +109,14 @@ def halfspace_polygon(
                        r[2][0] * x + r[2][1] * y + r[2][2] * z + p[2] - half * n[2]))  # fmt: skip
     gaps = [gaps[k] for k in near]
     if len(points) > 1:
-        (ux, uy, uz), (vx, vy, vz) = _plane_basis(n)
+        (ux, uy, uz), (vx, vy, vz) = plane_basis(n)
         flat = [(x * ux + y * uy + z * uz, x * vx + y * vy + z * vz) for x, y, z in points]
-        corners = _hull_corners(flat, gaps, tolerance)
+        corners = contact_corners(flat, gaps, tolerance)
         points, gaps = [points[k] for k in corners], [gaps[k] for k in corners]
     return np.array(points, dtype=float).reshape(-1, 3), np.array(gaps, dtype=float)
 
 
-def _plane_basis(normal: list[float]) -> tuple[list[float], list[float]]:
+def plane_basis(normal: list[float]) -> tuple[list[float], list[float]]:
     """Two orthonormal directions across the unit ``normal``, in plain floats."""
     x, y, z = normal
     if abs(x) <= abs(y) and abs(x) <= abs(z):  # across the normal's smallest entry's axis: far from parallel
@@ -87,12 +130,14 @@ def _plane_basis(normal: list[float]) -> tuple[list[float], list[float]]:
     return [a, b, c], [y * c - z * b, z * a - x * c, x * b - y * a]
 
 
-def _hull_corners(flat: list[tuple[float, float]], gaps: list[float], tolerance: float) -> list[int]:
-    """Indices of the corners of the 2-D hull of ``flat``, counter-clockwise (Andrew's monotone chain, in plain floats:
-    a patch has a few points, where each numpy call costs more than the arithmetic).
+def contact_corners(flat: list[tuple[float, float]], gaps: list[float], tolerance: float) -> list[int]:
+    """Indices of the points that carry a constraint: the corners of the 2-D hull of ``flat`` (Andrew's monotone
+    chain, counter-clockwise), then the points inside it (each on the lower surface, so lower than the corners
+    around it). In plain floats: a patch has a few points, where each numpy call costs more than the arithmetic.
 
     Points within ``tolerance`` of each other are one (the lowest gap stays); a point within ``tolerance``
-    of the segment between its hull neighbours is on an edge, not a corner.
+    of the segment between its hull neighbours is on an edge, not a corner, unless it lies lower than that
+    segment by more than ``tolerance`` (a part standing on an edge bent down in its middle).
     """
     limit = tolerance * tolerance
     kept: list[int] = []
@@ -108,7 +153,21 @@ def _hull_corners(flat: list[tuple[float, float]], gaps: list[float], tolerance:
     order = sorted(kept, key=flat.__getitem__)
     lower = _chain(flat, order, limit)
     upper = _chain(flat, order[::-1], limit)
-    return lower[:-1] + upper[:-1]
+    hull = lower[:-1] + upper[:-1]
+    inside = [k for k in kept if k not in hull and not _on_hull_edge(k, hull, flat, gaps, tolerance)]
+    return hull + sorted(inside)
+
+
+def _on_hull_edge(k: int, hull: list[int], flat: list[tuple[float, float]], gaps: list[float], tolerance: float) -> bool:
+    """Whether point ``k`` lies within ``tolerance`` of an edge of the hull, and no lower than the edge there."""
+    x, y = flat[k]
+    for a, b in zip(hull, hull[1:] + hull[:1], strict=True):
+        (ax, ay), (bx, by) = flat[a], flat[b]
+        ux, uy = bx - ax, by - ay
+        t = min(max(((x - ax) * ux + (y - ay) * uy) / max(ux * ux + uy * uy, 1e-300), 0.0), 1.0)
+        if (x - ax - t * ux) ** 2 + (y - ay - t * uy) ** 2 <= tolerance * tolerance:
+            return gaps[k] >= (1.0 - t) * gaps[a] + t * gaps[b] - tolerance
+    return False
 
 
 def _chain(flat: list[tuple[float, float]], order: list[int], limit: float) -> list[int]:
