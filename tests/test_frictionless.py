@@ -15,6 +15,10 @@ Conventions: the contact normal points into ``body``, the force acts on
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -450,3 +454,43 @@ def test_single_point_scene_at_any_distance_from_the_origin(x: float) -> None:
     assert qs.solve(qs.load_scene(data)).status == "ambiguous"
     data["contacts"][0]["normal"] = [1.0, 0.0]
     assert qs.solve(qs.load_scene(data)).status == "unstable"
+
+
+def test_rank_tests_of_rank_deficient_normals_give_the_svds_singular_values_without_overflow() -> None:
+    """The LP's rank test (one-sided Jacobi rotations) on a box's four table points (random scene 3-D 65, frictionless:
+    rank 3 in 4 x 6) and on random matrices of rank 2 to 4: a column rotated to nearly zero made the rotation's
+    ``zeta ** 2`` overflow (a numpy warning on random frictionless scenes without numba)."""
+    from quasistatic.solvers import lp
+
+    kernel = getattr(lp._singular_values, "py_func", lp._singular_values)  # the plain-Python kernel, as without numba
+    a, b = 0.7143988317914549, 0.6840701033419289
+    table = np.array([[0.0, 0.0, 1.0, x, y, 0.0] for x, y in ((-a, b), (a, b), (-a, -b), (a, -b))])
+    rng = np.random.default_rng(7)
+    matrices = [table] + [rng.normal(size=(4, r)) @ rng.normal(size=(r, 6)) for r in (2, 3, 4) for _ in range(30)]
+    for A in matrices:
+        with np.errstate(over="raise", divide="raise", invalid="raise"):  # underflow is round-off, as numpy holds
+            got = np.sort(kernel(A))[::-1]
+        want = np.linalg.svd(A, compute_uv=False)
+        np.testing.assert_allclose(got[:4], want, atol=1e-12 * want[0])
+
+
+def test_random_frictionless_scenes_solve_without_numba_and_without_a_warning() -> None:
+    """Random 3-D frictionless scenes 65, 109 and 141 printed "overflow encountered in scalar multiply" from the LP's
+    rank test when numba was missing (what plain ``pip install`` gives): run with warnings as errors."""
+    code = textwrap.dedent(
+        """
+        import sys
+        sys.modules["numba"] = None  # import numba now raises ImportError
+        sys.path.insert(0, "tests")
+        import quasistatic as qs
+        from random_scenes import random_scene
+        for seed in (65, 109, 141):
+            solution = qs.solve(random_scene(3, seed, friction="none"))
+            print(seed, solution.status)
+        """
+    )
+    root = Path(__file__).resolve().parents[1]
+    out = subprocess.run([sys.executable, "-W", "error", "-c", code], capture_output=True, text=True, timeout=300, cwd=root)
+    assert out.returncode == 0 and out.stderr == "", out.stderr[-2000:]
+    statuses = [line.split()[1] for line in out.stdout.splitlines()]
+    assert len(statuses) == 3 and "failed" not in statuses, out.stdout

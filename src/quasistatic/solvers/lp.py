@@ -204,8 +204,12 @@ def _singular_values(A: np.ndarray) -> np.ndarray:
                 if gamma == 0.0 or abs(gamma) <= JACOBI_ORTHOGONAL * np.sqrt(alpha * beta):
                     continue
                 rotated = True
-                zeta = (beta - alpha) / (2.0 * gamma)
-                t = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
+                # tan of the rotation, sign(z) / (|z| + sqrt(1 + z^2)) with z = (beta - alpha) / (2 gamma), times 2|gamma|
+                # above and below: a column rotated to nearly zero (a rank-deficient A) makes z ~ 1e165, and z^2
+                # overflowed (a numpy warning without numba); this form divides by at least 2|gamma| and overflows nowhere.
+                diff = beta - alpha
+                sign = 1.0 if diff == 0.0 or (diff > 0.0) == (gamma > 0.0) else -1.0
+                t = sign * 2.0 * abs(gamma) / (abs(diff) + np.hypot(2.0 * gamma, diff))
                 cos = 1.0 / np.sqrt(1.0 + t * t)
                 sin = cos * t
                 for i in range(rows):
