@@ -352,10 +352,13 @@ def _render_solutions(motions: Sequence[Motion], console: Console) -> None:
             exceeded = f" (torque limits exceeded: {', '.join(load.limits_exceeded)})" if load.limits_exceeded else ""
             console.print(Text(f"    {load.robot} joint torques: {format_vector(load.torques)}{exceeded}"))
         if motion.continuum and motion.extreme_twists:
-            console.print(Text("    extreme twists:"))
+            console.print(Text("    extreme twists (each audited with forces found at it):"))
             for extreme in motion.extreme_twists:
                 text = "; ".join(f"{name} {format_vector(t)}" for name, t in extreme.items())
                 console.print(Text(f"      {text}"))
+        if motion.unproven_extremes:
+            count = len(motion.unproven_extremes)
+            console.print(Text(f"    {count} more extreme twist{'s' if count > 1 else ''} failed the audit: not motions, not listed"))
 
 
 def render_trajectory(trajectory: Trajectory, console: Console, saved: str = "") -> None:

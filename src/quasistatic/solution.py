@@ -31,6 +31,7 @@ __all__ = [
     "Audit",
     "StepAudit",
     "CompliantStep",
+    "UnprovenExtreme",
     "Motion",
     "Solution",
 ]
@@ -461,6 +462,25 @@ class ContactList:
 
 
 @dataclass(frozen=True)
+class UnprovenExtreme:
+    """An extreme twist a method gave for a continuum that the audit did not pass: not a motion, not listed as one.
+
+    Attributes
+    ----------
+    twists : dict name -> array
+        Its body twists, as :attr:`Motion.twists`.
+    audit : Audit or None
+        The audit with the forces the method found at it; None when it found none.
+    """
+
+    twists: dict[str, np.ndarray]
+    audit: Audit | None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"twists": {n: _floats(t) for n, t in self.twists.items()}, "audit": None if self.audit is None else self.audit.to_dict()}
+
+
+@dataclass(frozen=True)
 class Motion:
     """One motion that satisfies the laws: twists, contacts, power and its audit.
 
@@ -479,6 +499,12 @@ class Motion:
     free_directions : tuple of str
         For an unbounded continuum: the twist entries that grow (``+``) or fall (``-``)
         without bound, e.g. ``("box v_x +",)``.
+    extreme_audits : tuple of Audit
+        The audit of each of ``extreme_twists``, in order, with the forces found at it: every listed
+        extreme passed its own (an extreme is a motion too).
+    unproven_extremes : tuple of UnprovenExtreme
+        Extremes the method gave that failed their audit (or had no forces): not motions, so not in
+        ``extreme_twists``; kept to show what was refused.
     loads : LoadSource
         The robot loads and mover wrenches, read through :attr:`robot_loads` and :attr:`mover_wrenches`.
     """
@@ -492,6 +518,8 @@ class Motion:
     unbounded: bool = False
     free_directions: tuple[str, ...] = ()
     loads: LoadSource = field(default=LoadList(), repr=False, compare=False)
+    extreme_audits: tuple[Audit, ...] = ()
+    unproven_extremes: tuple[UnprovenExtreme, ...] = ()
 
     def __getstate__(self) -> dict[str, Any]:
         # Twists as floats in lists: pickling small arrays costs more than the numbers in them.
@@ -561,6 +589,8 @@ class Motion:
             out["unbounded"] = self.unbounded
             out["free_directions"] = list(self.free_directions)
             out["extreme_twists"] = [{n: _floats(t) for n, t in e.items()} for e in self.extreme_twists]
+            out["extreme_audits"] = [audit.to_dict() for audit in self.extreme_audits]
+            out["unproven_extremes"] = [extreme.to_dict() for extreme in self.unproven_extremes]
         return out
 
     def _contact_dicts(self) -> list[dict[str, Any]]:

@@ -22,7 +22,7 @@ from .derivative import SolvedScene
 from .errors import QuasistaticError, SolverError
 from .laws import Problem, RawMotion, WorldForceSet, assemble, free_directions, physical_twists, to_world
 from .model import FloatArray, Scene
-from .solution import Attempt, CompliantStep, Mode, Motion, Solution
+from .solution import Attempt, CompliantStep, Mode, Motion, Solution, UnprovenExtreme
 from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, compliant_forces, compliant_step, get_backend, too_large
 
 Range = tuple[float, float | None]
@@ -198,19 +198,30 @@ def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFA
         ranges = _physical_ranges(raw.force_ranges, scales.force)
     elif raw.lazy_ranges is not None:
         ranges = partial(_physical_ranges_of, raw.lazy_ranges, scales.force)
-    extremes = tuple(physical_twists(problem, e) for e in raw.extremes)
-    if raw.extremes_share_forces:
-        for extreme in raw.extremes:  # each extreme with the motion's forces: a motion too, audited as one
-            at_extreme = audited_motion(geometry, scales, to_world(problem, extreme, raw.c)[0], forces, tolerance=tolerance)
-            if not at_extreme.audit.passed:
-                return at_extreme  # the evidence: this continuum is not what it claims
+    extremes, audits, unproven = [], [], []
+    for k, extreme in enumerate(raw.extremes):  # an extreme is a motion too: audited as one, with its forces
+        twists = physical_twists(problem, extreme)
+        own = raw.c if raw.extremes_share_forces else raw.extreme_forces[k] if k < len(raw.extreme_forces) else None
+        if own is None:  # no forces to audit it with: not a motion anyone has shown
+            unproven.append(UnprovenExtreme(twists, None))
+            continue
+        at_extreme = audited_motion(geometry, scales, *to_world(problem, extreme, own), tolerance=tolerance)
+        if at_extreme.audit.passed:
+            extremes.append(twists)
+            audits.append(at_extreme.audit)
+        elif raw.extremes_share_forces:
+            return at_extreme  # the evidence: this pattern's continuum is not what it claims
+        else:
+            unproven.append(UnprovenExtreme(twists, at_extreme.audit))
     return audited_motion(
         geometry,
         scales,
         T,
         forces,
         ranges=ranges,
-        extreme_twists=extremes,
+        extreme_twists=tuple(extremes),
+        extreme_audits=tuple(audits),
+        unproven_extremes=tuple(unproven),
         continuum=raw.continuum,
         unbounded=raw.unbounded,
         free_directions=free_directions(problem, raw.free_axes),

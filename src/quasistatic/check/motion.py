@@ -17,7 +17,7 @@ import numpy as np
 
 from ..jit import njit
 from ..model import Scales, Scene
-from ..solution import ContactResult, Mode, Motion, PowerBalance
+from ..solution import Audit, ContactResult, Mode, Motion, PowerBalance, UnprovenExtreme
 from ..tolerances import AUDIT, MODE_SPEED, ROUNDOFF
 from .audit import AuditGeometry, audit_arrays
 from .loads import ForceFunctionals, LoadTable
@@ -61,6 +61,8 @@ def audited_motion(
     free_directions: tuple[str, ...] = (),
     force_set: ForceFunctionals | None = None,
     tolerance: float = AUDIT,
+    extreme_audits: tuple[Audit, ...] = (),
+    unproven_extremes: tuple[UnprovenExtreme, ...] = (),
 ) -> Motion:
     """Audit one motion on the original scene data and name each contact's mode.
 
@@ -82,7 +84,19 @@ def audited_motion(
     named = dict(zip(geometry.names, _drop_roundoff(np.array(twists, dtype=float), geometry.twist_roundoff), strict=True))
     loads = LoadTable(geometry.scene, scales, forces, force_set)
     power = _clean_power(power, geometry.power_roundoff)
-    return Motion(named, table, power, audit, continuum, extreme_twists, unbounded, free_directions, loads)
+    return Motion(
+        named,
+        table,
+        power,
+        audit,
+        continuum,
+        extreme_twists,
+        unbounded,
+        free_directions,
+        loads,
+        extreme_audits=extreme_audits,
+        unproven_extremes=unproven_extremes,
+    )
 
 
 @njit

@@ -61,6 +61,9 @@ class RawMotion:
     extremes_share_forces : bool
         The forces ``c`` hold at every extreme too (one contact-mode pattern's motions are its twists times
         its forces), so each extreme is audited with them, as the motion itself is.
+    extreme_forces : tuple of (m, d) arrays
+        Otherwise: forces the backend found at each extreme (contact frames), in the order of ``extremes``; each
+        extreme is audited with its own. An extreme without forces (this empty) cannot be audited: not listed.
     """
 
     q: FloatArray
@@ -72,6 +75,7 @@ class RawMotion:
     lazy_ranges: Callable[[], tuple[tuple[float, float | None], ...]] | None = field(default=None, repr=False, compare=False)
     force_set: ForceSet | None = field(default=None, repr=False, compare=False)
     extremes_share_forces: bool = False
+    extreme_forces: tuple[FloatArray, ...] = ()
 
     @property
     def continuum(self) -> bool:

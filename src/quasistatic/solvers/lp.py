@@ -68,7 +68,8 @@ def solve_frictionless(problem: Problem, options: Options) -> BackendResult:
     # {d : Jn_S d = 0, Jn_T d >= 0} is only the origin at once when Jn_S has full column rank.
     if not motion_unique and not cone_is_trivial(Jn[support], Jn[tight]):
         extremes, free = twist_extremes(q.size, Jn[support], bn[support], Jn[~support], bn[~support])
-        motion = RawMotion(q, c, tuple(extremes), bool(free), free)
+        # every dual optimal c is complementary to every primal optimum: the same forces hold at each extreme
+        motion = RawMotion(q, c, tuple(extremes), bool(free), free, extreme_forces=(c,) * len(extremes))
         return BackendResult("ambiguous", _ambiguous_message(bool(free)), (motion,))
     forces_unique = forces_known > 0 if forces_known >= 0 else full_column_rank(sp.csr_matrix(Jn[closed]).T, FORCE_RANK)
     if forces_unique:

@@ -93,17 +93,17 @@ def _no_motion(problem: Problem, options: Options, proof: str) -> BackendResult:
 
 def _wedge_proof(problem: Problem, options: Options) -> str:
     """A certificate that the exact cones admit no motion (a sector relaxation of the exact laws is infeasible), or ''."""
-    proven, sectors = exact_cones_jam(problem, options, options.modes, lambda q: _is_exact_motion(problem, q))
+    proven, sectors = exact_cones_jam(problem, options, options.modes, lambda q: _exact_forces(problem, q) is not None)
     if not proven:
         return ""
     return f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; SCIP, complete search)"
 
 
-def _is_exact_motion(problem: Problem, q: np.ndarray) -> bool:
-    """Whether forces satisfying the exact laws exist at twist ``q`` (with the modes it gives each contact)."""
+def _exact_forces(problem: Problem, q: np.ndarray) -> np.ndarray | None:
+    """Forces (m, 3) satisfying the exact laws at twist ``q`` (with the modes it gives each contact), or None."""
     if np.min(problem.velocities(q)[:, -1], initial=0.0) < -MODE_SPEED:
-        return False
-    return _forces_at(problem, q, ModeMasks.of(problem, contact_modes(problem, q))) is not None
+        return None
+    return _forces_at(problem, q, ModeMasks.of(problem, contact_modes(problem, q)))
 
 
 def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResult | None, str]:
@@ -325,9 +325,12 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
         c = recovered
     if motion.continuum and _twist_is_free(_jacobian_at(problem, q, c, new_modes), problem.n_dof):
         # The pyramid's extremes are motions of the pyramid; only those that are motions of the exact
-        # cones are listed, and the refined point stands for the continuum when none is.
-        extremes = tuple(e for e in motion.extremes if _is_exact_motion(problem, e))
-        return RawMotion(q, c, extremes or (q,), motion.unbounded, motion.free_axes)
+        # cones are listed, each with its forces (the audit checks them), and the refined point stands
+        # for the continuum when none is.
+        found = [(e, _exact_forces(problem, e)) for e in motion.extremes]
+        exact = [(e, f) for e, f in found if f is not None] or [(q, c)]
+        extremes, forces = tuple(e for e, _ in exact), tuple(f for _, f in exact)
+        return RawMotion(q, c, extremes, motion.unbounded, motion.free_axes, extreme_forces=forces)
     return RawMotion(q, c)
 
 

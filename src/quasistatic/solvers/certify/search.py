@@ -25,7 +25,7 @@ from ...solution import Diagnosis
 from ...tolerances import DISTINCT_TWIST, MODE_SPEED, SAME_TWIST
 from ..numerics.forces import indeterminate_forces
 from ..numerics.highs import solve_lp
-from ..numerics.ranges import twist_extremes
+from ..numerics.ranges import polyhedron_extremes
 from ..numerics.scip_model import exclude_box, linear, new_model, optimize
 from ..result import BackendResult, Options
 from .diagnose import MESSAGES, diagnose
@@ -230,7 +230,8 @@ def _pattern_motion(form: LCPForm, x: np.ndarray, z: np.ndarray, options: Option
     A_in, b_in = form.W[z == 1], form.r[z == 1]
     A_eq, b_eq, A_in, b_in = _with_prescribed_modes(form, options, A_eq, b_eq, A_in, b_in)
     lower = np.r_[np.full(form.n_q, -np.inf), np.zeros(N - form.n_q)]
-    extremes, free = twist_extremes(form.n_q, A_eq, b_eq, A_in, b_in, lower)
+    points, free = polyhedron_extremes(form.n_q, A_eq, b_eq, A_in, b_in, lower)
+    extremes = [p[: form.n_q] for p in points]
     unbounded = bool(free)
     # One extreme (the 2n LPs' optima within SAME_TWIST of each other) is one twist, that vertex: SCIP's own point
     # meets the rows to its tolerance only, and where the twist is large (150 x the scene's speed) it was more
@@ -242,7 +243,8 @@ def _pattern_motion(form: LCPForm, x: np.ndarray, z: np.ndarray, options: Option
     # every inequality as slack as it can be, the pairs' own variables (slip speeds) included.
     free_pairs = np.eye(N)[cols[z == 0]]
     x = relative_interior_point(A_eq, b_eq, np.vstack([A_in, free_pairs]), np.r_[b_in, np.zeros(len(free_pairs))], lower, x)
-    return RawMotion(x[: form.n_q], form.forces(x), tuple(extremes), unbounded, free)
+    forces = tuple(form.forces(p) for p in points)  # each extreme's own: the pattern's forces vary over it
+    return RawMotion(x[: form.n_q], form.forces(x), tuple(extremes), unbounded, free, extreme_forces=forces)
 
 
 def relative_interior_point(

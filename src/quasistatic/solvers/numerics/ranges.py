@@ -18,6 +18,7 @@ from .rank import DENSE_MAX, full_column_rank
 __all__ = [
     "null_space",
     "cone_is_trivial",
+    "polyhedron_extremes",
     "twist_extremes",
     "value_ranges",
     "ranges_are_wide",
@@ -87,12 +88,28 @@ def twist_extremes(
     b_in: np.ndarray,
     col_lower: np.ndarray | None = None,
 ) -> tuple[list[np.ndarray], tuple[int, ...]]:
-    """Extreme points of a polyhedron along each of its first ``n_twist`` coordinates.
+    """Extreme points of a polyhedron along each of its first ``n_twist`` coordinates (those coordinates only).
+
+    See :func:`polyhedron_extremes`.
+    """
+    points, free = polyhedron_extremes(n_twist, A_eq, b_eq, A_in, b_in, col_lower)
+    return [x[:n_twist] for x in points], free
+
+
+def polyhedron_extremes(
+    n_twist: int,
+    A_eq: np.ndarray,
+    b_eq: np.ndarray,
+    A_in: np.ndarray,
+    b_in: np.ndarray,
+    col_lower: np.ndarray | None = None,
+) -> tuple[list[np.ndarray], tuple[int, ...]]:
+    """Extreme points of a polyhedron along each of its first ``n_twist`` coordinates, as whole points.
 
     Polyhedron: ``A_eq x = b_eq, A_in x >= b_in`` (columns free unless
-    ``col_lower``). Returns the distinct finite extremes and the directions
-    along which the twist projection is unbounded: ``+(j + 1)`` for coordinate
-    ``j`` growing without bound, ``-(j + 1)`` for it falling without bound.
+    ``col_lower``). Returns the points (every coordinate: a twist's forces with it) of the distinct finite
+    extremes of the first ``n_twist`` coordinates, and the directions along which that projection is
+    unbounded: ``+(j + 1)`` for coordinate ``j`` growing without bound, ``-(j + 1)`` for it falling without bound.
     """
     A = np.vstack([A_eq, A_in])
     lower = np.r_[b_eq, b_in]
@@ -103,9 +120,8 @@ def twist_extremes(
     objectives = [(sign * np.eye(1, A.shape[1], j)[0], False) for j, sign in axes]
     for (j, sign), lp in zip(axes, optimise_each(objectives, A, lower, upper, col_lower), strict=True):
         if lp.status == "optimal":
-            q = lp.x[:n_twist]
-            if not any(np.max(np.abs(q - p)) <= SAME_TWIST for p in points):
-                points.append(q)
+            if not any(np.max(np.abs(lp.x[:n_twist] - p[:n_twist])) <= SAME_TWIST for p in points):
+                points.append(lp.x)
         elif lp.status == "unbounded":  # minimising sign * x_j is unbounded: x_j runs to -sign infinity
             free.append(-sign * (j + 1))
         else:  # no answer is not an unbounded direction (it once made a bogus continuum free in every direction)
