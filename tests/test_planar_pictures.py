@@ -136,5 +136,5 @@ def test_the_3d_viewer_refuses_a_planar_run_in_one_line(push_run: Path, tmp_path
     result = run("view", str(push_run), "--export", str(tmp_path / "push.html"))
     lines = result.stderr.strip().splitlines()
     assert result.returncode == 2 and len(lines) == 1 and lines[0].startswith("error:"), result.stderr
-    assert "planar" in lines[0] and "animate" in lines[0]
+    assert "planar" in lines[0] and f"`quasistatic animate {push_run} -o push.gif` does" in lines[0]
     assert not (tmp_path / "push.html").exists()

@@ -12,6 +12,7 @@ unreadable or invalid scene, an unknown method or option, malformed
 from __future__ import annotations
 
 import json
+import shlex
 import sys
 from collections import Counter
 from collections.abc import Callable, Iterator
@@ -442,7 +443,9 @@ def _view_trajectory(trajectory_file: Path, scene: Path | None, host: str, port:
     trajectory = _guarded(lambda: Trajectory.load(trajectory_file))
     world = _run_world(trajectory_file, trajectory, scene)
     if not isinstance(world, World):
-        _fail(f"{str(trajectory_file)!r}: the 3-D viewer does not draw runs of planar scenes of shapes yet; `quasistatic animate` does")
+        command = f"quasistatic animate {shlex.quote(str(trajectory_file))} -o {shlex.quote(trajectory_file.with_suffix('.gif').name)}"
+        reason = f"the 3-D viewer does not draw runs of planar scenes of shapes yet; `{command}` does"
+        _fail(f"{str(trajectory_file)!r}: {reason}")
     viewer = _guarded(lambda: view_trajectory(trajectory, world, host=host, port=0 if export is not None else port, camera=camera))
     summary = f"{len(trajectory.states)} states, {trajectory.status}" + ("" if trajectory.certified else ", NOT proven")
     _serve_or_export(viewer, export, summary)
