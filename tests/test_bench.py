@@ -71,6 +71,30 @@ def test_outputs(result: runner.BenchResult, tmp_path: Path) -> None:
     assert write_scaling_plot(result, tmp_path / "plot.png") is None  # no scaling family in this subset
 
 
+def test_the_benchmark_holds_blas_to_one_thread_while_it_times_and_says_so(monkeypatch: pytest.MonkeyPatch) -> None:
+    """OpenBLAS's own threads made the Allegro simulate row's solve 270 ms a step instead of 19 on a loaded 2-core
+    machine: every row is timed with BLAS held to one thread, whatever the environment says."""
+    from threadpoolctl import threadpool_info
+
+    seen: list[int] = []
+    timed = runner._run_family
+
+    def recording(family: object, config: BenchConfig, say: object) -> list[Row]:
+        seen.extend(pool["num_threads"] for pool in threadpool_info() if pool["user_api"] == "blas")
+        return timed(family, config, say)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(runner, "_run_family", recording)
+    lines: list[str] = []
+    config = BenchConfig(families=("grasp-3d-nf",), methods=("lp",), repeat=1, instances=1, batch=False, robots=False, sweeps=False)
+    result = run_benchmarks(config, lines.append)
+    assert seen and set(seen) == {1}
+    assert result.machine["blas_threads"] == 1
+    assert any("BLAS held to 1 thread for every timing" in line for line in lines)
+    console = Console(file=io.StringIO(), width=200)
+    render_result(result, console)
+    assert "BLAS threads 1 while timing" in console.file.getvalue()  # type: ignore[attr-defined]
+
+
 def test_unregistered_or_inapplicable_methods_are_reported_not_dropped(monkeypatch: pytest.MonkeyPatch) -> None:
     problem = qs.assemble(FAMILIES["grasp-3d"].make(4, 0))
     monkeypatch.delitem(runner.BACKENDS, "lp")

@@ -111,7 +111,8 @@ def render_result(result: BenchResult, console: Console) -> None:
     m = result.machine
     console.print(
         f"machine: {m['cores']} cores, {m['cpu']}, Python {m['python']}, load average {m.get('load_average_at_start')} "
-        f"at start, effective cores for 2 workers {m.get('effective_cores_for_2_workers', '-')}; "
+        f"at start, effective cores for 2 workers {m.get('effective_cores_for_2_workers', '-')}, "
+        f"BLAS threads {m.get('blas_threads', 'not held')} while timing; "
         f"run took {result.wall_seconds:.0f} s"
     )
 

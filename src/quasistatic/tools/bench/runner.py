@@ -29,6 +29,7 @@ from importlib.util import find_spec
 from typing import Any
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from ...laws import Problem, assemble
 from ...solution import Solution
@@ -183,9 +184,23 @@ class BenchResult:
 Progress = Callable[[str], None]
 
 
+BLAS_THREADS = 1
+"""BLAS threads while the benchmark times anything: OpenBLAS's own threads, on a loaded 2-core machine, made the
+Allegro simulate row's solve take 270 ms a step instead of 19 (and its CPU time twice its wall time elsewhere)."""
+
+
 def run_benchmarks(config: BenchConfig, progress: Progress | None = None) -> BenchResult:
-    """Run the families and methods of ``config``; ``progress`` gets one line per finished row."""
+    """Run the families and methods of ``config`` with BLAS held to :data:`BLAS_THREADS` thread(s) (threadpoolctl);
+    ``progress`` gets one line per finished row."""
     say = progress or (lambda _line: None)
+    say(f"BLAS held to {BLAS_THREADS} thread for every timing (threadpoolctl), whatever OPENBLAS_NUM_THREADS says")
+    with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+        result = _run_benchmarks(config, say)
+    result.machine["blas_threads"] = BLAS_THREADS
+    return result
+
+
+def _run_benchmarks(config: BenchConfig, say: Progress) -> BenchResult:
     start = time.perf_counter()
     load_at_start = machine_info()["load_average"]
     rows: list[Row] = []
@@ -535,7 +550,7 @@ def machine_info() -> dict[str, Any]:
         pass
     usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     versions: dict[str, str | None] = {}
-    for package in ("quasistatic", "numpy", "scipy", "highspy", "pyscipopt", "numba", "joblib", "pin", "coal"):
+    for package in ("quasistatic", "numpy", "scipy", "highspy", "pyscipopt", "numba", "joblib", "threadpoolctl", "pin", "coal"):
         try:
             versions[package] = metadata.version(package)
         except metadata.PackageNotFoundError:
