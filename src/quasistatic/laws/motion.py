@@ -12,7 +12,7 @@ from ..jit import HAVE_NUMBA, njit
 from ..model import FloatArray
 from .assemble import Problem
 
-__all__ = ["RawMotion", "ForceSet", "WorldForceSet", "WorldLayout", "to_world", "physical_twists", "free_directions"]
+__all__ = ["RawMotion", "ForceSet", "DeferredForces", "WorldForceSet", "WorldLayout", "to_world", "physical_twists", "free_directions"]
 
 Bounds = tuple[float | None, float | None]
 
@@ -30,6 +30,20 @@ class ForceSet(Protocol):
     def feasible(self, functionals: FloatArray, lower: FloatArray, upper: FloatArray) -> bool:
         """Whether some distribution in the set has ``lower <= functionals . c <= upper``."""
         ...
+
+
+class DeferredForces(Protocol):
+    """What a solver knows of one motion's forces, worked out only when asked (scene-relative, contact frames).
+
+    :meth:`indeterminate` decides whether the contact forces are indeterminate (once); :meth:`normal_ranges`
+    and :meth:`force_set` are read only when they are.
+    """
+
+    def indeterminate(self) -> bool: ...
+
+    def normal_ranges(self) -> tuple[tuple[float, float | None], ...]: ...
+
+    def force_set(self) -> ForceSet: ...
 
 
 @dataclass(frozen=True)
@@ -61,6 +75,9 @@ class RawMotion:
     extremes_share_forces : bool
         The forces ``c`` hold at every extreme too (one contact-mode pattern's motions are its twists times
         its forces), so each extreme is audited with them, as the motion itself is.
+    deferred : DeferredForces or None
+        Instead of the three above: whether the forces are indeterminate, and their ranges and set,
+        all worked out when first read (deciding it costs more than the rest of a small 2-D solve).
     """
 
     q: FloatArray
@@ -72,6 +89,7 @@ class RawMotion:
     lazy_ranges: Callable[[], tuple[tuple[float, float | None], ...]] | None = field(default=None, repr=False, compare=False)
     force_set: ForceSet | None = field(default=None, repr=False, compare=False)
     extremes_share_forces: bool = False
+    deferred: DeferredForces | None = field(default=None, repr=False, compare=False)
 
     @property
     def continuum(self) -> bool:
@@ -79,6 +97,9 @@ class RawMotion:
 
     @property
     def forces_indeterminate(self) -> bool:
+        """Whether the forces are indeterminate (with ``deferred``, decided now)."""
+        if self.deferred is not None:
+            return self.deferred.indeterminate()
         return self.force_ranges is not None or self.lazy_ranges is not None
 
 

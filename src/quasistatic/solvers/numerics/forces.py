@@ -38,6 +38,7 @@ __all__ = [
     "ConsistentForces",
     "FrictionlessForces",
     "IndeterminateForces",
+    "DeferredIndeterminacy",
     "forces_at_twist",
     "indeterminate_forces",
     "measured_forces_at_twist",
@@ -201,6 +202,34 @@ class IndeterminateForces:
     known: tuple[Range, ...] | None
     lazy: Callable[[], tuple[Range, ...]] | None
     force_set: ForceSet
+
+
+class DeferredIndeterminacy:
+    """:func:`indeterminate_forces` at twist ``q``, decided when first asked, once (a
+    :class:`~quasistatic.laws.DeferredForces`): a simulation step or a sweep that never reads whether the
+    forces are indeterminate does not pay for deciding it (0.3-2 ms on a 2-D grasp, more than the rest of its solve)."""
+
+    def __init__(self, problem: Problem, edges: np.ndarray, q: np.ndarray) -> None:
+        self.problem, self.edges, self.q = problem, edges, q
+
+    @cached_property
+    def found(self) -> IndeterminateForces | None:
+        return indeterminate_forces(self.problem, self.edges, self.q)
+
+    def indeterminate(self) -> bool:
+        return self.found is not None
+
+    def normal_ranges(self) -> tuple[Range, ...]:
+        found = self._found()
+        return found.known if found.known is not None else found.lazy()  # type: ignore[misc]  # one of the two is set
+
+    def force_set(self) -> ForceSet:
+        return self._found().force_set
+
+    def _found(self) -> IndeterminateForces:
+        if self.found is None:
+            raise ValueError("the contact forces are unique: they have no ranges and no set to read")
+        return self.found
 
 
 def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> IndeterminateForces | None:

@@ -1,0 +1,108 @@
+"""Whether a solved motion's forces are indeterminate is decided when first read, and equals the eager decision.
+
+A certified 2-D solve no longer decides ``forces_indeterminate`` (a rank test, often an LP) unless something
+reads it: the flag, the message's claim, the JSON, the table, the ranges. These tests pin that a default
+solve leaves it undecided, that every way of reading it gives what the eager decision
+(:func:`~quasistatic.solvers.numerics.forces.indeterminate_forces` on the same twist) gives, on the bench
+grasps and on scenes whose forces are indeterminate, and that pickling works it out first.
+"""
+
+from __future__ import annotations
+
+import pickle
+
+import numpy as np
+import pytest
+
+import quasistatic as qs
+from quasistatic.laws.polyhedral import aligned_edges
+from quasistatic.sim import Inputs, SimModel, State, StepOptions, evaluate
+from quasistatic.solution import Later, LaterField
+from quasistatic.solvers.numerics.forces import indeterminate_forces
+from quasistatic.tools.bench.families import grasp_2d
+from quasistatic.tools.bench.simulation import planar_two_finger_push
+
+
+def _decided(solution: qs.Solution) -> bool:
+    field = type(solution).__dict__["forces_indeterminate"]
+    assert isinstance(field, LaterField)
+    return field.decided(solution)
+
+
+def _eager(problem: qs.Problem, twist: np.ndarray) -> bool:
+    return indeterminate_forces(problem, aligned_edges(problem, problem.friction.edges), twist) is not None
+
+
+def _scaled_twist(problem: qs.Problem, motion: qs.Motion) -> np.ndarray:
+    units = np.tile(problem.scales.twist_units(problem.dimension), len(problem.scene.bodies))
+    return np.concatenate([motion.twists[b.name] for b in problem.scene.bodies]) / units
+
+
+def _pushed_box(heights: tuple[float, ...], pull: float = 0.0) -> qs.Scene:
+    """A 2-D box on two table corners (mu 0.5) pushed in +x by frictionless fingers at ``heights`` (none: at rest)."""
+    box = qs.Body("box", mass=1.0, com=[0.0, 0.05])
+    movers = [qs.Mover("table")] + [qs.Mover(f"finger{k}", twist=[0.01, 0.0, 0.0]) for k in range(len(heights))]
+    contacts = [qs.Contact("box", "table", point=[x, 0.0], normal=[0.0, 1.0], mu=0.5) for x in (-0.05, 0.05)]
+    contacts += [qs.Contact("box", f"finger{k}", point=[-0.05, h], normal=[1.0, 0.0]) for k, h in enumerate(heights)]
+    return qs.Scene(bodies=[box], movers=movers, contacts=contacts, dimension=2, gravity=[pull, -9.81])
+
+
+SCENES = [grasp_2d(m, i) for m in (2, 4, 6, 8) for i in range(6)] + [
+    _pushed_box((0.03, 0.07)),  # sliding, two fingers: indeterminate
+    _pushed_box((0.05,)),  # sliding, one finger at the com's height: unique
+    _pushed_box((), pull=1.0),  # at rest, a pull shared by two supports: indeterminate friction
+]
+
+
+@pytest.mark.parametrize("scene", SCENES)
+def test_the_deferred_decision_equals_the_eager_one(scene: qs.Scene) -> None:
+    problem = qs.assemble(scene)
+    solution = qs.solve(problem)
+    motions = solution.solutions or ((solution.motion,) if solution.motion is not None else ())
+    if solution.status not in ("solved", "ambiguous") or (solution.motion is not None and solution.motion.continuum):
+        assert not solution.forces_indeterminate
+        return
+    assert not _decided(solution)  # nothing read it yet
+    eager = _eager(problem, _scaled_twist(problem, motions[0]))
+    assert solution.forces_indeterminate == eager
+    assert solution.to_dict()["forces_indeterminate"] == eager
+    if solution.status == "solved":
+        claim = "; the contact forces are indeterminate" if eager else " with unique contact forces"
+        assert solution.message.endswith(claim)
+        assert qs.solve(problem).message == solution.message  # the message alone decides it the same way
+    for motion in motions:
+        if not motion.continuum:
+            assert motion.forces_indeterminate == _eager(problem, _scaled_twist(problem, motion))
+            assert any(c.normal_force_range is not None for c in motion.contacts) == motion.forces_indeterminate
+
+
+def test_indeterminate_scenes_are_among_the_checked_ones() -> None:
+    """The scenes above hold both answers, so the equality is not checked on one side only."""
+    flags = {qs.solve(scene).forces_indeterminate for scene in SCENES[-3:]}
+    assert flags == {True, False}
+
+
+def test_a_pickled_solution_carries_the_decided_values() -> None:
+    solution = qs.solve(_pushed_box((0.03, 0.07)))
+    assert not _decided(solution)
+    back = pickle.loads(pickle.dumps(solution))
+    assert _decided(back) and back.forces_indeterminate and back.message == solution.message
+    assert [c.normal_force_range for c in back.contacts] == [c.normal_force_range for c in solution.contacts]
+
+
+def test_a_simulation_step_does_not_decide_it() -> None:
+    """A planar push step reads the motion, its modes and forces, never whether the forces are indeterminate."""
+    world = planar_two_finger_push()
+    model = SimModel(world, StepOptions(0.05))
+    evaluation = evaluate(model, State.of(world), Inputs())
+    assert evaluation.solution.status == "solved"
+    evaluation.contact_records()
+    assert not _decided(evaluation.solution)
+    assert isinstance(evaluation.solution.forces_indeterminate, bool)
+
+
+def test_later_works_its_value_out_once() -> None:
+    calls: list[int] = []
+    later = Later(lambda: calls.append(1) or len(calls))
+    assert not later.decided
+    assert later.value() == 1 and later.value() == 1 and calls == [1] and later.decided
