@@ -19,6 +19,7 @@ from quasistatic.laws.polyhedral import aligned_edges
 from quasistatic.sim import Inputs, SimModel, State, StepOptions, evaluate
 from quasistatic.solution import Later, LaterField
 from quasistatic.solvers.numerics.forces import indeterminate_forces
+from quasistatic.tolerances import LP_FEASIBILITY
 from quasistatic.tools.bench.families import grasp_2d
 from quasistatic.tools.bench.simulation import planar_two_finger_push
 
@@ -106,3 +107,36 @@ def test_later_works_its_value_out_once() -> None:
     later = Later(lambda: calls.append(1) or len(calls))
     assert not later.decided
     assert later.value() == 1 and later.value() == 1 and calls == [1] and later.decided
+
+
+def _tipping_box(height: float, mu: float) -> qs.Scene:
+    """The sweep bench's box (0.2 m wide, 2 kg) pushed at ``height`` by a frictionless pusher; mu on the floor."""
+    box = qs.Body("box", mass=2.0, com=[0.0, 0.2])
+    contacts = [qs.Contact("box", "floor", point=[x, 0.0], normal=[0.0, 1.0], mu=mu) for x in (-0.1, 0.1)]
+    contacts.append(qs.Contact("box", "pusher", point=[-0.1, height], normal=[1.0, 0.0]))
+    movers = [qs.Mover("floor"), qs.Mover("pusher", twist=[0.01, 0.0, 0.0])]
+    return qs.Scene(bodies=[box], movers=movers, contacts=contacts, dimension=2)
+
+
+@pytest.mark.parametrize(("height", "mu"), [(0.236, 0.5), (0.38, 1.0), (0.164, 1.0)])
+def test_a_lifted_corner_is_decided_by_the_rank_test(monkeypatch: pytest.MonkeyPatch, height: float, mu: float) -> None:
+    """A tipping box lifts one corner: that contact's friction edges and slack are held at zero with its normal force,
+    so the dense rank test proves the forces unique, as every component's LP range says, without building the set."""
+    from quasistatic.solvers.numerics import forces as forces_module
+
+    problem = qs.assemble(_tipping_box(height, mu))
+    solution = qs.solve(problem)
+    assert solution.modes[0] == "separating" and solution.status == "solved"
+    edges = aligned_edges(problem, problem.friction.edges)
+    q = _scaled_twist(problem, solution.motion)
+    masks = forces_module.measured_masks(problem, edges, q)
+    every = forces_module.forces_at_twist(problem, edges, q, masks)
+    units = np.eye(problem.n_contacts * 2).reshape(-1, problem.n_contacts, 2)
+    assert all(hi is not None and hi - lo <= LP_FEASIBILITY for lo, hi in every.ranges(units))  # the LPs: unique
+
+    def built(*args: object) -> None:
+        raise AssertionError("the force set was built")
+
+    monkeypatch.setattr(forces_module, "forces_at_twist", built)
+    assert indeterminate_forces(problem, edges, q) is None
+    assert not solution.forces_indeterminate and solution.message.endswith(" with unique contact forces")

@@ -173,8 +173,11 @@ def _held_columns(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: Mod
     best = drive.max(axis=1, initial=0.0)  # no edges (frictionless): nothing dissipates
     weaker = drive < best[:, None] - _MOVING
     normal = ~masks.closed
-    beta = (weaker & masks.sliding[:, None]).ravel() | np.repeat(problem.mu <= 0, K)
-    return np.concatenate([normal, beta, masks.sliding])  # the polytope's column order: normal, beta, slack
+    # An open contact's edge forces and slack are zero too: ``mu cn = sum beta + slack`` with cn held at 0 and all
+    # of them >= 0. Holding them says so as equations, which the rank tests read (a tipping box's lifted corner
+    # otherwise sent every decision to the LPs: 1.4 ms instead of 0.3 ms).
+    beta = (weaker & masks.sliding[:, None]).ravel() | np.repeat((problem.mu <= 0) | normal, K)
+    return np.concatenate([normal, beta, masks.sliding | normal])  # the polytope's column order: normal, beta, slack
 
 
 def measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeMasks:
