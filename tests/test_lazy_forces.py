@@ -140,3 +140,19 @@ def test_a_lifted_corner_is_decided_by_the_rank_test(monkeypatch: pytest.MonkeyP
     monkeypatch.setattr(forces_module, "forces_at_twist", built)
     assert indeterminate_forces(problem, edges, q) is None
     assert not solution.forces_indeterminate and solution.message.endswith(" with unique contact forces")
+
+
+def test_a_3d_rest_proven_on_the_exact_cones_defers_its_force_claim_too() -> None:
+    """A box at rest on a table (3-D, exact cones): the message ends with the exact-cone proof, after the force claim
+    worked out when read; the claim and the flag are the eager decision's on the 16-edge pyramid of the ranges."""
+    pytest.importorskip("coal")  # the world's contacts are found by the robots extra
+    from quasistatic.solvers.certify.exact_cone import RANGE_EDGES
+
+    body = qs.SolidBody("box", mass=1.0, shape=qs.Box([0.1, 0.1, 0.1]), pose=qs.Pose([0.0, 0.0, 0.05]))
+    world = qs.World(bodies=(body,), movers=(qs.ShapedMover("table", qs.Halfspace([0, 0, 1], 0.0)),), detection=qs.ContactDetection(mu=0.5))
+    problem = qs.assemble(world.scene())
+    solution = qs.solve(problem)
+    assert solution.status == "solved" and not _decided(solution)
+    eager = indeterminate_forces(problem, aligned_edges(problem, RANGE_EDGES), np.zeros(problem.n_dof)) is not None
+    assert eager and solution.forces_indeterminate
+    assert "solved: one motion; the contact forces are indeterminate; unique for the exact cones: " in solution.message

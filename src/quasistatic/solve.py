@@ -340,7 +340,7 @@ def _audited(
     indeterminate: bool | Later[bool] = False
     if result.motions and result.status != "failed":  # decided when read (often never: a simulation step, a batch)
         indeterminate = Later(partial(_first_indeterminate, result))
-    message: str | Later[str] = Later(result.full_message) if result.claims_forces else result.message
+    message: str | Later[str] = Later(result.full_message) if result.claims_forces else result.full_message()
     solution = Solution(
         result.status,
         message,

@@ -97,7 +97,10 @@ class BackendResult:
         Solver-specific remarks for people (pivots, stages); no logic may depend on them.
     claims_forces : bool
         The message goes on with what is known of the first motion's forces (:func:`force_claim`),
-        decided only when it is read (:meth:`full_message`; ``solve`` defers it to ``Solution.message``).
+        decided only when it is read (:meth:`full_message`; ``solve`` defers it to ``Solution.message``),
+        then with ``after_claim``.
+    after_claim : str
+        What the message says after that claim (the exact-cone proof of a refined motion).
     """
 
     status: Status
@@ -109,6 +112,7 @@ class BackendResult:
     search_complete: bool | None = None
     notes: tuple[tuple[str, Any], ...] = ()
     claims_forces: bool = False
+    after_claim: str = ""
 
     def with_notes(self, **notes: Any) -> BackendResult:
         """The same result with more notes."""
@@ -117,8 +121,8 @@ class BackendResult:
     def full_message(self) -> str:
         """The message with its claim about the forces, decided now when :attr:`claims_forces`."""
         if not self.claims_forces:
-            return self.message
-        return self.message + force_claim(bool(self.motions) and self.motions[0].forces_indeterminate)
+            return self.message + self.after_claim
+        return self.message + force_claim(bool(self.motions) and self.motions[0].forces_indeterminate) + self.after_claim
 
 
 def force_claim(indeterminate: bool) -> str:
