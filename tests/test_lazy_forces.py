@@ -139,6 +139,7 @@ def test_a_lifted_corner_is_decided_by_the_rank_test(monkeypatch: pytest.MonkeyP
 
     monkeypatch.setattr(forces_module, "forces_at_twist", built)
     assert indeterminate_forces(problem, edges, q) is None
+    assert forces_module._forces_fixed(problem, edges, q, masks, forces_module._component_rows(edges))  # the polytope's test too
     assert not solution.forces_indeterminate and solution.message.endswith(" with unique contact forces")
 
 
