@@ -18,7 +18,7 @@ from quasistatic.laws.polyhedral import aligned_edges, polyhedral_form
 from quasistatic.solvers import BACKENDS, Options
 from quasistatic.solvers.certify.cheap import kinematic_radius, seed_point
 from quasistatic.solvers.certify.search import enumerate_motions
-from quasistatic.solvers.numerics.forces import ForcesAtTwist, forces_at_twist, indeterminate_forces, measured_masks
+from quasistatic.solvers.numerics.forces import DeferredIndeterminacy, ForcesAtTwist, forces_at_twist, indeterminate_forces, measured_masks
 from quasistatic.solvers.numerics.highs import solve_lp
 from quasistatic.solvers.numerics.ranges import value_ranges
 from quasistatic.tolerances import LP_FEASIBILITY
@@ -211,12 +211,16 @@ def test_sliding_2d_contacts_decide_indeterminacy_as_the_ranges_do(heights: tupl
 
 
 def test_indeterminate_frictional_forces_are_reported_without_running_their_ranges() -> None:
-    """The 8-finger grasps are proven unique by kinematics with indeterminate forces: the ranges wait until read."""
+    """The 8-finger grasps are proven unique by kinematics with indeterminate forces: the decision and the ranges
+    wait until read, and reading the decision runs no range."""
     for instance in range(3):
         problem = qs.assemble(grasp_2d(8, instance))
         raw = BACKENDS["certified"].solver(problem, Options())
+        deferred = raw.motions[0].deferred
+        assert isinstance(deferred, DeferredIndeterminacy) and "found" not in deferred.__dict__  # not decided yet
         assert raw.status == "solved" and raw.motions[0].forces_indeterminate
-        assert raw.motions[0].force_ranges is None and raw.motions[0].lazy_ranges is not None
+        found = deferred.found
+        assert found is not None and found.known is None and found.lazy is not None
         solution = qs.solve(problem)
         assert solution.forces_indeterminate
         widths = [

@@ -6,10 +6,10 @@ Plain value types; this module imports nothing else of the package.
 from __future__ import annotations
 
 import enum
-from collections.abc import Collection
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, Literal, Protocol
+from typing import Any, Generic, Literal, Protocol, TypeVar, overload
 
 import numpy as np
 
@@ -34,12 +34,91 @@ __all__ = [
     "UnprovenExtreme",
     "Motion",
     "Solution",
+    "Later",
+    "LaterField",
 ]
 
 Status = Literal["solved", "ambiguous", "jammed", "unstable", "failed"]
 Mode = Literal["rolling", "sliding", "separating"]
 Bounds = tuple[float | None, float | None]
 """``(lo, hi)`` of a quantity over every consistent force distribution; None where it is unbounded."""
+
+T = TypeVar("T")
+
+
+class Later(Generic[T]):
+    """A value worked out when first read, then kept.
+
+    Whether a solved motion's contact forces are indeterminate costs more than the rest of a small
+    certified solve (a rank test, often an LP); a simulation step or a sweep that never reads it does
+    not pay. The value is the one an eager solve would have given: the same function, only called later.
+    Pickled (a batch's worker, a saved answer), it is worked out first and travels as its value.
+    """
+
+    __slots__ = ("_work", "_value")
+
+    def __init__(self, work: Callable[[], T]) -> None:
+        self._work: Callable[[], T] | None = work
+        self._value: T | None = None
+
+    @classmethod
+    def known(cls, value: T) -> Later[T]:
+        """A Later that already holds its value."""
+        later = cls(_nothing)
+        later._work, later._value = None, value
+        return later
+
+    @property
+    def decided(self) -> bool:
+        """Whether the value has been worked out (reading :meth:`value` does it)."""
+        return self._work is None
+
+    def value(self) -> T:
+        if self._work is not None:
+            self._value = self._work()
+            self._work = None  # drop the solver's data it held
+        return self._value  # type: ignore[return-value]  # set just above
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (Later.known, (self.value(),))
+
+
+def _nothing() -> Any:
+    return None
+
+
+class LaterField(Generic[T]):
+    """A frozen dataclass field that holds its value, or a :class:`Later` of it: reading it gives the value.
+
+    ``Solution(..., forces_indeterminate=Later(decide))`` decides only when ``solution.forces_indeterminate``
+    (or anything that shows it: the message, the JSON, the table, ``==``) is read.
+    """
+
+    def __init__(self, default: T | None = None, *, required: bool = False) -> None:
+        self.default, self.required, self.name = default, required, ""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    @overload
+    def __get__(self, obj: None, owner: type | None = None) -> T: ...
+    @overload
+    def __get__(self, obj: object, owner: type | None = None) -> T: ...
+    def __get__(self, obj: object | None, owner: type | None = None) -> T:
+        if obj is None:  # the class's own attribute: what dataclass reads as the field's default
+            if self.required:
+                raise AttributeError(self.name)
+            return self.default  # type: ignore[return-value]  # a default is given unless required
+        value = obj.__dict__[self.name]
+        return value.value() if isinstance(value, Later) else value  # type: ignore[no-any-return]
+
+    def __set__(self, obj: object, value: T | Later[T]) -> None:
+        obj.__dict__[self.name] = value  # frozen dataclasses set their fields through object.__setattr__, here
+
+    def decided(self, obj: object) -> bool:
+        """Whether ``obj``'s value is known without working anything out."""
+        value = obj.__dict__[self.name]
+        return not isinstance(value, Later) or value.decided
 
 
 class Diagnosis(enum.Enum):
@@ -625,7 +704,8 @@ class Solution:
     ----------
     status : {"solved", "ambiguous", "jammed", "unstable", "failed"}
     message : str
-        One sentence a person can act on.
+        One sentence a person can act on (a solved motion's claim about its forces is
+        worked out when the message is first read).
     method : str
         The solver backend that produced the answer.
     friction : str
@@ -638,7 +718,8 @@ class Solution:
     forces_indeterminate : bool
         The reported motion is determined but its contact forces are not; each
         contact then carries ``normal_force_range``. (For ``ambiguous``, each
-        listed motion says the same of itself.)
+        listed motion says the same of itself.) Decided when first read (here, in
+        the message, the JSON or the table): a caller that never reads it does not pay.
     compliant_forces : bool
         The reported forces are the compliant ones: of the forces the rigid motion allows,
         those of least elastic energy of the scene's contact springs and joint stiffness
@@ -673,12 +754,12 @@ class Solution:
     """
 
     status: Status
-    message: str
-    method: str
-    friction: str
+    message: LaterField[str] = LaterField(required=True)  # no default: reading it from the class raises AttributeError
+    method: str  # type: ignore[misc]  # mypy takes any descriptor for a default; the message has none
+    friction: str  # type: ignore[misc]
     motion: Motion | None = None
     solutions: tuple[Motion, ...] = ()
-    forces_indeterminate: bool = False
+    forces_indeterminate: LaterField[bool] = LaterField(False)
     compliant_forces: bool = False
     compliant_step: CompliantStep | None = None
     certified: bool = False

@@ -17,12 +17,12 @@ from functools import partial
 import numpy as np
 
 from .adapters import AnyWorld, Detection, PlanarWorld, World
-from .check import DEFAULT_TOLERANCE, MotionGeometry, audited_motion, audited_step
+from .check import DEFAULT_TOLERANCE, ForceFunctionals, MotionGeometry, audited_motion, audited_step
 from .derivative import SolvedScene
 from .errors import QuasistaticError, SolverError
-from .laws import Problem, RawMotion, WorldForceSet, assemble, free_directions, physical_twists, to_world
+from .laws import DeferredForces, Problem, RawMotion, WorldForceSet, assemble, free_directions, physical_twists, to_world
 from .model import FloatArray, Scene
-from .solution import Attempt, CompliantStep, Mode, Motion, Solution, UnprovenExtreme
+from .solution import Attempt, CompliantStep, Later, Mode, Motion, Solution, UnprovenExtreme
 from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, compliant_forces, compliant_step, get_backend, too_large
 
 Range = tuple[float, float | None]
@@ -194,10 +194,19 @@ def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFA
     geometry = problem.scene.derived("motion_geometry", lambda scene: MotionGeometry(scene, problem.scales))
     T, forces = to_world(problem, raw.q, raw.c)
     ranges: list[Range] | Callable[[], list[Range]] | None = None
-    if raw.force_ranges is not None:
+    force_set: ForceFunctionals | Later[ForceFunctionals | None] | None = None
+    indeterminate: Later[bool] | None = None
+    if raw.deferred is not None:  # decided when read: the ranges and the set are read only when it is indeterminate
+        deferred = raw.deferred
+        indeterminate = Later(deferred.indeterminate)
+        ranges = partial(_physical_ranges_of, deferred.normal_ranges, scales.force)
+        force_set = Later(partial(_deferred_set, problem, deferred))
+    elif raw.force_ranges is not None:
         ranges = _physical_ranges(raw.force_ranges, scales.force)
     elif raw.lazy_ranges is not None:
         ranges = partial(_physical_ranges_of, raw.lazy_ranges, scales.force)
+    if raw.force_set is not None:
+        force_set = WorldForceSet(problem, raw.force_set)
     extremes, audits, unproven = [], [], []
     for k, extreme in enumerate(raw.extremes):  # an extreme is a motion too: audited as one, with its forces
         twists = physical_twists(problem, extreme)
@@ -225,9 +234,15 @@ def audited_raw_motion(problem: Problem, raw: RawMotion, tolerance: float = DEFA
         continuum=raw.continuum,
         unbounded=raw.unbounded,
         free_directions=free_directions(problem, raw.free_axes),
-        force_set=None if raw.force_set is None else WorldForceSet(problem, raw.force_set),
+        force_set=force_set,
+        indeterminate=indeterminate,
         tolerance=tolerance,
     )
+
+
+def _deferred_set(problem: Problem, deferred: DeferredForces) -> ForceFunctionals | None:
+    """The world force set of a motion whose forces are indeterminate; None when they are unique."""
+    return WorldForceSet(problem, deferred.force_set()) if deferred.indeterminate() else None
 
 
 def _compliant(problem: Problem, solution: Solution, result: BackendResult, tolerance: float, time_limit: float) -> Solution:
@@ -316,6 +331,10 @@ def _compliance_note(solution: Solution, text: str) -> Solution:
     return dataclasses.replace(solution, notes=(*solution.notes, ("compliance", text)))
 
 
+def _first_indeterminate(result: BackendResult) -> bool:
+    return result.motions[0].forces_indeterminate
+
+
 def _physical_ranges(ranges: Sequence[Range], force: float) -> list[Range]:
     return [(lo * force, None if hi is None else hi * force) for lo, hi in ranges]
 
@@ -329,14 +348,18 @@ def _audited(
 ) -> Solution:
     """Turn raw motions into audited ones; a motion that fails its audit is never a success."""
     motions = [audited_raw_motion(problem, raw, tolerance) for raw in result.motions]
+    indeterminate: bool | Later[bool] = False
+    if result.motions and result.status != "failed":  # decided when read (often never: a simulation step, a batch)
+        indeterminate = Later(partial(_first_indeterminate, result))
+    message: str | Later[str] = Later(result.full_message) if result.claims_forces else result.full_message()
     solution = Solution(
         result.status,
-        result.message,
+        message,
         method,
         str(problem.friction),
         motion=motions[0] if motions else None,
         solutions=tuple(motions) if result.status == "ambiguous" else (),
-        forces_indeterminate=bool(result.motions) and result.motions[0].forces_indeterminate and result.status != "failed",
+        forces_indeterminate=indeterminate,
         certified=result.certified and result.status != "failed",
         diagnosis=result.diagnosis,
         certificate=result.certificate,

@@ -16,7 +16,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ..model import Mover, Robot, Scales, Scene
-from ..solution import Bounds, MoverWrench, RobotLoad
+from ..solution import Bounds, Later, MoverWrench, RobotLoad
 from ..tolerances import ROUNDOFF, TORQUE_LIMIT
 
 __all__ = ["ForceFunctionals", "LoadMap", "LoadTable"]
@@ -114,12 +114,20 @@ class LoadTable:
 
     __slots__ = ("scene", "scales", "forces", "force_set", "load_map")
 
-    def __init__(self, scene: Scene, scales: Scales, forces: np.ndarray, force_set: ForceFunctionals | None) -> None:
+    def __init__(
+        self, scene: Scene, scales: Scales, forces: np.ndarray, force_set: ForceFunctionals | Later[ForceFunctionals | None] | None
+    ) -> None:
         self.scene, self.scales, self.forces, self.force_set = scene, scales, forces, force_set
         self.load_map: LoadMap | None = None
 
     def __getstate__(self) -> tuple[Any, ...]:
-        return (self._map(), self.forces, self.force_set)
+        return (self._map(), self.forces, self._set())
+
+    def _set(self) -> ForceFunctionals | None:
+        """The force set; one decided only when read (None: the forces turned out unique) is decided now."""
+        if isinstance(self.force_set, Later):
+            self.force_set = self.force_set.value()
+        return self.force_set
 
     def __setstate__(self, state: tuple[Any, ...]) -> None:
         self.load_map, self.forces, self.force_set = state
@@ -143,7 +151,8 @@ class LoadTable:
         Two LPs per component, when first read: what friction leaves free (a pull shared by two supports)
         shows here and not in the normal forces' ranges.
         """
-        if self.force_set is None:
+        force_set = self._set()
+        if force_set is None:
             return None
         m, d = self.forces.shape
         load_map = self._map()
@@ -152,7 +161,7 @@ class LoadTable:
         for row, (i, axis) in enumerate((i, axis) for i in frictional for axis in range(d)):
             functionals[row, i, axis] = 1.0
         scale = np.full(functionals.shape[0], load_map.force_scale)
-        bounds = _clean_bounds(self.force_set.ranges(functionals), scale) if frictional else ()
+        bounds = _clean_bounds(force_set.ranges(functionals), scale) if frictional else ()
         per_contact: list[tuple[Bounds, ...] | None] = [None] * m
         for k, i in enumerate(frictional):
             per_contact[i] = bounds[k * d : (k + 1) * d]
@@ -160,25 +169,28 @@ class LoadTable:
 
     def _robot(self, robot: _RobotMap) -> RobotLoad:
         torques = _clean(np.einsum("jid,id->j", robot.matrix, self.forces), robot.scale)
-        ranges = None if self.force_set is None else _clean_bounds(self.force_set.ranges(robot.matrix), robot.scale)
+        force_set = self._set()
+        ranges = None if force_set is None else _clean_bounds(force_set.ranges(robot.matrix), robot.scale)
         exceeded = () if robot.limits is None else self._exceeded(robot, robot.limits, torques, ranges)
         return RobotLoad(robot.robot, robot.joints, torques, ranges, robot.limits, exceeded)
 
     def _mover(self, mover: _MoverMap) -> MoverWrench:
         values = _clean(np.einsum("kid,id->k", mover.matrix, self.forces), mover.scale)
-        ranges = None if self.force_set is None else _clean_bounds(self.force_set.ranges(mover.matrix), mover.scale)
+        force_set = self._set()
+        ranges = None if force_set is None else _clean_bounds(force_set.ranges(mover.matrix), mover.scale)
         d = self.forces.shape[1]
         return MoverWrench(mover.mover, mover.origin, values[:d], values[d:], ranges)
 
     def _exceeded(self, robot: _RobotMap, limits: np.ndarray, torques: np.ndarray, ranges: tuple[Bounds, ...] | None) -> tuple[str, ...]:
         """The joints whose limits no consistent force distribution meets (see :attr:`RobotLoad.limits_exceeded`)."""
         allowed = limits + TORQUE_LIMIT * robot.scale
-        if ranges is None or self.force_set is None:
+        force_set = self._set()
+        if ranges is None or force_set is None:
             over = np.abs(torques) > allowed
         else:
             over = np.array([_outside(bounds, limit) for bounds, limit in zip(ranges, allowed.tolist(), strict=True)], dtype=bool)
-            if not over.any() and not self.force_set.feasible(robot.matrix, -allowed, allowed):
-                over[_conflict(self.force_set, robot.matrix, allowed)] = True
+            if not over.any() and not force_set.feasible(robot.matrix, -allowed, allowed):
+                over[_conflict(force_set, robot.matrix, allowed)] = True
         return tuple(name for name, exceeded in zip(robot.joints, over.tolist(), strict=True) if exceeded)
 
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..jit import njit
 from ..model import Scales, Scene
-from ..solution import Audit, ContactResult, Mode, Motion, PowerBalance, UnprovenExtreme
+from ..solution import Audit, ContactResult, Later, Mode, Motion, PowerBalance, UnprovenExtreme
 from ..tolerances import AUDIT, MODE_SPEED, ROUNDOFF
 from .audit import AuditGeometry, audit_arrays
 from .loads import ForceFunctionals, LoadTable
@@ -59,7 +59,8 @@ def audited_motion(
     continuum: bool = False,
     unbounded: bool = False,
     free_directions: tuple[str, ...] = (),
-    force_set: ForceFunctionals | None = None,
+    force_set: ForceFunctionals | Later[ForceFunctionals | None] | None = None,
+    indeterminate: Later[bool] | None = None,
     tolerance: float = AUDIT,
     extreme_audits: tuple[Audit, ...] = (),
     unproven_extremes: tuple[UnprovenExtreme, ...] = (),
@@ -77,10 +78,16 @@ def audited_motion(
         function is called when the contacts' results are first read.
     force_set : ForceFunctionals, optional
         With indeterminate forces: every world force distribution consistent with the motion,
-        for the ranges of robot torques and mover wrenches (:mod:`.loads`).
+        for the ranges of robot torques and mover wrenches (:mod:`.loads`); a Later of it (None
+        when the forces turn out unique) when that is decided only when read.
+    indeterminate : Later of bool, optional
+        Whether the forces are indeterminate, decided when first read; ``ranges`` is then read only
+        when it is. None: they are indeterminate exactly when ``ranges`` is given.
     """
     audit, power, evaluation = audit_arrays(geometry.audit, twists, forces, scales, tolerance)
-    table = ContactTable(geometry.pairs, forces, evaluation.slips, evaluation.normal, geometry.threshold, ranges, geometry.roundoff)
+    table = ContactTable(
+        geometry.pairs, forces, evaluation.slips, evaluation.normal, geometry.threshold, ranges, geometry.roundoff, indeterminate
+    )
     named = dict(zip(geometry.names, _drop_roundoff(np.array(twists, dtype=float), geometry.twist_roundoff), strict=True))
     loads = LoadTable(geometry.scene, scales, forces, force_set)
     power = _clean_power(power, geometry.power_roundoff)
@@ -130,11 +137,13 @@ class ContactTable:
     ranges : physical normal-force ranges, a function that works them out (called once, when first
         needed), or None when the forces are unique
     roundoff : per-column magnitudes below which forces, slips and the normal columns are reported as 0
+    indeterminate : whether the forces are indeterminate, decided when first read (``ranges`` is read only
+        when they are); None: exactly when ``ranges`` is not None
 
     The arrays are kept as the audit measured them; round-off is dropped when results are made.
     """
 
-    __slots__ = ("pairs", "forces", "slips", "normal", "threshold", "ranges", "roundoff")
+    __slots__ = ("pairs", "forces", "slips", "normal", "threshold", "ranges", "roundoff", "indeterminate")
 
     def __init__(
         self,
@@ -145,9 +154,11 @@ class ContactTable:
         threshold: float,
         ranges: list[Range] | Callable[[], list[Range]] | None,
         roundoff: tuple[np.ndarray, np.ndarray, np.ndarray],
+        indeterminate: Later[bool] | None = None,
     ) -> None:
         self.pairs, self.forces, self.slips, self.normal = pairs, forces, slips, normal
         self.threshold, self.ranges, self.roundoff = threshold, ranges, roundoff
+        self.indeterminate = indeterminate
 
     def __getstate__(self) -> tuple[object, ...]:
         # Floats in lists: pickling a few small arrays costs more than the numbers in them.
@@ -163,15 +174,20 @@ class ContactTable:
 
     def __setstate__(self, state: tuple[Any, ...]) -> None:
         self.pairs, self.threshold, self.ranges = state[:3]
+        self.indeterminate = None  # decided when pickled: the ranges say it
         force, speed, normal = (np.array(r, dtype=float) for r in state[3])
         self.roundoff = (force, speed, normal)
         self.forces, self.slips, self.normal = (np.array(values, dtype=float).reshape(shape) for shape, values in state[4:])
 
     def forces_indeterminate(self) -> bool:
+        if self.indeterminate is not None:
+            return self.indeterminate.value()
         return self.ranges is not None
 
     def range_list(self) -> list[Range] | None:
-        """The normal-force ranges, worked out now if they were deferred."""
+        """The normal-force ranges, worked out now if they were deferred; None when the forces are unique."""
+        if not self.forces_indeterminate():
+            return None
         if callable(self.ranges):
             self.ranges = self.ranges()
         return self.ranges

@@ -6,9 +6,10 @@ type aliases) only. Every solver builds on these; the audit never does.
 
 from .assemble import Problem, assemble
 from .modes import ModeMasks, contact_modes, slips
-from .motion import ForceSet, RawMotion, WorldForceSet, free_directions, physical_twists, to_world
+from .motion import DeferredForces, ForceSet, RawMotion, WorldForceSet, free_directions, physical_twists, to_world
 
 __all__ = [
+    "DeferredForces",
     "ForceSet",
     "ModeMasks",
     "Problem",

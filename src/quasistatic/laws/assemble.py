@@ -145,13 +145,17 @@ def _twist_rows(frames: FloatArray, arms: FloatArray) -> FloatArray:
 
     A row ``f`` of a frame measures ``f . (v + omega x r) = f . v + omega . (r x f)``.
     """
-    if frames.shape[-1] == 2:
-        spin = arms[:, None, 0] * frames[:, :, 1] - arms[:, None, 1] * frames[:, :, 0]
-        return np.concatenate([frames, spin[:, :, None]], axis=2)
-    return np.concatenate([frames, cross(arms[:, None, :], frames)], axis=2)
+    m, d = frames.shape[:2]
+    rows = np.empty((m, d, 3 if d == 2 else 6))  # filled in place: a concatenation costs more on small scenes
+    rows[:, :, :d] = frames
+    if d == 2:
+        rows[:, :, 2] = arms[:, None, 0] * frames[:, :, 1] - arms[:, None, 1] * frames[:, :, 0]
+    else:
+        rows[:, :, 3:] = cross(arms[:, None, :], frames)
+    return rows
 
 
 def _add_blocks(J: FloatArray, rows: np.ndarray, bodies: np.ndarray, blocks: FloatArray, k: int) -> None:
-    """``J[row, :, body block] += block`` for each contact."""
-    for row, body, block in zip(rows, bodies, blocks, strict=True):
-        J[row, :, body * k : (body + 1) * k] += block
+    """``J[row, :, body block] += block`` for each contact (each row once per call)."""
+    by_body = J.reshape(J.shape[0], J.shape[1], J.shape[2] // k, k)  # a view: (m, d, bodies, k)
+    by_body[rows, :, bodies, :] += blocks

@@ -12,7 +12,7 @@ from ..jit import HAVE_NUMBA, njit
 from ..model import FloatArray
 from .assemble import Problem
 
-__all__ = ["RawMotion", "ForceSet", "WorldForceSet", "WorldLayout", "to_world", "physical_twists", "free_directions"]
+__all__ = ["RawMotion", "ForceSet", "DeferredForces", "WorldForceSet", "WorldLayout", "to_world", "physical_twists", "free_directions"]
 
 Bounds = tuple[float | None, float | None]
 
@@ -30,6 +30,20 @@ class ForceSet(Protocol):
     def feasible(self, functionals: FloatArray, lower: FloatArray, upper: FloatArray) -> bool:
         """Whether some distribution in the set has ``lower <= functionals . c <= upper``."""
         ...
+
+
+class DeferredForces(Protocol):
+    """What a solver knows of one motion's forces, worked out only when asked (scene-relative, contact frames).
+
+    :meth:`indeterminate` decides whether the contact forces are indeterminate (once); :meth:`normal_ranges`
+    and :meth:`force_set` are read only when they are.
+    """
+
+    def indeterminate(self) -> bool: ...
+
+    def normal_ranges(self) -> tuple[tuple[float, float | None], ...]: ...
+
+    def force_set(self) -> ForceSet: ...
 
 
 @dataclass(frozen=True)
@@ -64,6 +78,9 @@ class RawMotion:
     extreme_forces : tuple of (m, d) arrays
         Otherwise: forces the backend found at each extreme (contact frames), in the order of ``extremes``; each
         extreme is audited with its own. An extreme without forces (this empty) cannot be audited: not listed.
+    deferred : DeferredForces or None
+        Instead of ``force_ranges``, ``lazy_ranges`` and ``force_set``: whether the forces are indeterminate, and their ranges and set,
+        all worked out when first read (deciding it costs more than the rest of a small 2-D solve).
     """
 
     q: FloatArray
@@ -76,6 +93,7 @@ class RawMotion:
     force_set: ForceSet | None = field(default=None, repr=False, compare=False)
     extremes_share_forces: bool = False
     extreme_forces: tuple[FloatArray, ...] = ()
+    deferred: DeferredForces | None = field(default=None, repr=False, compare=False)
 
     @property
     def continuum(self) -> bool:
@@ -83,6 +101,9 @@ class RawMotion:
 
     @property
     def forces_indeterminate(self) -> bool:
+        """Whether the forces are indeterminate (with ``deferred``, decided now)."""
+        if self.deferred is not None:
+            return self.deferred.indeterminate()
         return self.force_ranges is not None or self.lazy_ranges is not None
 
 

@@ -11,7 +11,7 @@ from typing import Any
 from ..laws import RawMotion
 from ..solution import Certificate, Diagnosis, Mode, Status
 
-__all__ = ["Options", "BackendResult", "Range", "SearchProgress"]
+__all__ = ["Options", "BackendResult", "Range", "SearchProgress", "force_claim"]
 
 Range = tuple[float, float | None]
 """A value's range ``(lo, hi)``; ``hi`` None when unbounded."""
@@ -95,6 +95,12 @@ class BackendResult:
         For a search over motions: whether the list is complete.
     notes : tuple of (name, value) pairs
         Solver-specific remarks for people (pivots, stages); no logic may depend on them.
+    claims_forces : bool
+        The message goes on with what is known of the first motion's forces (:func:`force_claim`),
+        decided only when it is read (:meth:`full_message`; ``solve`` defers it to ``Solution.message``),
+        then with ``after_claim``.
+    after_claim : str
+        What the message says after that claim (the exact-cone proof of a refined motion).
     """
 
     status: Status
@@ -105,7 +111,21 @@ class BackendResult:
     certificate: Certificate | None = None
     search_complete: bool | None = None
     notes: tuple[tuple[str, Any], ...] = ()
+    claims_forces: bool = False
+    after_claim: str = ""
 
     def with_notes(self, **notes: Any) -> BackendResult:
         """The same result with more notes."""
         return dataclasses.replace(self, notes=tuple({**dict(self.notes), **notes}.items()))
+
+    def full_message(self) -> str:
+        """The message with its claim about the forces, decided now when :attr:`claims_forces`."""
+        if not self.claims_forces:
+            return self.message + self.after_claim
+        return self.message + force_claim(bool(self.motions) and self.motions[0].forces_indeterminate) + self.after_claim
+
+
+def force_claim(indeterminate: bool) -> str:
+    """What a solved motion's message says of its forces: every component of every contact force, friction
+    included, is unique, or not."""
+    return "; the contact forces are indeterminate" if indeterminate else " with unique contact forces"

@@ -206,7 +206,7 @@ def unique_exact_motion(problem: Problem, motion: RawMotion, options: Options, p
     """``solved``, certified, for a motion of the exact laws that ``proof`` shows is the only one (force ranges as usual)."""
     range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motion.q)))
     result = summarise(range_form, [motion], True, options)
-    return dataclasses.replace(result, message=f"{result.message}; unique for the exact cones: {proof}").with_notes(exact_cone=proof)
+    return dataclasses.replace(result, after_claim=f"; unique for the exact cones: {proof}").with_notes(exact_cone=proof)
 
 
 def _unique_for_the_pyramid(result: BackendResult) -> BackendResult:
@@ -219,7 +219,7 @@ def _unique_for_the_pyramid(result: BackendResult) -> BackendResult:
         f"solved: one motion found; it is the only one of the {SEARCH_EDGES}-edge pyramid, but for the exact cones "
         "its uniqueness is not proven (use friction 'pyramid:K' for a certified answer on a pyramid)"
     )
-    return dataclasses.replace(result, message=message, certified=False, search_complete=False)
+    return dataclasses.replace(result, message=message, certified=False, search_complete=False, claims_forces=False, after_claim="")
 
 
 def _free_motions_with_modes(problem: Problem, options: Options) -> BackendResult:

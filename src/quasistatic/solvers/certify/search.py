@@ -23,7 +23,7 @@ from ...laws import Problem, RawMotion, contact_modes
 from ...laws.polyhedral import LCPForm, polyhedral_form
 from ...solution import Diagnosis
 from ...tolerances import DISTINCT_TWIST, MODE_SPEED, SAME_TWIST
-from ..numerics.forces import indeterminate_forces
+from ..numerics.forces import DeferredIndeterminacy
 from ..numerics.highs import solve_lp
 from ..numerics.ranges import polyhedron_extremes
 from ..numerics.scip_model import exclude_box, linear, new_model, optimize
@@ -58,8 +58,7 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
         return BackendResult("failed", message, tuple(motions), certified=False, search_complete=False)
     motions = [_with_force_ranges(form, motion) for motion in motions]
     if len(motions) == 1 and not motions[0].continuum:
-        message = "solved: one motion" + _force_claim(form.problem, motions[0].forces_indeterminate)
-        return BackendResult("solved", message, tuple(motions), search_complete=True)
+        return BackendResult("solved", "solved: one motion", tuple(motions), search_complete=True, claims_forces=True)
     kinds = "a continuum of motions" if len(motions) == 1 else f"{len(motions)} distinct motions"
     more = "" if complete else " (the list may be incomplete)"
     return BackendResult(
@@ -70,23 +69,16 @@ def summarise(form: LCPForm, motions: list[RawMotion], complete: bool, options: 
     )
 
 
-def _force_claim(problem: Problem, indeterminate: bool) -> str:
-    """What is known of a solved motion's forces: every component of every contact force, friction included,
-    is unique or not (:func:`~..numerics.forces.indeterminate_forces`)."""
-    return "; the contact forces are indeterminate" if indeterminate else " with unique contact forces"
-
-
 def _with_force_ranges(form: LCPForm, motion: RawMotion) -> RawMotion:
-    """A single motion with its normal-force ranges when its forces are indeterminate (a continuum's forces vary along it).
+    """A single motion with whether its forces are indeterminate, and their ranges, all decided when first read
+    (:func:`~..numerics.forces.indeterminate_forces`; a continuum's forces vary along it, and it has no ranges).
 
-    The ranges are usually left to be worked out when read (:func:`~..numerics.forces.indeterminate_forces`).
+    What is known of a solved motion's forces: every component of every contact force, friction included,
+    is unique or not; the message says so (``BackendResult.claims_forces``) when it is read.
     """
     if motion.continuum:
         return motion
-    found = indeterminate_forces(form.problem, form.edges, motion.q)
-    if found is None:
-        return motion
-    return dataclasses.replace(motion, force_ranges=found.known, lazy_ranges=found.lazy, force_set=found.force_set)
+    return dataclasses.replace(motion, deferred=DeferredIndeterminacy(form.problem, form.edges, motion.q))
 
 
 @dataclass

@@ -38,6 +38,7 @@ __all__ = [
     "ConsistentForces",
     "FrictionlessForces",
     "IndeterminateForces",
+    "DeferredIndeterminacy",
     "forces_at_twist",
     "indeterminate_forces",
     "measured_forces_at_twist",
@@ -172,8 +173,11 @@ def _held_columns(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: Mod
     best = drive.max(axis=1, initial=0.0)  # no edges (frictionless): nothing dissipates
     weaker = drive < best[:, None] - _MOVING
     normal = ~masks.closed
-    beta = (weaker & masks.sliding[:, None]).ravel() | np.repeat(problem.mu <= 0, K)
-    return np.concatenate([normal, beta, masks.sliding])  # the polytope's column order: normal, beta, slack
+    # An open contact's edge forces and slack are zero too: ``mu cn = sum beta + slack`` with cn held at 0 and all
+    # of them >= 0. Holding them says so as equations, which the rank tests read (a tipping box's lifted corner
+    # otherwise sent every decision to the LPs: 1.4 ms instead of 0.3 ms).
+    beta = (weaker & masks.sliding[:, None]).ravel() | np.repeat((problem.mu <= 0) | normal, K)
+    return np.concatenate([normal, beta, masks.sliding | normal])  # the polytope's column order: normal, beta, slack
 
 
 def measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeMasks:
@@ -203,12 +207,42 @@ class IndeterminateForces:
     force_set: ForceSet
 
 
+class DeferredIndeterminacy:
+    """:func:`indeterminate_forces` at twist ``q``, decided when first asked, once (a
+    :class:`~quasistatic.laws.DeferredForces`): a simulation step or a sweep that never reads whether the
+    forces are indeterminate does not pay for deciding it (0.3-2 ms on a 2-D grasp, more than the rest of its solve)."""
+
+    def __init__(self, problem: Problem, edges: np.ndarray, q: np.ndarray) -> None:
+        self.problem, self.edges, self.q = problem, edges, q
+
+    @cached_property
+    def found(self) -> IndeterminateForces | None:
+        return indeterminate_forces(self.problem, self.edges, self.q)
+
+    def indeterminate(self) -> bool:
+        return self.found is not None
+
+    def normal_ranges(self) -> tuple[Range, ...]:
+        found = self._found()
+        return found.known if found.known is not None else found.lazy()  # type: ignore[misc]  # one of the two is set
+
+    def force_set(self) -> ForceSet:
+        return self._found().force_set
+
+    def _found(self) -> IndeterminateForces:
+        if self.found is None:
+            raise ValueError("the contact forces are unique: they have no ranges and no set to read")
+        return self.found
+
+
 def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> IndeterminateForces | None:
     """The normal-force ranges over every force consistent with twist ``q``; None when the contact forces are unique.
 
     Unique means every component of every contact force, friction included (a box at rest on two supports,
     pulled sideways, has fixed normal forces but a free split of the pull between its supports): no
     component varies by more than ``LP_FEASIBILITY`` over the set (:func:`~.ranges.ranges_are_wide`).
+    In the plane, a wrench map of full column rank on the closed contacts' own force coordinates says None
+    first (:func:`_unique_in_the_plane`).
     A segment of consistent forces through a balanced point found by least squares that moves some
     force component by more than that: indeterminate, without an LP (:func:`_wide_through_balanced_point`),
     and the force set and its ranges are built only when read.
@@ -220,7 +254,10 @@ def indeterminate_forces(problem: Problem, edges: np.ndarray, q: np.ndarray) -> 
     masks = measured_masks(problem, edges, q)
     m, K = edges.shape[:2]
     normal = np.arange(m)  # the polytope's first columns
-    if min(problem.n_dof + m, m * (K + 2)) <= DENSE_MAX and _forces_fixed(problem, edges, q, masks, _component_rows(edges)):
+    if problem.dimension == 2:
+        if _unique_in_the_plane(problem, masks, q):
+            return None  # otherwise the polytope's own rank test would find some component free too: skipped
+    elif min(problem.n_dof + m, m * (K + 2)) <= DENSE_MAX and _forces_fixed(problem, edges, q, masks, _component_rows(edges)):
         return None  # decided densely, before any sparse matrix is built (~0.5 ms on a grasp)
     if _wide_through_balanced_point(problem, masks, K, q):
         later = _LaterForces(problem, edges, q, masks)  # a simulation step never reads them (~1.2 ms on a planar push)
@@ -343,6 +380,25 @@ def _wide_through_balanced_point(problem: Problem, masks: ModeMasks, edge_count:
     return False
 
 
+def _unique_in_the_plane(problem: Problem, masks: ModeMasks, q: np.ndarray) -> bool:
+    """2-D: True when the closed contacts' force coordinates have a wrench map of full column rank, so one force
+    distribution balances the load (the rank test of :func:`_forces_fixed` on a 3 x (at most 2 m) matrix instead
+    of the force polytope's, which also carries each edge and slack: 30 us instead of 300 on a tipping box).
+
+    A rolling frictional contact's force is free in the plane (tangent and normal); a sliding one's lies on one
+    edge of its cone, ``cn (n - mu s)``; a frictionless one's along its normal (:func:`_wrench_columns`). The
+    set of consistent forces lies in ``{c : W c = -g}``: full column rank fixes every component of it exactly.
+    False decides nothing (the other tests run).
+    """
+    if problem.dimension != 2:
+        return False
+    closed = masks.closed
+    sliding = closed & masks.sliding & (problem.mu > 0.0)
+    single = (problem.mu <= 0.0) | sliding
+    wrenches = _wrench_columns(problem, np.flatnonzero(closed), single, _sliding_tilt(problem, q, sliding))
+    return full_column_rank(wrenches, FORCE_RANK)
+
+
 def _inradius(dimension: int, edge_count: int) -> float:
     """Radius of the disc inside the unit friction polygon of ``edge_count`` edges: 2-D, its two edges are the cone;
     3-D, a regular polygon's inscribed circle; no edges (no friction), none."""
@@ -363,7 +419,8 @@ def _sliding_tilt(problem: Problem, q: np.ndarray, sliding: np.ndarray) -> np.nd
 def _wrench_columns(problem: Problem, contacts: np.ndarray, single: np.ndarray, tilt: np.ndarray) -> np.ndarray:
     """The wrench of each force coordinate of ``contacts`` on the bodies (k n, f): tangents and normal for a cone,
     one column for a ``single`` contact (frictionless, or sliding: its normal tilted by its friction ``tilt``)."""
-    columns = [(problem.J[i].T @ np.r_[tilt[i], 1.0])[:, None] if single[i] else problem.J[i].T for i in contacts.tolist()]
+    J = problem.J  # a single contact's column: its normal row plus its tilt times its tangent rows (no np.r_: 5 us each)
+    columns = [(J[i, -1] + tilt[i] @ J[i, :-1])[:, None] if single[i] else J[i].T for i in contacts.tolist()]
     return np.hstack(columns) if columns else np.zeros((problem.n_dof, 0))
 
 
