@@ -39,7 +39,7 @@ def _edges(problem: qs.Problem) -> int:
     return problem.friction.edges if problem.friction.is_polyhedral(3) else exact_cone.SEARCH_EDGES
 
 
-def _agrees_with_scip(scene: qs.Scene) -> PatternVerdict | None:
+def _agrees_with_scip(scene: qs.Scene, scip_seconds: float = SCIP_SECONDS) -> PatternVerdict | None:
     """The branch and bound's verdict on the scene's pyramid, after checking it against SCIP's search (None
     where SCIP did not finish: nothing to compare)."""
     problem = qs.assemble(scene)
@@ -47,7 +47,7 @@ def _agrees_with_scip(scene: qs.Scene) -> PatternVerdict | None:
     proof = prove_by_patterns(form, seed_point(form))
     if proof.verdict is PatternVerdict.UNDECIDED:
         return proof.verdict
-    motions, complete = enumerate_motions(form, Options(time_limit=SCIP_SECONDS).start_clock())
+    motions, complete = enumerate_motions(form, Options(time_limit=scip_seconds).start_clock())
     if not complete:
         return None
     if proof.verdict is PatternVerdict.UNIQUE:
@@ -218,7 +218,7 @@ BENCH_GRASPS = [(4, 0), (4, 1), (6, 0), (8, 0), (8, 1)]  # (6, 1): SCIP's own se
 @pytest.mark.parametrize(("contacts", "instance"), BENCH_GRASPS)
 @pytest.mark.parametrize("friction", ["pyramid:8", "exact"])
 def test_pyramid_proof_never_contradicts_scip_on_benchmark_grasps(contacts: int, instance: int, friction: str) -> None:
-    assert _agrees_with_scip(grasp_3d(contacts, instance, friction=friction)) not in (PatternVerdict.UNDECIDED, None)
+    assert _agrees_with_scip(grasp_3d(contacts, instance, friction=friction), 60.0) not in (PatternVerdict.UNDECIDED, None)
 
 
 PROOFS = (PATTERN_PROOF, ENUMERATION_PROOF, NO_MOTION_PROOF)
