@@ -79,7 +79,9 @@ which is the box the SCIP search excludes around a found motion), and no mode
 assignment holds a continuum. Without a seed, a closed tree proves that no
 motion exists.
 
-**Listing every motion.** A leaf that survives is one full mode assignment,
+**Listing every motion.** (3-D: isolated motions only; a leaf holding a
+continuum gives no answer, as its family's faces are continua of other
+patterns that SCIP's search lists once.) A leaf that survives is one full mode assignment,
 so its motions are exactly ``Q x F`` (no node below it), with ``F`` non-empty
 (its non-negative fit balances the load). Its twist set ``Q`` is measured by
 ``2 n`` LPs (the least and largest of each twist entry): empty (pruned), one
@@ -364,8 +366,10 @@ def prove_by_patterns(
     without one, whether no motion exists; else every motion listed (at most ``max_motions``); see the module
     docstring. ``remaining``: seconds left to the caller (the search gives up, undecided, once none are)."""
     problem, n_q = form.problem, form.n_q
-    order = _order(problem, seed_x, n_q)
     planar = problem.dimension == 2
+    if not planar and form.n_edges < 3:  # frictionless 3-D (no edges): its normals are no pyramid's columns
+        return PatternProof(PatternVerdict.UNDECIDED, seed_x)
+    order = _order(problem, seed_x, n_q)
     layout = _planar_layout(problem, order) if planar else _pyramid_layout(form, [order])
     roots = layout.roots if planar or seed_x is None else _seed_modes_first(layout, form, seed_x)
     seed = None if seed_x is None else seed_x[:n_q]
@@ -625,6 +629,11 @@ def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
         return True  # the seed's twist alone
     if not free and len(extremes) == 1:
         return _record_point(rows, extremes[0], fit, node.columns)
+    if rows.width > 2:
+        # 3-D: a pyramid's continua come in families whose faces (a contact rolling at the end of its slip, on
+        # the same edge) are continua of other patterns; SCIP lists the family once (its cut leaves each listed
+        # polyhedron), this search would list each face. Until faces are merged, SCIP lists them.
+        return False
     return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit, node.columns)
 
 
