@@ -32,6 +32,7 @@ __all__ = [
     "FORCE_CEILING",
     "FORCE_INTERIOR",
     "PATTERN_NODES",
+    "PYRAMID_PATTERN_NODES",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
     "BASIS_FEASIBILITY",
@@ -146,6 +147,12 @@ PATTERN_NODES = 512
 the proof to the SCIP search [-]: measured, the benchmark's 2-D grasps of 2-8 contacts need 6-300 (their ambiguous
 ones listed in 12-130) and 840 random scenes at most 124, all decided; a node costs ~55 us, so the budget wastes at
 most ~30 ms before SCIP."""
+
+PYRAMID_PATTERN_NODES = 8192
+"""Most nodes of the 3-D pyramid's mode branch and bound (:mod:`quasistatic.solvers.certify.patterns`) before it
+gives the proof to the SCIP search [-]: measured on the 8-edge pyramid, the benchmark's 3-D grasps of 4-8 contacts
+need 208-4822 (0.03-0.6 s), where SCIP took 0.2-30 s; of 240 random scenes of 2-4 contacts, 235 were decided
+within it. A node costs 90-130 us, so the budget wastes at most about a second before SCIP."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""

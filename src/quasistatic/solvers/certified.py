@@ -7,8 +7,9 @@
    On exact 3-D cones, rest with every mover still is proven the only motion
    on the circles themselves when it is (:mod:`.certify.rest`: the load cannot
    do work, so loaded contacts stick, and LPs or else SCIP find no other such motion).
-3. Planar problems: a branch and bound over each contact's mode (separating,
-   rolling, sliding either way), whose nodes are pruned by checked Farkas
+3. Planar and 3-D pyramid problems: a branch and bound over each contact's mode
+   (separating, rolling, sliding either way in 2-D; on a pyramid's vertex or
+   face in 3-D), whose nodes are pruned by checked Farkas
    vectors (no forces balance the load), singular-value bounds on the twists
    the closed contacts leave, and LP statuses (:mod:`.certify.patterns`), proves
    that every motion has Lemke's twist (``solved``), or, without a Lemke point,
@@ -17,7 +18,8 @@
    each pattern that holds one gives a single twist or a continuum, its
    extremes measured by LPs). It needs no SCIP; where a pattern is too close
    to call, or past its node budget or ``max_solutions``, it proves nothing
-   and step 4 runs.
+   and step 4 runs. On exact 3-D cones the same proof replaces the SCIP search
+   on the inscribed 8-edge pyramid wherever it decides (:mod:`.certify.exact_cone`).
 4. Otherwise the complete SCIP search of ``scip`` runs. For polyhedral cones
    it starts from Lemke's point once every law of the search's own form is
    checked there, so SCIP only has to prove that no other motion exists
@@ -58,27 +60,26 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
     if seed is not None and kinematically_unique(problem, seed[: form.n_q]):
         motion = RawMotion(seed[: form.n_q], form.forces(seed))
         return summarise(form, [motion], True, options).with_notes(certificate=_KINEMATIC)
-    if problem.dimension == 2:
-        proof = prove_by_patterns(form, seed, options.max_solutions)
-        if proof.verdict is PatternVerdict.UNIQUE and proof.seed is not None:
-            motion = RawMotion(proof.seed[: form.n_q], form.forces(proof.seed))
-            return summarise(form, [motion], True, options).with_notes(certificate=PATTERN_PROOF)
-        if proof.verdict is PatternVerdict.ENUMERATED:
-            options.report(len(proof.motions), proof.nodes)  # as the SCIP search reports its steps
-            return summarise(form, list(proof.motions), True, options).with_notes(certificate=ENUMERATION_PROOF)
-        if proof.verdict is PatternVerdict.NONE:
-            return diagnose(problem, edges, equilibrium=proof.equilibrium).with_notes(certificate=NO_MOTION_PROOF)
+    proof = prove_by_patterns(form, seed, options.max_solutions, options.remaining)
+    if proof.verdict is PatternVerdict.UNIQUE and proof.seed is not None:
+        motion = RawMotion(proof.seed[: form.n_q], form.forces(proof.seed))
+        return summarise(form, [motion], True, options).with_notes(certificate=PATTERN_PROOF)
+    if proof.verdict is PatternVerdict.ENUMERATED:
+        options.report(len(proof.motions), proof.nodes)  # as the SCIP search reports its steps
+        return summarise(form, list(proof.motions), True, options).with_notes(certificate=ENUMERATION_PROOF)
+    if proof.verdict is PatternVerdict.NONE:
+        return diagnose(problem, edges, equilibrium=proof.equilibrium).with_notes(certificate=NO_MOTION_PROOF)
     return certified_polyhedral(problem, edges, options, seed)
 
 
 def _exact_cones(problem: Problem, options: Options) -> BackendResult:
     """Exact 3-D cones: a kinematically unique exact motion is certified; otherwise the pyramid search of ``scip``."""
     if options.modes is not None:
-        return solve_exact_3d(problem, options)
+        return solve_exact_3d(problem, options, by_patterns=True)
     motion = exact_motion(problem)
     if motion is not None and kinematically_unique(problem, motion.q):
         return unique_exact_motion(problem, motion, options, _KINEMATIC)
     proof = None if motion is None else rest_proof(problem, motion.q, options)
     if motion is not None and proof is not None:
         return unique_exact_motion(problem, motion, options, proof)
-    return solve_exact_3d(problem, options)
+    return solve_exact_3d(problem, options, by_patterns=True)

@@ -35,7 +35,7 @@ import scipy.optimize
 
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes, slips
 from ...laws.fixed_modes import FixedModeLaws
-from ...laws.polyhedral import aligned_edges, polyhedral_form
+from ...laws.polyhedral import LCPForm, aligned_edges, polyhedral_form
 from ...solution import Certificate, CertificateKind, Diagnosis
 from ...tolerances import (
     CONE_ROUNDOFF,
@@ -49,25 +49,32 @@ from ...tolerances import (
 )
 from ..numerics.forces import least_normal_forces
 from ..result import BackendResult, Options
+from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
 from .min_power import solve_min_power
+from .patterns import ENUMERATION_PROOF, NO_MOTION_PROOF, PATTERN_PROOF, PatternVerdict, prove_by_patterns
 from .search import enumerate_motions, summarise
 from .wedge import exact_cones_jam
 
 __all__ = ["solve_exact_3d", "unique_exact_motion", "SEARCH_EDGES"]
 
+_SCIP = "the complete SCIP search over contact modes"
 SEARCH_EDGES = 8  # pyramid edges of the first certified search
 VERDICT_EDGES = 256  # polygons tried when the searched ones cannot decide between unstable and at rest
 WIDER_SEARCH_EDGES = 32  # the most edges the mixed-integer search is run with (its size grows with them)
 RANGE_EDGES = 64  # polygon used for force ranges at rolling contacts (inner, within 0.12 %)
 
 
-def solve_exact_3d(problem: Problem, options: Options) -> BackendResult:
-    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided."""
+def solve_exact_3d(problem: Problem, options: Options, by_patterns: bool = False) -> BackendResult:
+    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided.
+
+    ``by_patterns``: each pyramid's motions are first sought by the mode branch and bound
+    (:mod:`.patterns`), and the SCIP search runs only where it leaves them undecided.
+    """
     options = options.start_clock()
     undecided, relaxed = "", False
     for count in (SEARCH_EDGES, WIDER_SEARCH_EDGES):
-        result, undecided = _search(problem, options, count)
+        result, undecided = _search(problem, options, count, by_patterns)
         if result is not None:
             return result
         if undecided in ("wedged", "modes") and not relaxed:  # the pyramid has no motion: try to prove it for the circle
@@ -77,7 +84,7 @@ def solve_exact_3d(problem: Problem, options: Options) -> BackendResult:
     if undecided == "wedged":
         return _confirm_wedged(problem, options)
     if undecided == "modes":
-        return _free_motions_with_modes(problem, options)
+        return _free_motions_with_modes(problem, options, by_patterns)
     if undecided == "equilibrium":
         return _equilibrium_verdict(problem, VERDICT_EDGES)
     return BackendResult(
@@ -106,7 +113,7 @@ def _exact_forces(problem: Problem, q: np.ndarray) -> np.ndarray | None:
     return _forces_at(problem, q, ModeMasks.of(problem, contact_modes(problem, q)))
 
 
-def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResult | None, str]:
+def _search(problem: Problem, options: Options, count: int, by_patterns: bool) -> tuple[BackendResult | None, str]:
     """Motions of a ``count``-edge pyramid refined to the exact cone, or None and why the pyramid cannot decide.
 
     Undecided: ``refinement`` (a pyramid motion has no exact motion next to
@@ -115,10 +122,17 @@ def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResu
     (equilibrium exists in the circumscribed pyramid but not the inscribed one).
     """
     edges = aligned_edges(problem, count)
-    motions, complete = enumerate_motions(polyhedral_form(problem, edges), options)
+    form = polyhedral_form(problem, edges)
+    if by_patterns and options.modes is None:
+        motions, complete, how = _pyramid_motions(form, options)
+    else:
+        motions, complete = enumerate_motions(form, options)
+        how = _SCIP
     if motions:
         result = _refined_result(problem, motions, complete, options, count)
-        return result, "" if result is not None else "refinement"
+        if result is None:
+            return None, "refinement"
+        return result.with_notes(pyramid_search=how), ""
     if not complete:
         return BackendResult("failed", "failed: the certified search hit its time limit before finding a motion"), ""
     if options.modes is not None:
@@ -128,7 +142,24 @@ def _search(problem: Problem, options: Options, count: int) -> tuple[BackendResu
         return None, "equilibrium"
     if verdict.diagnosis is Diagnosis.WEDGED:
         return None, "wedged"
-    return verdict, ""
+    return verdict.with_notes(pyramid_search=how), ""
+
+
+def _pyramid_motions(form: LCPForm, options: Options) -> tuple[list[RawMotion], bool, str]:
+    """Every motion of the pyramid ``form`` and whether the list is complete, by the mode branch and bound from
+    Lemke's point where it decides (its seed the only motion, every motion listed, or none), else by the SCIP
+    search; and which of the two decided."""
+    seed = seed_point(form)
+    proof = prove_by_patterns(form, seed, options.max_solutions, options.remaining)
+    if proof.verdict is PatternVerdict.UNIQUE and proof.seed is not None:
+        return [RawMotion(proof.seed[: form.n_q], form.forces(proof.seed))], True, PATTERN_PROOF
+    if proof.verdict is PatternVerdict.ENUMERATED:
+        options.report(len(proof.motions), proof.nodes)  # as the SCIP search reports its steps
+        return list(proof.motions), True, ENUMERATION_PROOF
+    if proof.verdict is PatternVerdict.NONE:
+        return [], True, NO_MOTION_PROOF
+    motions, complete = enumerate_motions(form, options)
+    return motions, complete, _SCIP
 
 
 def _equilibrium_verdict(problem: Problem, count: int) -> BackendResult:
@@ -222,10 +253,10 @@ def _unique_for_the_pyramid(result: BackendResult) -> BackendResult:
     return dataclasses.replace(result, message=message, certified=False, search_complete=False, claims_forces=False, after_claim="")
 
 
-def _free_motions_with_modes(problem: Problem, options: Options) -> BackendResult:
+def _free_motions_with_modes(problem: Problem, options: Options, by_patterns: bool) -> BackendResult:
     """No pyramid motion has the prescribed modes, yet an exact one may (a pyramid bends slips towards its edges):
     the motions of the free solve that have them, else ``failed``."""
-    free = solve_exact_3d(problem, dataclasses.replace(options, modes=None))
+    free = solve_exact_3d(problem, dataclasses.replace(options, modes=None), by_patterns)
     matching = [motion for motion in free.motions if _keeps_prescribed(problem, motion, options)]
     if matching and free.status in ("solved", "ambiguous"):
         note = "the motions with the prescribed modes among every motion of the free search (its exact refinement)"

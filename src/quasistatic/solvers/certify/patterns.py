@@ -1,4 +1,4 @@
-"""A complete certificate for small planar problems without SCIP: branch and bound over contact modes.
+"""A complete certificate for small planar and 3-D pyramid problems without SCIP: branch and bound over contact modes.
 
 **What it proves.** Every solution of the planar polyhedral laws (the LCP of
 :func:`~quasistatic.laws.polyhedral.polyhedral_form`, two edges per contact)
@@ -18,6 +18,38 @@ LCP's solutions are the union, over the ``4^m`` mode assignments, of
 polyhedra, and each of these is a product ``Q x F``: twists
 ``Q`` (kinematic rows only) times forces ``F`` (equilibrium with each contact's
 generators: both edges when rolling, one when sliding, none when separating).
+
+**3-D pyramids** (``K`` unit edges ``d_k`` per contact, a regular polygon, so
+``0`` is inside it and at most two neighbouring edges are most opposed to any
+slip ``u = Jt q - bt``). The LCP's friction rows are ``0 <= beta_k _|_
+d_k.u + lam >= 0`` and ``0 <= lam _|_ mu cn - sum beta >= 0``. Its modes::
+
+    separating    cn = 0 (so beta = 0)                     twist: wn >= 0
+    rolling       force anywhere in the pyramid             twist: wn = 0, u = 0
+    vertex j      force on edge j, n + mu d_j               twist: wn = 0, (d_{j+1} - d_j).u >= 0, (d_{j-1} - d_j).u >= 0
+    face j, j+1   force on edges j and j + 1                twist: wn = 0, (d_j - d_{j+1}).u = 0, -(d_j + d_{j+1}).u >= 0
+
+cover every solution: ``wn > 0`` forces ``cn = 0`` (separating). A closed
+contact with ``lam = 0`` has ``d_k.u >= 0`` for every edge, and as the edges
+positively span the plane, ``u = 0`` (rolling; any force of the pyramid is
+``cn`` times a convex combination of its edges, ``sum beta = mu cn``).
+With ``lam > 0``, ``sum beta = mu cn`` and ``beta_k > 0`` only where
+``d_k.u = -lam = min_k d_k.u``: the edges most opposed to ``u``, one edge
+``j`` (then ``u`` lies in the closed sector where ``j`` wins, bounded by its
+two neighbours' rows: vertex ``j``) or two neighbours (then ``u`` lies along
+the face's inner normal: face ``j, j+1``). A frictionless contact's closed modes are
+one, ``wn = 0`` (each of its columns is the normal). Each mode is again
+linear rows on the twist times generators of the force, so a full assignment
+is a product ``Q x F`` as in 2-D, and a set of modes that keeps the union of
+their rows' *common* constraints and their columns holds them all. The tree
+splits each contact's modes coarse to fine (:func:`_contact_tree`: closed or
+separating; rolling, or sliding in an arc of sectors of at most a half-plane,
+whose two boundary rows and edges hold every vertex and face mode in it;
+arcs halved down to one vertex and the face after it), and takes every
+contact at one depth before any goes deeper. Where the closed rows leave a
+plane of twists (``n - 2`` of them), its polygon is decided exactly
+(:func:`_on_plane`), which bounds the twists (and so prunes modes) long
+before the rows pin them.
 The twist and force conditions share no unknown once the modes are fixed.
 
 A depth-first search fixes one contact's mode per level. At a node, the
@@ -47,7 +79,9 @@ which is the box the SCIP search excludes around a found motion), and no mode
 assignment holds a continuum. Without a seed, a closed tree proves that no
 motion exists.
 
-**Listing every motion.** A leaf that survives is one full mode assignment,
+**Listing every motion.** (3-D: isolated motions only; a leaf holding a
+continuum gives no answer, as its family's faces are continua of other
+patterns that SCIP's search lists once.) A leaf that survives is one full mode assignment,
 so its motions are exactly ``Q x F`` (no node below it), with ``F`` non-empty
 (its non-negative fit balances the load). Its twist set ``Q`` is measured by
 ``2 n`` LPs (the least and largest of each twist entry): empty (pruned), one
@@ -68,14 +102,17 @@ unless a listed continuum holds it with the continuum's own contact modes.
 
 A leaf whose point or extremes fail the form's check (too close to call), an
 LP that does not answer, more motions than asked for, or more than
-:data:`PATTERN_NODES` nodes give no answer: the caller runs the SCIP search
+:data:`PATTERN_NODES` (3-D: :data:`PYRAMID_PATTERN_NODES`) nodes give no answer: the caller runs the SCIP search
 instead, unchanged, which lists as many as asked and says when the list may be
 incomplete.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 
@@ -84,7 +121,16 @@ from scipy.optimize import nnls
 
 from ...laws import Problem, RawMotion, contact_modes
 from ...laws.polyhedral import LCPForm
-from ...tolerances import DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, MOTION_RANK, PATTERN_NODES, SAME_TWIST, ZERO
+from ...tolerances import (
+    DISTINCT_TWIST,
+    FORCE_CEILING,
+    LP_FEASIBILITY,
+    MOTION_RANK,
+    PATTERN_NODES,
+    PYRAMID_PATTERN_NODES,
+    SAME_TWIST,
+    ZERO,
+)
 from ..numerics.highs import WarmLP, solve_lp
 from .cheap import satisfies_form
 from .search import relative_interior_point
@@ -97,8 +143,6 @@ ENUMERATION_PROOF = (
     "every contact-mode pattern excluded or its motions listed: single twists, continua by their extremes "
     "(mode branch and bound, LPs and Farkas vectors)"
 )
-
-_SEPARATING, _ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _CLOSED = range(5)  # _CLOSED: a frictionless contact's three closed modes
 
 
 class PatternVerdict(Enum):
@@ -121,14 +165,42 @@ class PatternProof:
     equilibrium: bool | None = None  # at the root: True, a balancing fit; False, a checked Farkas vector; None, neither
 
 
+@dataclass(frozen=True, slots=True)
+class _Mode:
+    """A set of a contact's modes as data: the bank rows its twists meet as equalities (``equal``: the gap row,
+    and the slip rows it pins) and as inequalities (``at_least``), which of the contact's load columns its force
+    may use (``keep``), and the sets it splits into (``children``; none for one mode). The twist rows and force
+    columns of a set hold those of every mode in it, so a node that keeps them holds every assignment below it."""
+
+    equal: np.ndarray  # int: bank rows, ``bank q = rhs``
+    at_least: np.ndarray  # int: bank rows, ``bank q >= rhs``
+    keep: np.ndarray  # bool (K,): the contact's load columns its force may use
+    children: tuple[_Mode, ...] = ()
+    separating: bool = False  # no force, the gap row stays an inequality (as at the root)
+
+
+@dataclass(frozen=True, slots=True)
+class _Level:
+    """One level of the tree: the contact whose current set of modes (the node's) is split into its children."""
+
+    contact: int
+
+
+@dataclass(frozen=True, slots=True)
+class _Layout:
+    """A problem's twist rows (``bank q >= or = rhs``), its load columns (a unit normal force on each edge of
+    each contact, ``K`` per contact), each contact's set of every mode (``roots``) and the levels of the tree."""
+
+    bank: np.ndarray
+    rhs: np.ndarray
+    loads: np.ndarray
+    roots: tuple[_Mode, ...]
+    levels: tuple[_Level, ...]
+
+
 @dataclass
 class _Rows:
-    """A planar problem's rows, scene-relative, and the search's counters.
-
-    ``bank`` (4 m, n) holds every twist row a mode can use, ``bank q >= or = rhs``: contact ``i``'s normal row
-    (``i``), tangent row (``m + i``, rolling), and the slip signs of sliding + (``2 m + i``: ``-s >= 0``) and
-    sliding - (``3 m + i``: ``s >= 0``). ``loads`` (n, 2 m): a unit normal force on each contact's edge +t, -t.
-    """
+    """A problem's rows (:class:`_Layout`), scene-relative, and the search's counters."""
 
     bank: np.ndarray
     rhs: np.ndarray
@@ -137,43 +209,51 @@ class _Rows:
     g: np.ndarray
     seed: np.ndarray | None  # the seed's twist
     form: LCPForm
-    frictionless: np.ndarray  # (m,) bool: mu = 0
-    order: list[int]  # contacts in the order they are fixed
+    levels: tuple[_Level, ...]
+    budget: int  # most nodes
+    farkas: _FarkasVectors
     proof: PatternProof = field(default_factory=lambda: PatternProof(PatternVerdict.UNDECIDED))
     closed_sets: dict[bytes, _ClosedSet | _Twists] = field(default_factory=dict)  # by which bank rows are closed
     max_motions: int = 16
+    remaining: Callable[[], float] | None = None  # seconds left to the caller
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
 
     @property
-    def m(self) -> int:
-        return self.loads.shape[1] // 2
+    def width(self) -> int:
+        """Load columns per contact (the form's edges)."""
+        return self.form.n_edges
 
 
 @dataclass(frozen=True, slots=True)
 class _Node:
-    """Which bank rows hold as equalities and inequalities, which load columns may carry force, how deep."""
+    """Which bank rows hold as equalities and inequalities, which load columns may carry force, each contact's
+    current set of modes, how deep."""
 
     equal: np.ndarray
     at_least: np.ndarray
     columns: np.ndarray
+    modes: tuple[_Mode, ...]
     depth: int
     closed_rows: int = 0  # how many entries of ``equal`` are set
 
-    def child(self, rows: _Rows, contact: int, mode: int) -> _Node:
+    def child(self, rows: _Rows, contact: int, mode: _Mode) -> _Node:
         columns = self.columns.copy()
-        columns[2 * contact : 2 * contact + 2] &= _EDGES_OF[mode]
-        if mode == _SEPARATING:  # a free contact's twist rows: the parent's arrays, shared (no node writes them)
-            return _Node(self.equal, self.at_least, columns, self.depth + 1, self.closed_rows)
-        m = rows.m
+        K = rows.width
+        columns[K * contact : K * contact + K] &= mode.keep
+        modes = (*self.modes[:contact], mode, *self.modes[contact + 1 :])
+        new_equal = mode.equal[~self.equal[mode.equal]]
+        new_at_least = mode.at_least[~self.at_least[mode.at_least]]
+        if not (new_equal.size or new_at_least.size):  # the parent's twist rows: its arrays, shared (no node writes them)
+            return _Node(self.equal, self.at_least, columns, modes, self.depth + 1, self.closed_rows)
         equal, at_least = self.equal.copy(), self.at_least.copy()
-        at_least[contact], equal[contact] = False, True
-        closed_rows = self.closed_rows + 1
-        if mode == _ROLLING:
-            equal[m + contact] = True
-            closed_rows += 1
-        elif mode != _CLOSED:
-            at_least[(2 if mode == _SLIDE_PLUS else 3) * m + contact] = True
-        return _Node(equal, at_least, columns, self.depth + 1, closed_rows)
+        at_least[new_equal] = False
+        equal[new_equal] = True
+        at_least[new_at_least] = True
+        return _Node(equal, at_least, columns, modes, self.depth + 1, self.closed_rows + new_equal.size)
+
+    def deeper(self) -> _Node:
+        """The same node one level down (a level that does not apply to it)."""
+        return _Node(self.equal, self.at_least, self.columns, self.modes, self.depth + 1, self.closed_rows)
 
 
 @dataclass(frozen=True, slots=True)
@@ -184,47 +264,170 @@ class _Ball:
     radius: float
 
 
-_EDGES_OF = {  # which of a contact's two load columns each mode keeps
-    _SEPARATING: np.array([False, False]),
-    _ROLLING: np.array([True, True]),
-    _SLIDE_PLUS: np.array([True, False]),
-    _SLIDE_MINUS: np.array([False, True]),
-    _CLOSED: np.array([True, False]),  # frictionless: both columns are the normal
-}
-_ALL_MODES = (_ROLLING, _SLIDE_PLUS, _SLIDE_MINUS, _SEPARATING)  # separating last: see _search
-_FRICTIONLESS_MODES = (_CLOSED, _SEPARATING)
+def _mode(equal: list[int], at_least: list[int], keep: np.ndarray, children: tuple[_Mode, ...] = (), separating: bool = False) -> _Mode:
+    return _Mode(np.array(equal, dtype=int), np.array(at_least, dtype=int), keep, children, separating)
 
 
-def prove_by_patterns(form: LCPForm, seed_x: np.ndarray | None, max_motions: int = 16) -> PatternProof:
-    """Every motion of the planar polyhedral laws ``form`` (two edges per contact): whether each has the twist of
-    ``seed_x`` (a point ``[q, cn, beta, lam]`` of it), or of a seed found on the way, or, without one, whether
-    no motion exists; else every motion listed (at most ``max_motions``); see the module docstring."""
-    problem, n_q = form.problem, form.n_q
+def _planar_layout(problem: Problem, order: list[int]) -> _Layout:
+    """Planar rows: ``bank`` (4 m, n) holds contact ``i``'s normal row (``i``), tangent row (``m + i``, rolling),
+    and the slip signs of sliding + (``2 m + i``: ``-s >= 0``) and sliding - (``3 m + i``: ``s >= 0``); ``loads``
+    (n, 2 m): a unit normal force on each contact's edge +t, -t. One level per contact: rolling, sliding +,
+    sliding -, separating (last: see :func:`_search`); a frictionless contact's three closed modes are one."""
+    m = problem.n_contacts
     Jn, Jt, bn, bt = problem.Jn, problem.Jt[:, 0, :], problem.bn, problem.bt[:, 0]
     mu = problem.mu[:, None]
     loads = np.stack([Jn + mu * Jt, Jn - mu * Jt], axis=1).reshape(-1, problem.n_dof).T
-    bank = np.vstack([Jn, Jt, -Jt, Jt])
+    both, plus, minus, none = np.array([True, True]), np.array([True, False]), np.array([False, True]), np.array([False, False])
+    roots = []
+    for i in range(m):
+        separating = _mode([], [], none, separating=True)
+        if problem.mu[i] <= 0.0:  # frictionless: both columns are the normal
+            modes: tuple[_Mode, ...] = (_mode([i], [], plus), separating)
+        else:
+            modes = (_mode([i, m + i], [], both), _mode([i], [2 * m + i], plus), _mode([i], [3 * m + i], minus), separating)
+        roots.append(_mode([], [], both, modes))
+    bank, rhs = np.vstack([Jn, Jt, -Jt, Jt]), np.concatenate([bn, bt, -bt, bt])
+    return _Layout(bank, rhs, loads, tuple(roots), tuple(_Level(i) for i in order))
+
+
+def _pyramid_layout(form: LCPForm, groups: list[list[int]]) -> _Layout:
+    """3-D pyramid rows, with ``u = Jt q - bt`` a contact's slip and ``d_k`` its edges (``K``): ``bank`` holds the
+    normal rows (``i``), the two tangent rows (``m + i``, ``2 m + i``), then per contact and edge ``j`` the rows
+    of the sector where ``d_j`` is the most opposed edge, ``(d_{j+1} - d_j).u >= 0`` and ``(d_{j-1} - d_j).u >= 0``,
+    and of the face ``(j, j + 1)``: ``(d_j - d_{j+1}).u = 0`` and ``-(d_j + d_{j+1}).u >= 0``. ``loads``
+    (n, m K): a unit normal force on each edge, ``J_n + mu d_k.J_t``.
+
+    Each contact's modes form a tree of sets (:func:`_slip_tree`): closed or separating; a closed contact
+    rolling, or sliding with its slip in an arc of sectors (at most a half-plane) and its force on their
+    edges; arcs halved down to one sector, which splits into its vertex and the face after it. The levels
+    take every contact of a group (those the seed closes, then the others) at one depth of its tree before
+    any goes deeper: coarse sets of all contacts together exclude whole regions of the tree (a Farkas vector
+    for forces on half of each polygon), and the twist is pinned (closed normals, rolling contacts) before
+    the slip's finest modes are tried."""
+    problem = form.problem
+    m, K = form.edges.shape[:2]
+    n = problem.n_dof
+    Jn, Jt, bn, bt, mu = problem.Jn, problem.Jt, problem.bn, problem.bt, problem.mu
+    JD = np.einsum("mkt,mtn->mkn", form.edges, Jt)  # slip along each edge per unit twist
+    bD = np.einsum("mkt,mt->mk", form.edges, bt)
+    after, b_after = np.roll(JD, -1, axis=1), np.roll(bD, -1, axis=1)
+    before, b_before = np.roll(JD, 1, axis=1), np.roll(bD, 1, axis=1)
+    blocks = [(after - JD, b_after - bD), (before - JD, b_before - bD), (JD - after, bD - b_after), (-(JD + after), -(bD + b_after))]
+    bank = np.vstack([Jn, Jt[:, 0], Jt[:, 1], *(rows.reshape(m * K, n) for rows, _ in blocks)])
+    rhs = np.concatenate([bn, bt[:, 0], bt[:, 1], *(values.ravel() for _, values in blocks)])
+    loads = (Jn[:, None, :] + mu[:, None, None] * JD).reshape(m * K, n).T
+    roots = tuple(_contact_tree(i, m, K, bool(mu[i] > 0.0)) for i in range(m))
+    rounds = max(_tree_depth(root) for root in roots)
+    levels = [_Level(i) for group in groups for _ in range(rounds) for i in group]
+    return _Layout(bank, rhs, loads, roots, tuple(levels))
+
+
+def _contact_tree(i: int, m: int, K: int, frictional: bool) -> _Mode:
+    """Contact ``i``'s modes as a tree of sets (bank rows as in :func:`_pyramid_layout`): separating, or closed
+    (its gap row an equality); closed and frictional: rolling (both tangent rows), or sliding in one of the
+    arcs of at most ``K / 2`` sectors (a half-plane at most, so their rows are its two boundary rays)."""
+    every, none = np.ones(K, dtype=bool), np.zeros(K, dtype=bool)
+    separating = _mode([], [], none, separating=True)
+    if not frictional:  # its closed modes are one: its columns are all the normal, so one of them is kept
+        return _mode([], [], every, (_mode([i], [], np.arange(K) == 0), separating))
+    parts = 2 if K % 2 == 0 else 3
+    bounds = [round(K * p / parts) for p in range(parts + 1)]
+    arcs = tuple(_arc(i, m, K, bounds[p], bounds[p + 1] - 1) for p in range(parts))
+    closed = _mode([i], [], every, (_mode([i, m + i, 2 * m + i], [], every), *arcs))
+    return _mode([], [], every, (closed, separating))
+
+
+def _arc(i: int, m: int, K: int, first: int, last: int) -> _Mode:
+    """Contact ``i`` sliding with its slip in sectors ``first..last``: the edges they oppose, and the faces after
+    each (``(last, last + 1)`` included, whose slip lies on the arc's boundary), so its force is on edges
+    ``first..last + 1``; halved until one sector is left, which is its vertex mode or the face after it."""
+    sector_next, sector_prev, face_equal, face_sign = (3 * m + block * m * K + i * K for block in range(4))
+    keep = np.zeros(K, dtype=bool)
+    keep[np.arange(first, last + 2) % K] = True
+    rows = [sector_prev + first % K, sector_next + last % K]
+    if first == last:
+        j, edge = first % K, np.eye(K, dtype=bool)
+        vertex = _mode([i], [sector_next + j, sector_prev + j], edge[j])
+        face = _mode([i, face_equal + j], [face_sign + j], edge[j] | edge[(j + 1) % K])
+        return _mode([i], rows, keep, (vertex, face))
+    middle = (first + last) // 2
+    return _mode([i], rows, keep, (_arc(i, m, K, first, middle), _arc(i, m, K, middle + 1, last)))
+
+
+def _tree_depth(mode: _Mode) -> int:
+    return 1 + max((_tree_depth(child) for child in mode.children), default=-1)
+
+
+def prove_by_patterns(
+    form: LCPForm, seed_x: np.ndarray | None, max_motions: int = 16, remaining: Callable[[], float] | None = None
+) -> PatternProof:
+    """Every motion of the polyhedral laws ``form`` (planar, two edges per contact, or a 3-D pyramid): whether
+    each has the twist of ``seed_x`` (a point ``[q, cn, beta, lam]`` of it), or of a seed found on the way, or,
+    without one, whether no motion exists; else every motion listed (at most ``max_motions``); see the module
+    docstring. ``remaining``: seconds left to the caller (the search gives up, undecided, once none are)."""
+    problem, n_q = form.problem, form.n_q
+    planar = problem.dimension == 2
+    if not planar and form.n_edges < 3:  # frictionless 3-D (no edges): its normals are no pyramid's columns
+        return PatternProof(PatternVerdict.UNDECIDED, seed_x)
+    order = _order(problem, seed_x, n_q)
+    layout = _planar_layout(problem, order) if planar else _pyramid_layout(form, [order])
+    roots = layout.roots if planar or seed_x is None else _seed_modes_first(layout, form, seed_x)
     seed = None if seed_x is None else seed_x[:n_q]
     rows = _Rows(
-        bank,
-        np.concatenate([bn, bt, -bt, bt]),
-        np.linalg.norm(bank, axis=1),
-        loads,
+        layout.bank,
+        layout.rhs,
+        np.linalg.norm(layout.bank, axis=1),
+        layout.loads,
         problem.g,
         seed,
         form,
-        problem.mu <= 0.0,
-        _order(problem, seed_x, n_q),
+        layout.levels,
+        PATTERN_NODES if planar else PYRAMID_PATTERN_NODES,
+        _FarkasVectors(layout.loads, problem.g, math.sqrt(problem.g.size) * LP_FEASIBILITY),
         max_motions=max_motions,
+        remaining=remaining,
     )
     rows.proof.seed = seed_x
     m = problem.n_contacts
-    root = _Node(np.zeros(4 * m, dtype=bool), np.arange(4 * m) < m, np.ones(2 * m, dtype=bool), 0)
+    n_rows = layout.bank.shape[0]
+    root = _Node(np.zeros(n_rows, dtype=bool), np.arange(n_rows) < m, np.ones(layout.loads.shape[1], dtype=bool), roots, 0)
     fit = _forces(rows, root.columns, None)
     rows.proof.equilibrium = False if fit is None else _balances(rows, fit)
-    closed = fit is None or _search(rows, root, fit, _UNKNOWN)
+    closed = fit is None or _search(rows, _past_settled(rows, root), fit, _UNKNOWN)
     rows.proof.verdict = _verdict(rows, closed)
     return rows.proof
+
+
+def _closed_first(problem: Problem, seed_x: np.ndarray | None, order: list[int], n_q: int) -> list[list[int]]:
+    """``order`` split in two groups: the contacts the seed closes (gap within ``ZERO``), then the others."""
+    if seed_x is None:
+        return [order]
+    gap = problem.Jn @ seed_x[:n_q] - problem.bn
+    return [[i for i in order if gap[i] <= ZERO], [i for i in order if gap[i] > ZERO]]
+
+
+def _seed_modes_first(layout: _Layout, form: LCPForm, seed_x: np.ndarray) -> tuple[_Mode, ...]:
+    """Each contact's tree with the seed's slip set first among siblings: the first whose rows the seed's twist
+    meets (to ``ZERO`` per unit row) and whose columns hold the seed's edge forces (closed stays before
+    separating: see :func:`_search`)."""
+    q, _, beta, _ = form.split(seed_x)
+    slack = layout.bank @ q - layout.rhs
+    scale = np.linalg.norm(layout.bank, axis=1) + 1.0
+
+    def holds(mode: _Mode, loaded: np.ndarray) -> bool:
+        return (
+            bool(np.all(np.abs(slack[mode.equal]) <= ZERO * scale[mode.equal]))
+            and bool(np.all(slack[mode.at_least] >= -ZERO * scale[mode.at_least]))
+            and not np.any(loaded & ~mode.keep)
+        )
+
+    def reorder(mode: _Mode, loaded: np.ndarray) -> _Mode:
+        children = tuple(reorder(child, loaded) for child in mode.children)
+        if not any(child.separating for child in children):
+            children = tuple(sorted(children, key=lambda child: not holds(child, loaded)))
+        return dataclasses.replace(mode, children=children)
+
+    return tuple(reorder(root, beta[i] > ZERO) for i, root in enumerate(layout.roots))
 
 
 def _verdict(rows: _Rows, closed: bool) -> PatternVerdict:
@@ -257,23 +460,29 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
     ``fit``: forces on the node's columns with ``|G fit + g|`` within the margin; ``twists``: what the node's
     twists are known to be.
     """
-    if node.depth == len(rows.order):
+    leaf = len(rows.levels)
+    if node.depth == leaf:
         return False  # a leaf that survived: another motion may exist
-    contact = rows.order[node.depth]
-    slide_blocked = False  # a closed sibling's Farkas vector also holds for separating, which keeps fewer columns
-    for mode in _possible_modes(rows, contact, twists.ball):
+    contact = rows.levels[node.depth].contact
+    modes = _possible_modes(rows, node.modes[contact].children, twists.ball)
+    excluded = rows.farkas.excludes(node.columns, contact, rows.width, modes)
+    blocked = False  # a closed sibling's Farkas vector also holds for separating, which keeps fewer columns
+    for mode, known_empty in zip(modes, excluded, strict=True):
         rows.proof.nodes += 1
-        if rows.proof.nodes > PATTERN_NODES:
+        if rows.proof.nodes > rows.budget or _out_of_time(rows):
             return False
-        child = node.child(rows, contact, mode)
-        child_fit = None if mode == _SEPARATING and slide_blocked else _forces(rows, child.columns, fit)
+        if known_empty or (mode.separating and blocked):
+            blocked |= not mode.separating
+            continue  # no equilibrium below this node
+        child = _past_settled(rows, node.child(rows, contact, mode))
+        child_fit = _forces(rows, child.columns, fit)
         if child_fit is None:
-            slide_blocked |= mode in (_SLIDE_PLUS, _SLIDE_MINUS, _CLOSED)
+            blocked |= not mode.separating
             continue  # no equilibrium below this node
         child_twists = _child_twists(rows, child, mode, twists)
         if child_twists.pruned:
             continue
-        if child.depth == len(rows.order):
+        if child.depth == leaf:
             if child_twists is twists:  # every row counted: a tighter ball, perhaps the seed's
                 child_twists = _twist(rows, child)
                 if child_twists.pruned:
@@ -292,11 +501,27 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
     return True
 
 
-def _child_twists(rows: _Rows, child: _Node, mode: int, parent: _Twists) -> _Twists:
+def _out_of_time(rows: _Rows) -> bool:
+    """Whether the caller's clock has run out (read every :data:`CLOCK_NODES` nodes)."""
+    return rows.remaining is not None and rows.proof.nodes % CLOCK_NODES == 0 and rows.remaining() <= 0.0
+
+
+def _past_settled(rows: _Rows, node: _Node) -> _Node:
+    """``node`` moved past the levels whose contact's set is one mode already (nothing to split)."""
+    levels = rows.levels
+    while node.depth < len(levels) and not node.modes[levels[node.depth].contact].children:
+        node = node.deeper()
+    return node
+
+
+def _child_twists(rows: _Rows, child: _Node, mode: _Mode, parent: _Twists) -> _Twists:
     """The child's twists: the parent's when its rows are the same (a separating contact, as a free one) or
     already pin one twist (the child's lie in the same ball, and its modes were filtered against it)."""
-    if not (mode == _SEPARATING or parent.point):
-        return _twist(rows, child)
+    if not (mode.separating or parent.point):
+        own = _twist(rows, child)
+        if own is _UNKNOWN and parent.ball is not None:
+            return _Twists(False, parent.ball)  # the child's twists are among the parent's
+        return own
     ball, spread = parent.ball, parent.spread
     if parent.point and ball is not None and spread is not None and _near_seed(rows, ball.center, ball.center, spread):
         return _PRUNED  # a seed adopted since the parent was seen
@@ -315,18 +540,29 @@ def _adopted(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> bool:
 
 
 def _form_point(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> np.ndarray | None:
-    """The point ``[q, cn, beta, lam]`` of twist ``q`` and forces ``fit``, when it satisfies every law of the form."""
-    m = rows.m
-    mu = rows.form.problem.mu
-    pairs = fit.reshape(m, 2)  # unit normal forces on edges +t, -t
-    slip = rows.bank[m : 2 * m] @ q - rows.rhs[m : 2 * m]
-    x = np.concatenate([q, pairs.sum(axis=1), (mu[:, None] * pairs).ravel(), np.abs(slip)])
+    """The point ``[q, cn, beta, lam]`` of twist ``q`` and forces ``fit``, when it satisfies every law of the form.
+
+    ``fit`` holds a unit normal force on each edge (``K`` per contact): ``cn`` their sum, ``beta = mu fit``; the
+    slip speed ``lam`` is the least the edges accept, ``max(0, max_k -d_k.u)`` (in 2-D, ``|s|``)."""
+    form = rows.form
+    m, K = form.edges.shape[:2]
+    mu = form.problem.mu
+    per_edge = fit.reshape(m, K)
+    slip_along = (form.W[m : m + m * K, : q.size] @ q - form.r[m : m + m * K]).reshape(m, K)
+    lam = np.maximum(0.0, np.max(-slip_along, axis=1))
+    x = np.concatenate([q, per_edge.sum(axis=1), (mu[:, None] * per_edge).ravel(), lam])
     # Round-off (a 1e-16 edge force, a rolling contact's 1e-16 slip) to exact zeros, as Lemke's pivots leave them:
     # the search reads a point's pattern from which of each pair is nearer zero.
     pairs_part = x[q.size :]  # a view: forces and slip speeds, all >= 0
     pairs_part[pairs_part <= ZERO] = 0.0
     return x if satisfies_form(rows.form, x) else None
 
+
+_PARALLEL = 1e-13  # sine of the angle below which two twist rows' lines in a plane are parallel (round-off)
+_SKEW = 1e-9  # sine above which two such lines meet at a vertex computed well; between the two, too close to call
+ROUNDOFF_SLACK = 1e-12  # relative leniency of a computed polygon vertex on its rows, and of its bounding radius
+CLOCK_NODES = 256  # nodes between two looks at the caller's clock (~10 ms)
+FARKAS_KEPT = 8  # Farkas vectors tried before a new non-negative fit (each check: one masked max)
 
 _Region = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # a leaf's twist rows: E q = e, A q >= a
 
@@ -393,6 +629,11 @@ def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
         return True  # the seed's twist alone
     if not free and len(extremes) == 1:
         return _record_point(rows, extremes[0], fit, node.columns)
+    if rows.width > 2:
+        # 3-D: a pyramid's continua come in families whose faces (a contact rolling at the end of its slip, on
+        # the same edge) are continua of other patterns; SCIP lists the family once (its cut leaves each listed
+        # polyhedron), this search would list each face. Until faces are merged, SCIP lists them.
+        return False
     return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit, node.columns)
 
 
@@ -457,29 +698,15 @@ def _same_continuum(motion: RawMotion, other: RawMotion) -> bool:
     return all(any(np.max(np.abs(p - r)) <= SAME_TWIST for r in other.extremes) for p in motion.extremes)
 
 
-def _possible_modes(rows: _Rows, contact: int, ball: _Ball | None) -> tuple[int, ...]:
-    """The modes whose twist rows some point of ``ball`` meets (loosened by ``LP_FEASIBILITY``); all of them without one."""
-    frictionless = bool(rows.frictionless[contact])
+def _possible_modes(rows: _Rows, modes: tuple[_Mode, ...], ball: _Ball | None) -> tuple[_Mode, ...]:
+    """The ``modes`` whose twist rows some point of ``ball`` meets (each loosened by ``LP_FEASIBILITY``): all
+    of them without one. Separating is always kept (its gap row was checked as the parent's)."""
     if ball is None:
-        return _FRICTIONLESS_MODES if frictionless else _ALL_MODES
-    m = rows.m
-    normal, tangent = contact, m + contact
-    wn = float(rows.bank[normal] @ ball.center - rows.rhs[normal])
-    reach_n = float(rows.norms[normal]) * ball.radius + LP_FEASIBILITY
-    if abs(wn) > reach_n:
-        return (_SEPARATING,)
-    if frictionless:
-        return _FRICTIONLESS_MODES
-    slip = float(rows.bank[tangent] @ ball.center - rows.rhs[tangent])
-    reach_t = float(rows.norms[tangent]) * ball.radius + LP_FEASIBILITY
-    modes = []
-    if abs(slip) <= reach_t:
-        modes.append(_ROLLING)
-    if slip <= reach_t:
-        modes.append(_SLIDE_PLUS)
-    if slip >= -reach_t:
-        modes.append(_SLIDE_MINUS)
-    return (*modes, _SEPARATING)
+        return modes
+    slack = rows.bank @ ball.center - rows.rhs
+    reach = rows.norms * ball.radius + LP_FEASIBILITY
+    meets, above = np.abs(slack) <= reach, slack >= -reach
+    return tuple(mode for mode in modes if mode.separating or (meets[mode.equal].all() and above[mode.at_least].all()))
 
 
 def _margin(rows: _Rows) -> float:
@@ -493,8 +720,8 @@ def _balances(rows: _Rows, fit: np.ndarray) -> bool | None:
 
 
 def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndarray | None:
-    """Non-negative forces on ``columns`` balancing the load within the margin, or None with a checked Farkas vector:
-    then no forces on them (sum below FORCE_CEILING) leave ``|G lam + g|`` below ``LP_FEASIBILITY`` per row.
+    """Non-negative forces on ``columns`` balancing the load within the margin, or None with a checked Farkas vector
+    (kept in ``rows.farkas``: it may exclude the next nodes' columns too).
 
     ``fit``: the parent's forces; kept when they use none of the columns taken away.
     """
@@ -509,11 +736,55 @@ def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndar
         residual = float(np.linalg.norm(rows.g))
     if residual <= margin:
         return lam
-    y = -(rows.loads @ lam + rows.g)
-    # For lam >= 0: y.(G lam + g) <= max(G^T y) sum(lam) + g.y, while |G lam + g| <= margin needs it >= -margin |y|.
-    worst = max(float(np.max(G.T @ y, initial=0.0)), 0.0) * FORCE_CEILING
-    proven = -float(rows.g @ y) - worst > margin * float(np.linalg.norm(y))
-    return None if proven else lam
+    return None if rows.farkas.add(-(rows.loads @ lam + rows.g), columns) else lam
+
+
+@dataclass
+class _FarkasVectors:
+    """The last Farkas vectors found, each a certificate that no forces on some load columns balance the load:
+    ``per_column`` holds ``G^T y`` per column, ``reserve`` is ``-g.y - margin |y|``.
+
+    For ``lam >= 0``: ``y.(G lam + g) <= max(G^T y) sum(lam) + g.y``, while ``|G lam + g| <= margin`` needs it
+    ``>= -margin |y|``; so ``reserve > max(G_S^T y, 0) FORCE_CEILING`` excludes every balancing ``lam`` on the
+    columns ``S`` whose sum is below :data:`FORCE_CEILING`. One vector often excludes a node's siblings and
+    cousins: each is tried on a node's children at once, before any non-negative fit."""
+
+    loads: np.ndarray
+    g: np.ndarray
+    margin: float
+    per_column: np.ndarray = field(init=False)
+    reserve: np.ndarray = field(init=False)
+    count: int = 0
+
+    def __post_init__(self) -> None:
+        self.per_column = np.zeros((FARKAS_KEPT, self.loads.shape[1]))
+        self.reserve = np.full(FARKAS_KEPT, -np.inf)
+
+    def add(self, y: np.ndarray, columns: np.ndarray) -> bool:
+        """Keep ``y`` when it excludes ``columns`` (then True)."""
+        per_column = self.loads.T @ y
+        reserve = -float(self.g @ y) - self.margin * float(np.linalg.norm(y))
+        if reserve <= max(float(np.max(per_column[columns], initial=0.0)), 0.0) * FORCE_CEILING:
+            return False
+        slot = self.count % FARKAS_KEPT
+        self.per_column[slot], self.reserve[slot] = per_column, reserve
+        self.count += 1
+        return True
+
+    def excludes(self, columns: np.ndarray, contact: int, K: int, modes: tuple[_Mode, ...]) -> np.ndarray:
+        """For each of ``modes`` of ``contact``: whether a kept vector excludes ``columns`` with the contact's
+        block of ``K`` columns narrowed to the mode's."""
+        if not self.count or not modes:
+            return np.zeros(len(modes), dtype=bool)
+        block = slice(K * contact, K * contact + K)
+        outside = columns.copy()
+        outside[block] = False
+        values = self.per_column[: min(self.count, FARKAS_KEPT)]
+        worst_outside = np.max(np.where(outside, values, -np.inf), axis=1)  # (F,)
+        keeps = np.array([mode.keep for mode in modes]) & columns[block]  # (M, K)
+        worst_inside = np.max(np.where(keeps[None], values[:, None, block], -np.inf), axis=2)  # (F, M)
+        worst = np.maximum(np.maximum(worst_outside[:, None], worst_inside), 0.0) * FORCE_CEILING
+        return np.any(self.reserve[: values.shape[0], None] > worst, axis=0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -539,7 +810,8 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     """
     n = rows.g.size
     k = node.closed_rows
-    if k < n - 1 or k == 0:
+    plane = k == n - 2 and rows.width > 2  # 3-D pyramids: a plane of twists is bounded exactly (planar: as before)
+    if (k < n - 1 and not plane) or k == 0:
         return _UNKNOWN
     key = node.equal.tobytes()
     closed = rows.closed_sets.get(key)
@@ -548,6 +820,8 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     if isinstance(closed, _Twists):
         return closed
     reserve = closed.reserve[node.at_least]
+    if plane:
+        return _on_plane(rows, closed, rows.bank[node.at_least] @ closed.plane.T, reserve)
     if closed.slope is not None:
         return _on_line(rows, closed.q0, closed.direction, closed.radius, closed.spread, closed.slope[node.at_least], reserve)
     if (reserve < 0.0).any():
@@ -569,6 +843,7 @@ class _ClosedSet:
     reserve: np.ndarray
     direction: np.ndarray
     slope: np.ndarray | None
+    plane: np.ndarray  # (2, n): orthonormal directions of what ``n - 2`` rows leave (the last two of E's full ``vt``)
 
 
 def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
@@ -602,7 +877,7 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     reserve = bank @ q0 + LP_FEASIBILITY * np.abs(bank @ pseudo_inverse).sum(axis=1) - rows.rhs + LP_FEASIBILITY
     direction = vt[-1]
     slope = bank @ direction if k < n else None
-    return _ClosedSet(q0, radius, spread, reserve, direction, slope)
+    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:])
 
 
 def _on_line(
@@ -622,6 +897,60 @@ def _on_line(
     if _near_seed(rows, *ends, spread):
         return _PRUNED
     return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + radius))
+
+
+def _on_plane(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.ndarray) -> _Twists:
+    """Twists ``q0 + P^T x`` (``P``: the closed set's plane, ``x`` in R^2) with ``slope x + reserve >= 0`` for every
+    inequality row: a polygon, decided exactly in the plane.
+
+    It is bounded when its rows' normals leave no angle of ``pi`` or more between neighbours (they positively
+    span the plane); then it is the hull of its vertices, the intersections of two of its lines that meet every
+    row (with round-off's leniency): none means it is empty. Lines closer to parallel than :data:`_PARALLEL`
+    meet far away or not at all; between that and :data:`_SKEW` a vertex is too close to call (no bound given).
+    """
+    norms = np.sqrt(slope[:, 0] ** 2 + slope[:, 1] ** 2)
+    flat = norms == 0.0
+    if flat.any():
+        if (reserve[flat] < 0.0).any():
+            return _PRUNED
+        slope, reserve, norms = slope[~flat], reserve[~flat], norms[~flat]
+    angles = np.sort(np.arctan2(slope[:, 1], slope[:, 0]))
+    if angles.size < 3 or max(float(np.max(np.diff(angles))), float(angles[0] + 2.0 * np.pi - angles[-1])) >= np.pi - _SKEW:
+        return _UNKNOWN  # unbounded (or too close to call)
+    i, j = _pairs(angles.size)
+    a, b, c, d = slope[i, 0], slope[i, 1], slope[j, 0], slope[j, 1]
+    det = a * d - b * c
+    sine = np.abs(det) / (norms[i] * norms[j])
+    meet = sine >= _SKEW
+    if np.any(~meet & (sine > _PARALLEL)):
+        return _UNKNOWN
+    a, b, c, d, det, ri, rj = a[meet], b[meet], c[meet], d[meet], det[meet], reserve[i[meet]], reserve[j[meet]]
+    points = np.stack([(b * rj - d * ri) / det, (c * ri - a * rj) / det])  # (2, P): where two lines meet
+    values = slope @ points + reserve[:, None]
+    lenient = ROUNDOFF_SLACK * (norms[:, None] * np.sqrt(points[0] ** 2 + points[1] ** 2) + np.abs(reserve)[:, None])
+    vertices = points[:, (values >= -lenient).all(axis=0)].T
+    if not vertices.size:
+        return _PRUNED
+    twists = closed.q0 + vertices @ closed.plane
+    if _all_near_seed(rows, twists, closed.spread):
+        return _PRUNED
+    center = 0.5 * (twists.min(axis=0) + twists.max(axis=0))
+    reach = float(np.sqrt(np.max(np.sum((twists - center) ** 2, axis=1))))
+    return _Twists(False, _Ball(center, reach * (1.0 + ROUNDOFF_SLACK) + closed.radius))
+
+
+@functools.cache
+def _pairs(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair ``i < j`` of ``count`` indices."""
+    return np.triu_indices(count, 1)
+
+
+def _all_near_seed(rows: _Rows, twists: np.ndarray, spread: np.ndarray) -> bool:
+    """Whether every twist of ``twists`` (rows; their hull) lies within the seed's box, as :func:`_near_seed`."""
+    if rows.seed is None:
+        return False
+    offset = np.max(np.abs(twists - rows.seed), axis=0)
+    return bool(offset.max() <= 0.5 * SAME_TWIST and (offset + spread).max() <= 0.5 * DISTINCT_TWIST)
 
 
 def _near_seed(rows: _Rows, first: np.ndarray, second: np.ndarray, spread: np.ndarray) -> bool:
