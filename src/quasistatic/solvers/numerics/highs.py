@@ -234,10 +234,11 @@ def _load(
 def _run(solver: highspy.Highs, cost: np.ndarray, maximize: bool) -> LPResult:
     n = cost.size
     status = _solve(solver)
-    if status in ("infeasible", "unbounded_or_infeasible"):
+    if status in ("infeasible", "unbounded_or_infeasible", "error"):
         # HiGHS's presolve has called a feasible, degenerate LP infeasible (tiny entries it keeps, rows
-        # redundant to round-off: a pattern of a peg sliding in a slot); a claim of infeasibility is
-        # confirmed by the simplex alone before anyone relies on it.
+        # redundant to round-off: a pattern of a peg sliding in a slot), or a warm-started simplex has
+        # stopped without a status (kUnknown: a continuum's extent in the same slot); either is confirmed,
+        # or answered, by the simplex alone from a cold start before anyone relies on it.
         solver.setOptionValue("presolve", "off")
         solver.clearSolver()
         status = _solve(solver)
