@@ -135,6 +135,24 @@ def test_contact_made_at_the_time_the_gap_closes() -> None:
     np.testing.assert_allclose(trajectory.positions("box")[-1], [0.01 * (2.6 - made[0].time), 0, 0.05], atol=2e-5)
 
 
+def test_a_solver_crash_mid_run_ends_it_failed_with_the_steps_before_kept(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A HiGHS or SCIP crash at one step is that step's `failed` answer: the run stops there, not with an exception."""
+    step_module = sys.modules["quasistatic.sim.step"]  # the package exports the function `step` under the same name
+    real_solve, calls = step_module.solve, []
+
+    def crashing_after_three(*args: object, **kwargs: object) -> qs.Solution:
+        calls.append(None)
+        if len(calls) > 3:
+            raise qs.SolverError("highs", "LP error")
+        return real_solve(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(step_module, "solve", crashing_after_three)
+    trajectory = qs.simulate(PUSH, duration=2.6, dt=0.5, ambiguous="min_power")
+    assert trajectory.status == "failed" and not trajectory.certified
+    assert "the solver failed" in trajectory.message and "LP error" in trajectory.message
+    assert len(trajectory.times) >= 3 and trajectory.steps[-1].status == "failed"
+
+
 def test_a_thin_plate_is_not_passed_through_with_a_long_step() -> None:
     world = qs.load_world(PUSH)
     plate = replace(world.bodies[0], shape=qs.Box([0.002, 0.1, 0.1]))

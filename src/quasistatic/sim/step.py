@@ -19,8 +19,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ..adapters import AnyWorld, Detection
-from ..errors import SceneError
-from ..model import Contact
+from ..errors import SceneError, SolverError
+from ..model import Contact, Scene
 from ..solution import Mode, Motion, Solution, Status
 from ..solve import solve
 from ..tolerances import SIM_APPROACH, SIM_LOOKAHEAD, SIM_PENETRATION, SIM_POWER_TIE
@@ -220,10 +220,17 @@ def evaluate(model: SimModel, state: State, inputs: Inputs) -> Evaluation:
     detection = Detection(
         tuple(found.contacts[i] for i in touching), tuple(found.gaps[i] for i in touching), margin, _isolated(world, found, touching)
     )
-    options = model.options
-    solution = solve(world.scene(detection), options.method, certify=options.certify, time_limit=options.time_limit)
-    motion, choice = _chosen(solution, options.ambiguous)
+    solution = _solved(model.options, world.scene(detection))
+    motion, choice = _chosen(solution, model.options.ambiguous)
     return Evaluation(state, inputs, world, margin, detection, near, solution, motion, choice, penetration, model)
+
+
+def _solved(options: StepOptions, scene: Scene) -> Solution:
+    """The certified answer; a solver that crashes underneath (HiGHS, SCIP) ends the run ``failed``, its steps kept."""
+    try:
+        return solve(scene, options.method, certify=options.certify, time_limit=options.time_limit)
+    except SolverError as error:
+        return Solution("failed", f"the solver failed: {error}", options.method, str(scene.friction))
 
 
 def _isolated(world: AnyWorld, found: Detection, touching: list[int]) -> Mapping[str, tuple[str, float]]:
