@@ -3,8 +3,8 @@
 Property: on the same pyramid (``pyramid:4``, ``pyramid:8``, and the 8-edge pyramid inscribed in exact cones),
 the branch and bound's verdict never contradicts SCIP's ``enumerate_motions``: "unique" only where SCIP finds
 that one twist and proves the list complete, "no motion" only where SCIP finds none, and a listed set of
-motions equal to SCIP's. 200 random scenes of 2-4 contacts (boxes of ``random_scenes.py`` and ellipsoid
-grasps, some with frictionless contacts mixed in; 600 more with ``pytest -m slow``), degenerate scenes
+motions equal to SCIP's. 125 random scenes of 2-4 contacts (boxes of ``random_scenes.py`` and ellipsoid
+grasps, some with frictionless contacts mixed in; 675 more with ``pytest -m slow``), degenerate scenes
 (contacts on one line, coincident contacts, no load, every contact frictionless) and the 3-D benchmark grasps.
 And it decides most scenes, so the property is not met by proving nothing. Then: the default ``certified``
 solve takes this path on the benchmark grasps (SCIP's pyramid search monkeypatched to raise), and agrees with
@@ -134,13 +134,18 @@ def _check_chunk(chunk: int, size: int = 25) -> None:
     assert len(compared) >= 0.8 * size and decided >= 0.9 * len(compared), f"{decided} decided, {len(compared)} compared"
 
 
-@pytest.mark.parametrize("chunk", range(8))
+# Chunks 3-5 hold the scenes whose SCIP reference is slowest (12-18 s each on 2 cores): the slow suite runs them,
+# keeping the default suite under its 10 minutes.
+DEFAULT_CHUNKS, SLOW_CHUNKS = (0, 1, 2, 6, 7), (3, 4, 5, *range(8, 32))
+
+
+@pytest.mark.parametrize("chunk", DEFAULT_CHUNKS)
 def test_pyramid_proof_never_contradicts_scip_on_random_scenes(chunk: int) -> None:
     _check_chunk(chunk)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("chunk", range(8, 32))
+@pytest.mark.parametrize("chunk", SLOW_CHUNKS)
 def test_pyramid_proof_never_contradicts_scip_on_random_scenes_sweep(chunk: int) -> None:
     _check_chunk(chunk)
 
