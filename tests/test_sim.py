@@ -147,7 +147,7 @@ def test_a_solver_crash_mid_run_ends_it_failed_with_the_steps_before_kept(monkey
         return real_solve(*args, **kwargs)  # type: ignore[arg-type]
 
     monkeypatch.setattr(step_module, "solve", crashing_after_three)
-    trajectory = qs.simulate(PUSH, duration=2.6, dt=0.5, ambiguous="min_power")
+    trajectory = qs.simulate(EXAMPLES / "push_planar.yaml", duration=0.5, dt=0.05)
     assert trajectory.status == "failed" and not trajectory.certified
     assert "the solver failed" in trajectory.message and "LP error" in trajectory.message
     assert len(trajectory.times) >= 3 and trajectory.steps[-1].status == "failed"
