@@ -17,10 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
-from scipy.optimize import nnls
 
 import quasistatic as qs
 import quasistatic.solvers.certified as certified_door
+from hulls import near_hull
 from quasistatic.laws import RawMotion
 from quasistatic.laws.polyhedral import aligned_edges, polyhedral_form
 from quasistatic.solvers.certify.cheap import seed_point
@@ -134,19 +134,11 @@ class _Listed:
         return bool(self.extremes) or self.free
 
 
-def _near_hull(q: np.ndarray, points: tuple[np.ndarray, ...], tol: float) -> bool:
-    """Whether ``q`` is within ``tol`` (largest entry) of the convex hull of ``points`` (weights by NNLS)."""
-    P = np.column_stack(points)
-    weight = 1e6  # the weights' sum held at 1 far more tightly than the distance
-    w, _ = nnls(np.vstack([P, weight * np.ones(P.shape[1])]), np.r_[q, weight])
-    return bool(np.max(np.abs(P @ w - q)) <= tol)
-
-
 def _covered(motion: _Listed, others: list[_Listed], tol: float) -> bool:
     """A twist: one of ``others`` has it, or a continuum holds it; a continuum: one of ``others`` with its extremes."""
     if not motion.continuum:
         return any(
-            np.max(np.abs(o.q - motion.q)) <= tol if not o.continuum else bool(o.extremes) and _near_hull(motion.q, o.extremes, tol)
+            np.max(np.abs(o.q - motion.q)) <= tol if not o.continuum else bool(o.extremes) and near_hull(motion.q, o.extremes, tol)
             for o in others
         )
     return any(

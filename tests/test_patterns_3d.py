@@ -20,6 +20,7 @@ import pytest
 
 import quasistatic as qs
 import quasistatic.solvers.certify.exact_cone as exact_cone
+from hulls import near_hull
 from quasistatic.laws import RawMotion
 from quasistatic.laws.polyhedral import aligned_edges, polyhedral_form
 from quasistatic.solvers.certify.cheap import seed_point
@@ -80,21 +81,11 @@ def _close(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.max(np.abs(a - b)) <= DISTINCT_TWIST * max(1.0, float(np.max(np.abs(a)))))
 
 
-def _near_hull(q: np.ndarray, points: tuple[np.ndarray, ...], tol: float) -> bool:
-    """Whether ``q`` is within ``tol`` (largest entry) of the convex hull of ``points`` (least squares on weights)."""
-    from scipy.optimize import nnls
-
-    P = np.column_stack(points)
-    weight = 1e6  # the weights' sum held at 1 far more tightly than the distance
-    w, _ = nnls(np.vstack([P, weight * np.ones(P.shape[1])]), np.r_[q, weight])
-    return bool(np.max(np.abs(P @ w - q)) <= tol)
-
-
 def _covered(motion: RawMotion, others: list[RawMotion], tol: float) -> bool:
     """A twist: one of ``others`` has it, or a continuum's extremes hold it; a continuum: one with its extremes."""
     if not motion.continuum:
         return any(
-            np.max(np.abs(o.q - motion.q)) <= tol if not o.continuum else bool(o.extremes) and _near_hull(motion.q, o.extremes, tol)
+            np.max(np.abs(o.q - motion.q)) <= tol if not o.continuum else bool(o.extremes) and near_hull(motion.q, o.extremes, tol)
             for o in others
         )
     return any(
