@@ -33,6 +33,8 @@ __all__ = [
     "FORCE_INTERIOR",
     "PATTERN_NODES",
     "PYRAMID_PATTERN_NODES",
+    "ARRANGEMENT_CONTACTS",
+    "ARRANGEMENT_ROUNDOFF",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
     "BASIS_FEASIBILITY",
@@ -153,6 +155,19 @@ PYRAMID_PATTERN_NODES = 8192
 gives the proof to the SCIP search [-]: measured on the 8-edge pyramid, the benchmark's 3-D grasps of 4-8 contacts
 need 208-4822 (0.03-0.6 s), where SCIP took 0.2-30 s; of 240 random scenes of 2-4 contacts, 235 were decided
 within it. A node costs 90-130 us, so the budget wastes at most about a second before SCIP."""
+
+ARRANGEMENT_CONTACTS = 16
+"""Most contacts of a planar one-body problem the vertex certificate (:mod:`quasistatic.solvers.certify.arrangement`)
+is tried on [-]: it solves every triple of the up to ``2 m`` twist planes, C(32, 3) = 4960 3x3 systems at 16 contacts
+(a few milliseconds); past it the mode branch and bound decides alone."""
+
+ARRANGEMENT_ROUNDOFF = 1e-12
+"""Relative round-off of the vertex certificate's 3x3 solves [-]: three twist-plane normals whose determinant is below
+this fraction of the product of their lengths are dependent (they meet in a line, or not at all), a ray's rate along a
+plane below this fraction of their lengths' product is zero, and a computed vertex meets its planes to this fraction
+of ``|n| |w| + |r|``. A zero rate or a near plane only adds force generators (it can keep a vertex from being
+excluded, never exclude one); dependent normals are the one round-off assumption, as for the branch and bound's
+parallel lines: computed to 1e-16, normals this close to dependent meet 1e12 times farther than their offsets."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""

@@ -7,7 +7,10 @@
    On exact 3-D cones, rest with every mover still is proven the only motion
    on the circles themselves when it is (:mod:`.certify.rest`: the load cannot
    do work, so loaded contacts stick, and LPs or else SCIP find no other such motion).
-3. Planar and 3-D pyramid problems: a branch and bound over each contact's mode
+3. One planar body: the vertices of the contacts' twist planes (:mod:`.certify.arrangement`,
+   a few whole-array solves) prove Lemke's twist the only motion, or that none exists,
+   for most problems; otherwise, and for 3-D pyramids, step 4.
+4. Planar and 3-D pyramid problems: a branch and bound over each contact's mode
    (separating, rolling, sliding either way in 2-D; on a pyramid's vertex or
    face in 3-D), whose nodes are pruned by checked Farkas
    vectors (no forces balance the load), singular-value bounds on the twists
@@ -18,15 +21,15 @@
    each pattern that holds one gives a single twist or a continuum, its
    extremes measured by LPs). It needs no SCIP; where a pattern is too close
    to call, or past its node budget or ``max_solutions``, it proves nothing
-   and step 4 runs. On exact 3-D cones the same proof replaces the SCIP search
+   and step 5 runs. On exact 3-D cones the same proof replaces the SCIP search
    on the inscribed 8-edge pyramid wherever it decides (:mod:`.certify.exact_cone`).
-4. Otherwise the complete SCIP search of ``scip`` runs. For polyhedral cones
+5. Otherwise the complete SCIP search of ``scip`` runs. For polyhedral cones
    it starts from Lemke's point once every law of the search's own form is
    checked there, so SCIP only has to prove that no other motion exists
    (measured 10-20 % faster on 2-D grasps). The 8-edge pyramid search of exact
    3-D cones is not seeded: measured, its proof then took 1.4x longer.
 
-Everything not proven by steps 2-3 is decided by the same search as ``scip``, so
+Everything not proven by steps 2-4 is decided by the same search as ``scip``, so
 the answers are the same; prescribed modes go straight to it.
 """
 
@@ -34,6 +37,7 @@ from __future__ import annotations
 
 from ..laws import Problem, RawMotion
 from ..laws.polyhedral import aligned_edges, polyhedral_form
+from .certify.arrangement import NO_VERTEX_PROOF, VERTEX_PROOF, VertexVerdict, prove_by_vertices
 from .certify.cheap import exact_motion, kinematically_unique, seed_point
 from .certify.diagnose import diagnose
 from .certify.exact_cone import solve_exact_3d, unique_exact_motion
@@ -60,6 +64,12 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
     if seed is not None and kinematically_unique(problem, seed[: form.n_q]):
         motion = RawMotion(seed[: form.n_q], form.forces(seed))
         return summarise(form, [motion], True, options).with_notes(certificate=_KINEMATIC)
+    vertices = prove_by_vertices(form, seed)
+    if vertices.verdict is VertexVerdict.UNIQUE and vertices.seed is not None:
+        motion = RawMotion(vertices.seed[: form.n_q], form.forces(vertices.seed))
+        return summarise(form, [motion], True, options).with_notes(certificate=VERTEX_PROOF)
+    if vertices.verdict is VertexVerdict.NONE:
+        return diagnose(problem, edges, equilibrium=vertices.equilibrium).with_notes(certificate=NO_VERTEX_PROOF)
     proof = prove_by_patterns(form, seed, options.max_solutions, options.remaining)
     if proof.verdict is PatternVerdict.UNIQUE and proof.seed is not None:
         motion = RawMotion(proof.seed[: form.n_q], form.forces(proof.seed))

@@ -1,0 +1,410 @@
+"""A vertex certificate for one rigid body in the plane: the arrangement of the contacts' twist planes.
+
+**The laws as a plane arrangement.** One planar body (twist ``q`` in R^3), the
+polyhedral laws of :func:`~quasistatic.laws.polyhedral.polyhedral_form` (two
+edges per contact). Contact ``i`` has a gap-rate plane ``wn_i = Jn_i q - bn_i = 0``
+and, when it has friction, a slip plane ``s_i = Jt_i q - bt_i = 0``. A twist's
+*sign vector* (the sign of every plane's row at it) fixes the force generators
+each contact may use (:mod:`.patterns` lists the four modes of a contact):
+
+    wn > 0             none (separating)
+    wn = 0, s = 0      both cone edges n + mu t and n - mu t (rolling, or either sliding mode)
+    wn = 0, s < 0      the edge n + mu t (sliding +)
+    wn = 0, s > 0      the edge n - mu t (sliding -)
+
+(a frictionless contact: its normal whenever ``wn = 0``). Twist and forces
+share no unknown once the modes are fixed, so ``q`` is a motion exactly when
+``wn(q) >= 0`` and ``-g`` lies in the cone of the generators ``G(q)``: the
+union, per contact, of the generators of every mode ``q`` meets, which one
+mode assignment (each contact's largest) attains.
+
+**Faces.** The planes cut R^3 into faces (relatively open polyhedra of
+constant sign vector). ``G`` is constant on a face and only grows when a face
+is left for one in its boundary (a sign becomes 0), so the motions are a union
+of faces, closed under taking boundary faces. When the planes' normals span
+R^3 every face's closure is a pointed polyhedron; its vertices are vertices of
+the arrangement (points on three planes with independent normals) and its
+edges at a vertex are 1-faces of the arrangement (rays of the lines where two
+planes through it meet). Hence:
+
+1. no motion vertex means no motion (every motion face has a motion vertex);
+2. one motion vertex ``v``, and no motion edge leaving it, means ``v`` is the
+   only motion (a motion face of dimension >= 1 with ``v`` its only vertex is
+   ``v`` plus a pointed cone, whose extreme rays are motion edges at ``v``);
+3. two motion vertices, or a motion edge, mean more than one motion: the
+   listing is the branch and bound's, which runs unchanged.
+
+**With the tolerances of the rest of certify/.** The claims are made for the
+twists that meet every row to ``tau`` (``LP_FEASIBILITY``, what HiGHS and SCIP
+meet; ``ZERO``, as the seed is checked; and 0) and forces that balance the load
+to ``LP_FEASIBILITY`` per row with total below ``FORCE_CEILING``. Call such a
+twist a *loose motion*: ``wn >= -tau``, and the loads allowed by every mode
+whose rows it meets to ``tau`` (``G_tau(q)``, which only grows with ``tau``)
+are not excluded. Fix ``tau`` and split R^3 into *cells* of constant loose
+sign vector (0 where ``|row| <= tau``): each is a convex polyhedron, pointed,
+so a nonempty cell's closure has a vertex ``x`` on three of its bounding planes
+``row_p = +-tau`` with independent normals ``N_T`` (triple ``T``). The exact
+vertex ``w_T`` (``N_T w = r_T``, computed to round-off ``delta_T``) is within
+``(tau + delta_T) |N_T^-1|_1`` per entry of ``x``, so every plane ``p`` has
+``|row_p(x) - row_p(w_T)| <= (tau + delta_T) |n_p N_T^-1|_1``. Call ``p`` *near*
+``w_T`` when ``|row_p(w_T)|`` is at most ``tau`` plus that (plus round-off);
+a plane that is not near has the same sign at ``x`` as at ``w_T`` and is not
+within ``tau`` there. So the cell's loads are among ``G(sigma_T)``: the
+generators of ``w_T``'s sign vector with every near plane set to 0 (a gap row
+of ``w_T`` below ``-near`` puts no cell of loose ``Q0`` there). Therefore, at
+``tau = LP_FEASIBILITY`` (the nearer planes of a smaller ``tau`` only shrink
+the loads):
+
+- every triple whose ``G(sigma_T)`` a checked Farkas vector excludes (as in
+  :mod:`.patterns`: ``G^T y <= 0`` with the margins of ``LP_FEASIBILITY`` and
+  ``FORCE_CEILING``) holds no loose motion near it; when every triple is
+  excluded there is **no motion** (claim 1);
+- when the triples left (not excluded) all have ``w_T`` within ``SAME_TWIST / 2``
+  of Lemke's checked motion ``q*`` and ``|w_T - q*| + (tau + delta) |N_T^-1|_1``
+  within ``DISTINCT_TWIST / 2`` at ``tau = ZERO`` and within ``DISTINCT_TWIST``
+  at ``tau = LP_FEASIBILITY`` (the box the SCIP search excludes around a
+  motion, as :func:`~.cheap.kinematically_unique` bounds it), every cell whose
+  vertices lie near them is bounded: an unbounded one has a recession direction
+  ``d`` that keeps every near plane of ``w_T`` at its cell sign or on it; the
+  face of ``d`` in the central arrangement of the near planes' normals is a
+  pointed cone, one of whose extreme rays ``e`` (a line where two near planes
+  meet, ``+-n_a x n_b``, kept only where no near gap row falls along it) has a
+  sign vector with at least the zeros of the cell's, so ``G(e)`` holds the
+  cell's loads. So when every such ray's loads are excluded, every loose motion
+  lies in a bounded cell whose vertices are near ``q*``: the **only motion** is
+  ``q*`` (claim 2).
+
+Signs of ``n_p . e`` within round-off are taken as 0, and three normals whose
+determinant is within round-off of 0 as dependent (:data:`ARRANGEMENT_ROUNDOFF`):
+either only ever adds loads, so it can only keep a triple or a ray from being
+excluded. Which loads a cone holds is read from a table: for a few hundred
+candidate Farkas directions (``-g``, ``-g`` less its part along each load, and
+the normals of the planes two loads span, the directions the least-squares
+residual of ``-g`` from any cone of loads can take), the set of loads each
+excludes, as a bit mask; a set of loads is excluded when one direction's mask
+holds it. Anything else (no seed, a triple left far from it, a ray not
+excluded, normals that do not span R^3, more than :data:`ARRANGEMENT_CONTACTS`
+contacts) proves nothing here and the branch and bound runs as before.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import math
+from dataclasses import dataclass
+from enum import Enum
+
+import numpy as np
+from scipy.optimize import nnls
+
+from ...laws.polyhedral import LCPForm
+from ...tolerances import ARRANGEMENT_CONTACTS, ARRANGEMENT_ROUNDOFF, DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, SAME_TWIST, ZERO
+from .cheap import satisfies_form
+
+__all__ = ["VertexVerdict", "VertexProof", "prove_by_vertices", "VERTEX_PROOF", "NO_VERTEX_PROOF"]
+
+VERTEX_PROOF = (
+    "the found twist is the only motion vertex of the contacts' twist planes and no motion edge leaves it "
+    "(vertex certificate: 3x3 solves and checked Farkas vectors)"
+)
+NO_VERTEX_PROOF = "no vertex of the contacts' twist planes holds a motion (vertex certificate: 3x3 solves and checked Farkas vectors)"
+
+
+class VertexVerdict(Enum):
+    UNIQUE = "unique"  # every motion is the seed's twist
+    NONE = "none"  # no motion at all
+    UNDECIDED = "undecided"  # not applicable, several motions, or too close to call: the branch and bound decides
+
+
+@dataclass(frozen=True)
+class VertexProof:
+    """The verdict; for ``NONE``, whether equilibrium exists with every load (True: a balancing fit, False: a
+    checked Farkas vector, None: neither), as :class:`~.patterns.PatternProof` says it; the triples solved; for
+    ``UNIQUE``, the only motion (the caller's seed, or without one the vertex's, checked on every law of the form)."""
+
+    verdict: VertexVerdict
+    equilibrium: bool | None = None
+    triples: int = 0
+    seed: np.ndarray | None = None  # for ``UNIQUE``: the motion, a point ``[q, cn, beta, lam]`` of the form (checked)
+
+
+_UNDECIDED = VertexProof(VertexVerdict.UNDECIDED)
+
+
+@dataclass(frozen=True)
+class _Planes:
+    """The arrangement: ``normals`` (P, 3) and ``rhs`` (P,), gap rows first (one per contact), then the slip rows
+    of the frictional contacts (``frictional``: which contacts); ``crosses`` (P, P, 3): ``n_a x n_b``; ``triple``
+    (P, P * P): ``n_p . (n_a x n_b)`` at column ``a P + b``; ``loads`` (3, 2 m): a unit normal force on each
+    contact's edge ``+t`` (column ``2 i``) and ``-t`` (``2 i + 1``)."""
+
+    normals: np.ndarray
+    rhs: np.ndarray
+    lengths: np.ndarray
+    frictional: np.ndarray
+    crosses: np.ndarray
+    triple: np.ndarray
+    loads: np.ndarray
+
+    @functools.cached_property
+    def cross_lengths(self) -> np.ndarray:
+        """(P * P,): ``|n_a x n_b|`` at ``a P + b``."""
+        flat = self.crosses.reshape(-1, 3)
+        return np.sqrt(np.einsum("lj,lj->l", flat, flat))
+
+    @property
+    def m(self) -> int:
+        return int(self.frictional.size)
+
+
+def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None) -> VertexProof:
+    """Whether the only motion of the planar laws ``form`` is the twist of ``seed_x`` (a point ``[q, cn, beta, lam]``
+    every law of the form holds at, checked by the caller), or no motion exists; see the module docstring."""
+    problem = form.problem
+    m = problem.n_contacts
+    if problem.dimension != 2 or form.n_q != 3 or form.n_edges != 2 or not 0 < m <= ARRANGEMENT_CONTACTS:
+        return _UNDECIDED
+    planes = _planes(problem.J, problem.b, problem.mu)
+    excluded = _Exclusions.of(planes.loads, problem.g)
+    if excluded.every_load():  # no forces balance the load at all, whatever the twist
+        return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False)
+    vertices = _vertices(planes)
+    if vertices is None:
+        return _UNDECIDED  # the normals do not span R^3: every motion lies on a line of motions
+    kinds, kind_of = np.unique(_load_masks(planes, vertices.signs), return_inverse=True)
+    held = np.flatnonzero(~excluded.excludes(kinds)[kind_of])
+    if not held.size:
+        if seed_x is not None:
+            return _UNDECIDED  # a checked motion, yet every vertex excluded: too close to call
+        return VertexProof(VertexVerdict.NONE, excluded.equilibrium(), vertices.count)
+    seed_x = seed_x if seed_x is not None else _vertex_point(form, planes, vertices, held)
+    if seed_x is None or not _near_seed(vertices, held, seed_x[:3]):
+        return _UNDECIDED
+    if not _edges_excluded(planes, vertices.signs[held], excluded):
+        return _UNDECIDED
+    return VertexProof(VertexVerdict.UNIQUE, None, vertices.count, seed_x)
+
+
+def _planes(J: np.ndarray, b: np.ndarray, mu: np.ndarray) -> _Planes:
+    """The planes of the planar laws ``J`` (m, 2, 3), ``b`` (m, 2) (tangent row, then normal), friction ``mu``."""
+    frictional = mu > 0.0
+    Jt, Jn = J[:, 0], J[:, 1]
+    normals = np.concatenate((Jn, Jt[frictional]))
+    crosses = _all_crosses(normals)
+    P = normals.shape[0]
+    triple = normals @ crosses.reshape(P * P, 3).T
+    lengths = np.sqrt(np.einsum("pj,pj->p", normals, normals))
+    rhs = np.concatenate((b[:, 1], b[frictional, 0]))
+    return _Planes(normals, rhs, lengths, frictional, crosses, triple, _loads(Jn, mu[:, None] * Jt))
+
+
+def _all_crosses(vectors: np.ndarray) -> np.ndarray:
+    """(k, k, 3): ``u_a x u_b`` for every pair of the rows ``u`` of ``vectors`` (k, 3), in two matrix products:
+    ``u_a x v = S_a v`` with ``S_a = sum_j u_a[j] EPSILON[j]`` (the Levi-Civita symbol)."""
+    k = vectors.shape[0]
+    return ((vectors @ _EPSILON).reshape(k * 3, 3) @ vectors.T).reshape(k, 3, k).transpose(0, 2, 1)
+
+
+def _loads(Jn: np.ndarray, friction: np.ndarray) -> np.ndarray:
+    """(3, 2 m): the edges ``n + mu t`` and ``n - mu t`` of each contact, as patterns.py orders them."""
+    loads = np.empty((3, 2 * Jn.shape[0]))
+    loads[:, 0::2] = (Jn + friction).T
+    loads[:, 1::2] = (Jn - friction).T
+    return loads
+
+
+def _levi_civita() -> np.ndarray:
+    """(3, 9): row ``j``, column ``3 i + k``: the Levi-Civita symbol ``eps_ijk``, so ``(n @ E)[3 i + k]`` is ``[n]_x``."""
+    epsilon = np.zeros((3, 3, 3))
+    for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+        epsilon[j, i, k], epsilon[j, k, i] = 1.0, -1.0
+    return epsilon.reshape(3, 9)
+
+
+_EPSILON = _levi_civita()
+
+
+@dataclass(frozen=True)
+class _Vertices:
+    """The vertices ``w`` (V, 3) of the independent triples whose gap rows are not below their margin; ``signs``
+    (V, P): each plane's sign there, 0 where it is near (see the module docstring) at ``tau = LP_FEASIBILITY``;
+    ``spread`` (V, 3): ``|N_T^-1|_1`` per twist entry, and ``slack`` (V,) the triple's own round-off."""
+
+    w: np.ndarray
+    signs: np.ndarray
+    spread: np.ndarray
+    slack: np.ndarray
+    count: int
+
+
+@functools.cache
+def _triples(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every triple ``i < j < k`` of ``count`` indices, (T, 3), and the columns of :attr:`_Planes.triple` of its
+    adjugate's rows ``n_j x n_k``, ``n_k x n_i``, ``n_i x n_j`` (3, T)."""
+    triples = np.array(list(itertools.combinations(range(count), 3)), dtype=np.intp).reshape(-1, 3)
+    i, j, k = triples.T
+    return triples, np.stack([j * count + k, k * count + i, i * count + j])
+
+
+def _vertices(planes: _Planes) -> _Vertices | None:
+    """Every vertex of the arrangement (one per independent triple) in loose ``Q0``, or None when no triple is
+    independent (the normals do not span R^3).
+
+    With ``X_k`` the adjugate's rows (cross products of the other two normals), ``N_T^-1 = [X_0 X_1 X_2] / det``,
+    so each plane's rate along ``N_T^-1``'s columns is a triple product ``n_p . X_k / det``, read off a table. A
+    vertex is dropped from ``Q0`` first on a bound of its margin (``|n_p . X_k| <= |n_p| |X_k|``), then on the
+    margin itself."""
+    rhs, lengths, m = planes.rhs, planes.lengths, planes.m
+    P = rhs.size
+    if P < 3:
+        return None
+    triples, columns = _triples(P)
+    det = planes.triple[triples[:, 0], columns[0]]
+    size = lengths[triples[:, 0]] * lengths[triples[:, 1]] * lengths[triples[:, 2]]
+    independent = np.abs(det) > ARRANGEMENT_ROUNDOFF * size
+    if not independent.any():
+        return None
+    columns, det = columns[:, independent], det[independent]
+    r = rhs[triples[independent]].T  # (3, T)
+    inverse = planes.crosses.reshape(P * P, 3)[columns] / det[:, None]  # (3, T, 3): column k of N_T^-1
+    w = r[0, :, None] * inverse[0] + r[1, :, None] * inverse[1] + r[2, :, None] * inverse[2]
+    spread = np.abs(inverse).sum(axis=0)  # (T, 3): per twist entry, sum over k of |N_T^-1[j, k]|
+    magnitude = np.abs(w).sum(axis=1)
+    slack = ARRANGEMENT_ROUNDOFF * (lengths.max() * magnitude + np.abs(r).max(axis=0))
+    gaps = planes.normals[:m] @ w.T - rhs[:m, None]
+    reach = planes.cross_lengths[columns].sum(axis=0) / np.abs(det)  # sum_k |X_k| / |det|
+    roundoff = ARRANGEMENT_ROUNDOFF * (lengths[:, None] * magnitude + np.abs(rhs)[:, None])
+    bound = (LP_FEASIBILITY + slack) * (1.0 + lengths[:m, None] * reach) + roundoff[:m]
+    kept = np.flatnonzero((gaps >= -bound).all(axis=0))
+    products = planes.triple[:, columns[:, kept]] / det[kept]  # (P, 3, K): n_p . N_T^-1[:, k]
+    rows = planes.normals @ w[kept].T - rhs[:, None]
+    near = (LP_FEASIBILITY + slack[kept]) * (1.0 + np.abs(products).sum(axis=1)) + roundoff[:, kept]
+    signs = (rows > near).view(np.int8) - (rows < -near).view(np.int8)
+    in_q0 = (signs[:m] >= 0).all(axis=0)  # loose Q0
+    kept = kept[in_q0]
+    return _Vertices(w[kept], signs[:, in_q0].T, spread[kept], slack[kept], int(det.size))
+
+
+def _load_masks(planes: _Planes, signs: np.ndarray) -> np.ndarray:
+    """Per sign vector (rows of ``signs``, 0 on every near plane), the loads its contacts may use, as bit masks
+    (load ``k``, bit ``k``): a closed contact's two bits ``b = 1`` (``+t``, sliding +), ``2`` (``-t``) or ``3``."""
+    m = planes.m
+    slip = np.zeros((signs.shape[0], m), dtype=np.int8)
+    slip[:, planes.frictional] = signs[:, m:]
+    bits = _EDGE_BITS[slip + 1] * (signs[:, :m] == 0)
+    return (bits @ _weights(m)).astype(np.uint64)
+
+
+_EDGE_BITS = np.array([1.0, 3.0, 2.0])  # by slip sign -1, 0, +1: the edge n + mu t, both, the edge n - mu t
+
+
+@functools.cache
+def _weights(m: int) -> np.ndarray:
+    """``4^i`` for each of ``m`` contacts, as floats (exact up to 2^53: at most 26 contacts)."""
+    return 4.0 ** np.arange(m)
+
+
+@dataclass(frozen=True)
+class _Exclusions:
+    """Candidate Farkas directions ``y`` and, per direction, the loads it excludes (``blocked``, bit masks): ``y``
+    excludes a set ``S`` of loads when ``-g.y - margin |y| > max(G_S^T y, 0) FORCE_CEILING`` (as
+    :mod:`.patterns` checks its vectors), i.e. when ``S`` lies in the mask."""
+
+    loads: np.ndarray
+    g: np.ndarray
+    blocked: np.ndarray
+
+    @classmethod
+    def of(cls, loads: np.ndarray, g: np.ndarray) -> _Exclusions:
+        count = loads.shape[1]
+        columns = loads.T
+        i, j = _pairs(count)
+        normals = _all_crosses(columns)[i, j]  # of the planes two loads span
+        square = np.einsum("kj,kj->k", columns, columns)
+        along = -g - ((columns @ -g) / np.maximum(square, 1e-300))[:, None] * columns  # -g less its part along a load
+        directions = np.concatenate((-g[None, :], along, normals, -normals))
+        reserve = directions @ -g - _margin(g) * np.sqrt(np.einsum("yj,yj->y", directions, directions))
+        useful = reserve > 0.0
+        blocked = (directions[useful] @ loads) * FORCE_CEILING < reserve[useful, None]
+        return cls(loads, g, (blocked @ 2.0 ** np.arange(count)).astype(np.uint64))
+
+    def excludes(self, masks: np.ndarray) -> np.ndarray:
+        """Whether a direction excludes each set of loads (bit masks)."""
+        return ((masks[:, None] & ~self.blocked[None, :]) == 0).any(axis=1)
+
+    def every_load(self) -> bool:
+        """Whether a direction excludes every load at once: no forces at all balance the load."""
+        return bool(self.excludes(np.array([2 ** self.loads.shape[1] - 1], dtype=np.uint64))[0])
+
+    def equilibrium(self) -> bool | None:
+        """With every load: False when excluded, True when a non-negative fit balances the load to the margin, None
+        otherwise (the caller's LP decides), as the branch and bound's root says it."""
+        if self.every_load():
+            return False
+        _, residual = nnls(self.loads, -self.g)
+        return True if residual <= _margin(self.g) else None
+
+
+@functools.cache
+def _pairs(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair ``i < j`` of ``count`` indices."""
+    return np.triu_indices(count, 1)
+
+
+def _margin(g: np.ndarray) -> float:
+    """How far from the load a balancing fit may be (``LP_FEASIBILITY`` per row) [-]."""
+    return math.sqrt(g.size) * LP_FEASIBILITY
+
+
+_LOOSENESS = np.array([0.0, ZERO, LP_FEASIBILITY])[:, None, None]  # the tau of each claim on the twist
+_WITHIN = np.array([0.5 * SAME_TWIST, 0.5 * DISTINCT_TWIST, DISTINCT_TWIST])  # and how near the seed it puts them
+
+
+def _vertex_point(form: LCPForm, planes: _Planes, vertices: _Vertices, held: np.ndarray) -> np.ndarray | None:
+    """Without Lemke's point: the held vertex best computed (least ``|N_T^-1|_1``), with non-negative forces on its
+    loads (least squares), as a point ``[q, cn, beta, lam]`` of the form when every law of the form holds there
+    (:func:`~.cheap.satisfies_form`, as Lemke's point is checked), else None."""
+    best = held[np.argmin(vertices.spread[held].max(axis=1))]
+    q = vertices.w[best]
+    mask = int(_load_masks(planes, vertices.signs[best : best + 1])[0])
+    allowed = np.array([(mask >> k) & 1 for k in range(planes.loads.shape[1])], dtype=bool)
+    fit = np.zeros(allowed.size)
+    fit[allowed], _ = nnls(planes.loads[:, allowed], -form.problem.g)
+    m = planes.m
+    per_edge = fit.reshape(m, 2)
+    slip = form.problem.Jt[:, 0, :] @ q - form.problem.bt[:, 0]
+    x = np.concatenate([q, per_edge.sum(axis=1), (form.problem.mu[:, None] * per_edge).ravel(), np.abs(slip)])
+    pairs = x[3:]  # forces and slip speeds, all >= 0: round-off to exact zeros, as Lemke's pivots leave them
+    pairs[pairs <= ZERO] = 0.0
+    return x if satisfies_form(form, x) else None
+
+
+def _near_seed(vertices: _Vertices, held: np.ndarray, q: np.ndarray) -> bool:
+    """Whether every vertex not excluded is the seed's twist ``q``, with the loose twists near it: within
+    ``SAME_TWIST / 2`` exactly, ``DISTINCT_TWIST / 2`` at ``tau = ZERO`` and ``DISTINCT_TWIST`` at ``LP_FEASIBILITY``."""
+    offset = np.abs(vertices.w[held] - q)
+    reach = offset + (_LOOSENESS + vertices.slack[held, None]) * vertices.spread[held]  # (3, H, 3)
+    return bool((reach.max(axis=(1, 2)) <= _WITHIN).all())
+
+
+def _edges_excluded(planes: _Planes, signs: np.ndarray, excluded: _Exclusions) -> bool:
+    """Whether every ray leaving the vertices not excluded (each a sign vector, 0 on its near planes), along a
+    line where two near planes meet and kept in loose ``Q0``, has its loads excluded."""
+    P, m = planes.rhs.size, planes.m
+    masks = []
+    for sign in {row.tobytes(): row for row in signs}.values():
+        near = np.flatnonzero(sign == 0)
+        i, j = _pairs(near.size)
+        a, b = near[i], near[j]
+        lines = planes.crosses[a, b]
+        line_length = np.sqrt(np.einsum("lj,lj->l", lines, lines))
+        kept = line_length > ARRANGEMENT_ROUNDOFF * planes.lengths[a] * planes.lengths[b]
+        along = planes.triple[near[:, None], (a * P + b)[kept]].T  # (L, k): n_p . (n_a x n_b), p near
+        along[np.abs(along) <= ARRANGEMENT_ROUNDOFF * line_length[kept, None] * planes.lengths[near]] = 0.0
+        rays = np.concatenate((along, -along))
+        rays = rays[(rays[:, near < m] >= 0.0).all(axis=1)]  # no near gap row falls along it
+        ray_signs = np.repeat(sign[None, :], rays.shape[0], axis=0)
+        ray_signs[:, near] = np.sign(rays)
+        masks.append(_load_masks(planes, ray_signs))
+    return bool(excluded.excludes(np.concatenate(masks)).all())
