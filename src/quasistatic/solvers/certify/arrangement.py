@@ -63,7 +63,8 @@ the loads):
   of Lemke's checked motion ``q*`` and ``|w_T - q*| + (tau + delta) |N_T^-1|_1``
   within ``DISTINCT_TWIST / 2`` at ``tau = ZERO`` and within ``DISTINCT_TWIST``
   at ``tau = LP_FEASIBILITY`` (the box the SCIP search excludes around a
-  motion, as :func:`~.cheap.kinematically_unique` bounds it), every cell whose
+  motion, as :func:`~.cheap.kinematically_unique` bounds it; a cell's vertices
+  each lie near a triple whose loads hold the cell's, so a held one), every cell whose
   vertices lie near them is bounded: an unbounded one has a recession direction
   ``d`` that keeps every near plane of ``w_T`` at its cell sign or on it; the
   face of ``d`` in the central arrangement of the near planes' normals is a
@@ -74,17 +75,28 @@ the loads):
   lies in a bounded cell whose vertices are near ``q*``: the **only motion** is
   ``q*`` (claim 2).
 
-Signs of ``n_p . e`` within round-off are taken as 0, and three normals whose
-determinant is within round-off of 0 as dependent (:data:`ARRANGEMENT_ROUNDOFF`):
-either only ever adds loads, so it can only keep a triple or a ray from being
-excluded. Which loads a cone holds is read from a table: for a few hundred
-candidate Farkas directions (``-g``, ``-g`` less its part along each load, and
-the normals of the planes two loads span, the directions the least-squares
-residual of ``-g`` from any cone of loads can take), the set of loads each
-excludes, as a bit mask; a set of loads is excluded when one direction's mask
-holds it. Anything else (no seed, a triple left far from it, a ray not
-excluded, normals that do not span R^3, more than :data:`ARRANGEMENT_CONTACTS`
-contacts) proves nothing here and the branch and bound runs as before.
+A sign of ``n_p . e`` within round-off is taken as 0, which only adds loads
+(it can keep a ray from being excluded, never exclude one). Three normals whose
+determinant is within round-off of 0 are taken as dependent
+(:data:`ARRANGEMENT_ROUNDOFF`): the one round-off assumption, as the branch and
+bound takes lines within round-off of parallel as parallel.
+
+**Cheaply.** All triples at once: the triple products ``n_p . (n_a x n_b)``
+of every plane with every pair are one table (two matrix products), from which
+each triple's determinant, its inverse's columns and every plane's rate along
+them are read off. Which loads a cone holds is read from a second table: for
+a few hundred candidate Farkas directions (``-g``; ``-g`` less its part along
+each load; the normals of the planes two loads span, both ways: the directions
+the least-squares residual of ``-g`` from any cone of loads can take), the set
+of loads each excludes, as a bit mask; a set of loads is excluded when one
+direction's mask holds it (one bitwise test per pair). When no forces at all
+balance the load (every load excluded) no twist is needed to say so. Without
+Lemke's point, the held vertex best computed becomes the seed when its twist
+with non-negative least-squares forces on its loads satisfies every law of the
+form (:func:`~.cheap.satisfies_form`, as Lemke's point is checked). Anything
+else (a held triple far from the seed, a ray not excluded, normals that do not
+span R^3, more than :data:`ARRANGEMENT_CONTACTS` contacts) proves nothing
+here, and the branch and bound runs as before.
 """
 
 from __future__ import annotations
