@@ -163,10 +163,10 @@ is tried on [-]: it solves every triple of the up to ``2 m`` twist planes, C(32,
 
 ARRANGEMENT_ROUNDOFF = 1e-12
 """Relative round-off of the vertex certificate's 3x3 solves [-]: three twist-plane normals whose determinant is below
-this fraction of the product of their lengths are dependent (they meet in a line, or not at all), a ray's rate along a
-plane below this fraction of their lengths' product is zero, and a computed vertex meets its planes to this fraction
-of ``|n| |w| + |r|``. A zero rate or a near plane only adds force generators (it can keep a vertex from being
-excluded, never exclude one); dependent normals are the one round-off assumption, as for the branch and bound's
+this fraction of the longest normal's cube are dependent (they meet in a line, or not at all; scene-relative normals
+have lengths 1 to 2), a ray's rate along a plane below it is zero, and a computed vertex meets its planes to this
+fraction of ``|n| |w|_1 + |r|``. A zero rate or a near plane only adds force generators (it can keep a vertex from
+being excluded, never exclude one); dependent normals are the one round-off assumption, as for the branch and bound's
 parallel lines: computed to 1e-16, normals this close to dependent meet 1e12 times farther than their offsets."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12

@@ -153,17 +153,19 @@ class _Planes:
 
     normals: np.ndarray
     rhs: np.ndarray
-    lengths: np.ndarray
     frictional: np.ndarray
     crosses: np.ndarray
     triple: np.ndarray
     loads: np.ndarray
 
-    @functools.cached_property
-    def cross_lengths(self) -> np.ndarray:
-        """(P * P,): ``|n_a x n_b|`` at ``a P + b``."""
-        flat = self.crosses.reshape(-1, 3)
-        return np.sqrt(np.einsum("lj,lj->l", flat, flat))
+    longest: float  # the longest normal's length
+    largest_offset: float  # the largest |rhs|
+    dependent: float  # three normals whose determinant is at most this are dependent: round-off of the longest's cube
+
+    @property
+    def flat_crosses(self) -> np.ndarray:
+        """(P * P, 3): ``n_a x n_b`` at ``a P + b``."""
+        return self.crosses.reshape(-1, 3)
 
     @property
     def m(self) -> int:
@@ -184,8 +186,7 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None) -> VertexProof:
     vertices = _vertices(planes)
     if vertices is None:
         return _UNDECIDED  # the normals do not span R^3: every motion lies on a line of motions
-    kinds, kind_of = np.unique(_load_masks(planes, vertices.signs), return_inverse=True)
-    held = np.flatnonzero(~excluded.excludes(kinds)[kind_of])
+    held = np.flatnonzero(~excluded.excludes(_load_masks(planes, vertices.signs)))
     if not held.size:
         if seed_x is not None:
             return _UNDECIDED  # a checked motion, yet every vertex excluded: too close to call
@@ -206,16 +207,18 @@ def _planes(J: np.ndarray, b: np.ndarray, mu: np.ndarray) -> _Planes:
     crosses = _all_crosses(normals)
     P = normals.shape[0]
     triple = normals @ crosses.reshape(P * P, 3).T
-    lengths = np.sqrt(np.einsum("pj,pj->p", normals, normals))
+    longest = math.sqrt(float(np.einsum("pj,pj->p", normals, normals).max()))
     rhs = np.concatenate((b[:, 1], b[frictional, 0]))
-    return _Planes(normals, rhs, lengths, frictional, crosses, triple, _loads(Jn, mu[:, None] * Jt))
+    offset = float(np.abs(rhs).max())
+    loads = _loads(Jn, mu[:, None] * Jt)
+    return _Planes(normals, rhs, frictional, crosses, triple, loads, longest, offset, ARRANGEMENT_ROUNDOFF * longest**3)
 
 
 def _all_crosses(vectors: np.ndarray) -> np.ndarray:
     """(k, k, 3): ``u_a x u_b`` for every pair of the rows ``u`` of ``vectors`` (k, 3), in two matrix products:
     ``u_a x v = S_a v`` with ``S_a = sum_j u_a[j] EPSILON[j]`` (the Levi-Civita symbol)."""
     k = vectors.shape[0]
-    return ((vectors @ _EPSILON).reshape(k * 3, 3) @ vectors.T).reshape(k, 3, k).transpose(0, 2, 1)
+    return np.ascontiguousarray(((vectors @ _EPSILON).reshape(k * 3, 3) @ vectors.T).reshape(k, 3, k).transpose(0, 2, 1))
 
 
 def _loads(Jn: np.ndarray, friction: np.ndarray) -> np.ndarray:
@@ -264,46 +267,41 @@ def _vertices(planes: _Planes) -> _Vertices | None:
     independent (the normals do not span R^3).
 
     With ``X_k`` the adjugate's rows (cross products of the other two normals), ``N_T^-1 = [X_0 X_1 X_2] / det``,
-    so each plane's rate along ``N_T^-1``'s columns is a triple product ``n_p . X_k / det``, read off a table. A
-    vertex is dropped from ``Q0`` first on a bound of its margin (``|n_p . X_k| <= |n_p| |X_k|``), then on the
-    margin itself."""
-    rhs, lengths, m = planes.rhs, planes.lengths, planes.m
+    so each plane's rate along ``N_T^-1``'s columns is a triple product ``n_p . X_k / det``, read off a table.
+    The round-off of a vertex's rows, ``ARRANGEMENT_ROUNDOFF (|n| |w|_1 + |r|)`` at the longest normal and
+    largest offset, is added to its margin, and to the margin's ``tau``."""
+    rhs, m = planes.rhs, planes.m
     P = rhs.size
     if P < 3:
         return None
     triples, columns = _triples(P)
     det = planes.triple[triples[:, 0], columns[0]]
-    size = lengths[triples[:, 0]] * lengths[triples[:, 1]] * lengths[triples[:, 2]]
-    independent = np.abs(det) > ARRANGEMENT_ROUNDOFF * size
-    if not independent.any():
-        return None
-    columns, det = columns[:, independent], det[independent]
-    r = rhs[triples[independent]].T  # (3, T)
-    inverse = planes.crosses.reshape(P * P, 3)[columns] / det[:, None]  # (3, T, 3): column k of N_T^-1
-    w = r[0, :, None] * inverse[0] + r[1, :, None] * inverse[1] + r[2, :, None] * inverse[2]
-    spread = np.abs(inverse).sum(axis=0)  # (T, 3): per twist entry, sum over k of |N_T^-1[j, k]|
-    magnitude = np.abs(w).sum(axis=1)
-    slack = ARRANGEMENT_ROUNDOFF * (lengths.max() * magnitude + np.abs(r).max(axis=0))
-    gaps = planes.normals[:m] @ w.T - rhs[:m, None]
-    reach = planes.cross_lengths[columns].sum(axis=0) / np.abs(det)  # sum_k |X_k| / |det|
-    roundoff = ARRANGEMENT_ROUNDOFF * (lengths[:, None] * magnitude + np.abs(rhs)[:, None])
-    bound = (LP_FEASIBILITY + slack) * (1.0 + lengths[:m, None] * reach) + roundoff[:m]
-    kept = np.flatnonzero((gaps >= -bound).all(axis=0))
-    products = planes.triple[:, columns[:, kept]] / det[kept]  # (P, 3, K): n_p . N_T^-1[:, k]
-    rows = planes.normals @ w[kept].T - rhs[:, None]
-    near = (LP_FEASIBILITY + slack[kept]) * (1.0 + np.abs(products).sum(axis=1)) + roundoff[:, kept]
+    independent = np.abs(det) > planes.dependent
+    if not independent.all():
+        if not independent.any():
+            return None
+        triples, columns, det = triples[independent], columns[:, independent], det[independent]
+    products = planes.triple[:, columns] / det  # (P, 3, T): n_p . N_T^-1[:, k]
+    r = rhs[triples].T  # (3, T)
+    rows = np.einsum("pkt,kt->pt", products, r) - rhs[:, None]
+    w = np.einsum("kt,ktj->tj", r, planes.flat_crosses[columns]) / det[:, None]
+    slack = ARRANGEMENT_ROUNDOFF * (planes.longest * np.abs(w).sum(axis=1) + planes.largest_offset)
+    near = (LP_FEASIBILITY + slack) * (1.0 + np.abs(products).sum(axis=1)) + slack
     signs = (rows > near).view(np.int8) - (rows < -near).view(np.int8)
-    in_q0 = (signs[:m] >= 0).all(axis=0)  # loose Q0
-    kept = kept[in_q0]
-    return _Vertices(w[kept], signs[:, in_q0].T, spread[kept], slack[kept], int(det.size))
+    kept = (signs[:m] >= 0).all(axis=0)  # loose Q0
+    spread = np.abs(planes.flat_crosses[columns[:, kept]]).sum(axis=0) / np.abs(det[kept, None])  # sum_k |N_T^-1[j, k]|
+    return _Vertices(w[kept], signs[:, kept].T, spread, slack[kept], int(det.size))
 
 
 def _load_masks(planes: _Planes, signs: np.ndarray) -> np.ndarray:
     """Per sign vector (rows of ``signs``, 0 on every near plane), the loads its contacts may use, as bit masks
     (load ``k``, bit ``k``): a closed contact's two bits ``b = 1`` (``+t``, sliding +), ``2`` (``-t``) or ``3``."""
     m = planes.m
-    slip = np.zeros((signs.shape[0], m), dtype=np.int8)
-    slip[:, planes.frictional] = signs[:, m:]
+    if signs.shape[1] == 2 * m:  # every contact has friction
+        slip = signs[:, m:]
+    else:
+        slip = np.zeros((signs.shape[0], m), dtype=np.int8)
+        slip[:, planes.frictional] = signs[:, m:]
     bits = _EDGE_BITS[slip + 1] * (signs[:, :m] == 0)
     return (bits @ _weights(m)).astype(np.uint64)
 
@@ -402,18 +400,18 @@ def _near_seed(vertices: _Vertices, held: np.ndarray, q: np.ndarray) -> bool:
 
 def _edges_excluded(planes: _Planes, signs: np.ndarray, excluded: _Exclusions) -> bool:
     """Whether every ray leaving the vertices not excluded (each a sign vector, 0 on its near planes), along a
-    line where two near planes meet and kept in loose ``Q0``, has its loads excluded."""
+    line where two near planes meet and kept in loose ``Q0``, has its loads excluded. A rate along a plane within
+    round-off of the longest normals' (``ARRANGEMENT_ROUNDOFF`` of their cube) is taken as 0: it only adds loads."""
     P, m = planes.rhs.size, planes.m
     masks = []
     for sign in {row.tobytes(): row for row in signs}.values():
         near = np.flatnonzero(sign == 0)
         i, j = _pairs(near.size)
-        a, b = near[i], near[j]
-        lines = planes.crosses[a, b]
-        line_length = np.sqrt(np.einsum("lj,lj->l", lines, lines))
-        kept = line_length > ARRANGEMENT_ROUNDOFF * planes.lengths[a] * planes.lengths[b]
-        along = planes.triple[near[:, None], (a * P + b)[kept]].T  # (L, k): n_p . (n_a x n_b), p near
-        along[np.abs(along) <= ARRANGEMENT_ROUNDOFF * line_length[kept, None] * planes.lengths[near]] = 0.0
+        pair = near[i] * P + near[j]
+        lines = planes.flat_crosses[pair]
+        pair = pair[np.einsum("lj,lj->l", lines, lines) > planes.dependent**2 / planes.longest**2]  # not parallel
+        along = planes.triple[near[:, None], pair].T  # (L, k): n_p . (n_a x n_b), p near
+        along[np.abs(along) <= planes.dependent] = 0.0
         rays = np.concatenate((along, -along))
         rays = rays[(rays[:, near < m] >= 0.0).all(axis=1)]  # no near gap row falls along it
         ray_signs = np.repeat(sign[None, :], rays.shape[0], axis=0)
