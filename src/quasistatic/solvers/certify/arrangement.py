@@ -302,7 +302,7 @@ def _load_masks(planes: _Planes, signs: np.ndarray) -> np.ndarray:
     else:
         slip = np.zeros((signs.shape[0], m), dtype=np.int8)
         slip[:, planes.frictional] = signs[:, m:]
-    bits = _EDGE_BITS[slip + 1] * (signs[:, :m] == 0)
+    bits = np.take(_EDGE_BITS, slip.astype(np.intp) + 1) * (signs[:, :m] == 0)
     return (bits @ _weights(m)).astype(np.uint64)
 
 
