@@ -69,7 +69,9 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
         motion = RawMotion(vertices.seed[: form.n_q], form.forces(vertices.seed))
         return summarise(form, [motion], True, options).with_notes(certificate=VERTEX_PROOF)
     if vertices.verdict is VertexVerdict.NONE:
-        return diagnose(problem, edges, equilibrium=vertices.equilibrium).with_notes(certificate=NO_VERTEX_PROOF)
+        return diagnose(problem, edges, equilibrium=vertices.equilibrium, admissible=vertices.admissible).with_notes(
+            certificate=NO_VERTEX_PROOF
+        )
     proof = prove_by_patterns(form, seed, options.max_solutions, options.remaining)
     if proof.verdict is PatternVerdict.UNIQUE and proof.seed is not None:
         motion = RawMotion(proof.seed[: form.n_q], form.forces(proof.seed))

@@ -113,6 +113,7 @@ from scipy.optimize import nnls
 from ...laws.polyhedral import LCPForm
 from ...tolerances import ARRANGEMENT_CONTACTS, ARRANGEMENT_ROUNDOFF, DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, SAME_TWIST, ZERO
 from .cheap import satisfies_form
+from .diagnose import admits_no_multipliers
 
 __all__ = ["VertexVerdict", "VertexProof", "prove_by_vertices", "VERTEX_PROOF", "NO_VERTEX_PROOF"]
 
@@ -139,6 +140,7 @@ class VertexProof:
     equilibrium: bool | None = None
     triples: int = 0
     seed: np.ndarray | None = None  # for ``UNIQUE``: the motion, a point ``[q, cn, beta, lam]`` of the form (checked)
+    admissible: bool = False  # for ``NONE``: a vertex keeps every contact closed or opening (no kinematic certificate)
 
 
 _UNDECIDED = VertexProof(VertexVerdict.UNDECIDED)
@@ -190,7 +192,7 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None) -> VertexProof:
     if not held.size:
         if seed_x is not None:
             return _UNDECIDED  # a checked motion, yet every vertex excluded: too close to call
-        return VertexProof(VertexVerdict.NONE, excluded.equilibrium(), vertices.count)
+        return VertexProof(VertexVerdict.NONE, excluded.equilibrium(), vertices.count, admissible=_admissible(planes, vertices))
     seed_x = seed_x if seed_x is not None else _vertex_point(form, planes, vertices, held)
     if seed_x is None or not _near_seed(vertices, held, seed_x[:3]):
         return _UNDECIDED
@@ -244,13 +246,15 @@ _EPSILON = _levi_civita()
 class _Vertices:
     """The vertices ``w`` (V, 3) of the independent triples whose gap rows are not below their margin; ``signs``
     (V, P): each plane's sign there, 0 where it is near (see the module docstring) at ``tau = LP_FEASIBILITY``;
-    ``spread`` (V, 3): ``|N_T^-1|_1`` per twist entry, and ``slack`` (V,) the triple's own round-off."""
+    ``spread`` (V, 3): ``|N_T^-1|_1`` per twist entry, and ``slack`` (V,) the triple's own round-off (of its rows
+    at ``w``, and of the exact vertex's rows)."""
 
     w: np.ndarray
     signs: np.ndarray
     spread: np.ndarray
     slack: np.ndarray
     count: int
+    triples: np.ndarray  # (V, 3): each vertex's planes
 
 
 @functools.cache
@@ -290,7 +294,7 @@ def _vertices(planes: _Planes) -> _Vertices | None:
     signs = (rows > near).view(np.int8) - (rows < -near).view(np.int8)
     kept = (signs[:m] >= 0).all(axis=0)  # loose Q0
     spread = np.abs(planes.flat_crosses[columns[:, kept]]).sum(axis=0) / np.abs(det[kept, None])  # sum_k |N_T^-1[j, k]|
-    return _Vertices(w[kept], signs[:, kept].T, spread, slack[kept], int(det.size))
+    return _Vertices(w[kept], signs[:, kept].T, spread, slack[kept], int(det.size), triples[kept])
 
 
 def _load_masks(planes: _Planes, signs: np.ndarray) -> np.ndarray:
@@ -388,6 +392,23 @@ def _vertex_point(form: LCPForm, planes: _Planes, vertices: _Vertices, held: np.
     pairs = x[3:]  # forces and slip speeds, all >= 0: round-off to exact zeros, as Lemke's pivots leave them
     pairs[pairs <= ZERO] = 0.0
     return x if satisfies_form(form, x) else None
+
+
+def _admissible(planes: _Planes, vertices: _Vertices) -> bool:
+    """Whether an exact vertex keeps every contact closed or opening, near enough for
+    :func:`~.diagnose.admits_no_multipliers`. Its own triple's rows are 0 there; another gap row, computed at the
+    computed vertex ``w``, is off by its evaluation's round-off plus ``|n_p N_T^-1|_1`` times the triple's residual
+    (round-off of ``|n| |w|_1`` and the triple's offsets: 0 where both are, as at rest with still movers)."""
+    m, w = planes.m, vertices.w
+    gaps = planes.normals[:m] @ w.T - planes.rhs[:m, None]  # (m, V)
+    own = (vertices.triples[None, :, :] == np.arange(m)[:, None, None]).any(axis=2)  # (m, V): the triple's gap rows
+    size = np.abs(w).sum(axis=1)
+    residual = ARRANGEMENT_ROUNDOFF * (planes.longest * size + np.abs(planes.rhs[vertices.triples]).max(axis=1))
+    drift = math.sqrt(3.0) * planes.longest * vertices.spread.max(axis=1) * residual  # |n_p (w_T - w)|
+    evaluation = ARRANGEMENT_ROUNDOFF * (planes.longest * size + np.abs(planes.rhs[:m, None]))
+    opening = (own | (gaps >= drift + evaluation)).all(axis=0)
+    exact = np.where(own, 0.0, gaps + drift + evaluation)  # at most this at the exact vertex
+    return any(admits_no_multipliers(exact[:, v], w[v]) for v in np.flatnonzero(opening))
 
 
 def _near_seed(vertices: _Vertices, held: np.ndarray, q: np.ndarray) -> bool:

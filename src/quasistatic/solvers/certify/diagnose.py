@@ -18,7 +18,15 @@ from ...tolerances import LP_FEASIBILITY
 from ..numerics.highs import solve_lp
 from ..result import BackendResult
 
-__all__ = ["diagnose", "equilibrium_exists", "kinematic_certificate", "MESSAGES", "no_equilibrium_certificate", "no_motion"]
+__all__ = [
+    "diagnose",
+    "admits_no_multipliers",
+    "equilibrium_exists",
+    "kinematic_certificate",
+    "MESSAGES",
+    "no_equilibrium_certificate",
+    "no_motion",
+]
 
 MESSAGES = {
     Diagnosis.KINEMATIC: (
@@ -57,6 +65,15 @@ def kinematic_certificate(problem: Problem) -> np.ndarray | None:
     if lp.status == "optimal" and np.max(np.abs(A @ lp.x - rhs), initial=0.0) <= LP_FEASIBILITY:
         return lp.x
     return None
+
+
+def admits_no_multipliers(gaps: np.ndarray, q: np.ndarray) -> bool:
+    """Whether a twist ``q`` whose gap rates ``gaps = Jn q - bn`` are all non-negative rules out every kinematic
+    certificate :func:`kinematic_certificate` accepts: such ``y >= -LP_FEASIBILITY`` meets ``|Jn^T y| <= LP_FEASIBILITY``
+    and ``bn.y >= 1 - LP_FEASIBILITY``, so ``-LP_FEASIBILITY sum(gaps) <= y.gaps = (Jn^T y).q - bn.y <=
+    LP_FEASIBILITY |q|_1 - 1 + LP_FEASIBILITY``, impossible while ``LP_FEASIBILITY (|q|_1 + sum(gaps) + 1) < 1``
+    (asked here with a factor 2 to spare)."""
+    return bool(np.all(gaps >= 0.0) and LP_FEASIBILITY * (np.abs(q).sum() + gaps.sum() + 1.0) < 0.5)
 
 
 def equilibrium_exists(problem: Problem, edges: np.ndarray) -> bool:
@@ -100,16 +117,22 @@ def _generator_rows(problem: Problem, edges: np.ndarray) -> np.ndarray:
 
 
 def diagnose(
-    problem: Problem, inner_edges: np.ndarray, outer_edges: np.ndarray | None = None, equilibrium: bool | None = None
+    problem: Problem,
+    inner_edges: np.ndarray,
+    outer_edges: np.ndarray | None = None,
+    equilibrium: bool | None = None,
+    admissible: bool = False,
 ) -> BackendResult:
     """Explain why no motion exists. ``inner_edges`` span cones inside the true ones.
 
     For the exact 3-D cone pass ``outer_edges`` too (a polygon around the circle):
     no equilibrium with the outer cones proves none with the exact ones. ``equilibrium``: whether
     one exists in the inner cones, when the caller has decided it (the planar branch and bound's
-    root: a balancing fit, or a checked Farkas vector); None runs the LP.
+    root: a balancing fit, or a checked Farkas vector); None runs the LP. ``admissible``: the caller
+    holds a twist ``q`` with ``Jn q >= bn`` and ``LP_FEASIBILITY (|q|_1 + sum(Jn q - bn) + 1) < 1/2``
+    (:func:`admits_no_multipliers`); then no multipliers pass the kinematic check, and its LP is not run.
     """
-    multipliers = kinematic_certificate(problem)
+    multipliers = None if admissible else kinematic_certificate(problem)
     if multipliers is not None:
         return no_motion(
             Diagnosis.KINEMATIC, Certificate(CertificateKind.FARKAS, "kinematic (Farkas multipliers)", tuple(multipliers.tolist()))
