@@ -183,9 +183,10 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None) -> VertexProof:
         return _UNDECIDED
     planes = _planes(problem.J, problem.b, problem.mu)
     excluded = _Exclusions.of(planes.loads, problem.g)
-    if excluded.every_load():  # no forces balance the load at all, whatever the twist
-        return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False)
     vertices = _vertices(planes)
+    if excluded.every_load():  # no forces balance the load at all, whatever the twist
+        admissible = vertices is not None and _admissible(planes, vertices)
+        return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False, admissible=admissible)
     if vertices is None:
         return _UNDECIDED  # the normals do not span R^3: every motion lies on a line of motions
     held = np.flatnonzero(~excluded.excludes(_load_masks(planes, vertices.signs)))
