@@ -7,9 +7,11 @@
    On exact 3-D cones, rest with every mover still is proven the only motion
    on the circles themselves when it is (:mod:`.certify.rest`: the load cannot
    do work, so loaded contacts stick, and LPs or else SCIP find no other such motion).
-3. One planar body: the vertices of the contacts' twist planes (:mod:`.certify.arrangement`,
-   a few whole-array solves) prove Lemke's twist the only motion, or that none exists,
-   for most problems; otherwise, and for 3-D pyramids, step 4.
+3. One planar body: the vertices and edges of the contacts' gap-rate and slip planes
+   (:mod:`.certify.arrangement`, whole-array 3x3 solves and checked Farkas directions)
+   prove Lemke's (or a vertex's) twist the only motion, or that none exists (then
+   ``jammed``/``unstable`` by :func:`~.certify.diagnose.diagnose`, told when a vertex
+   keeps every contact open), for most problems; where it proves nothing, step 4.
 4. Planar and 3-D pyramid problems: a branch and bound over each contact's mode
    (separating, rolling, sliding either way in 2-D; on a pyramid's vertex or
    face in 3-D), whose nodes are pruned by checked Farkas

@@ -60,7 +60,8 @@ the loads):
   ``FORCE_CEILING``) holds no loose motion near it; when every triple is
   excluded there is **no motion** (claim 1);
 - when the triples left (not excluded) all have ``w_T`` within ``SAME_TWIST / 2``
-  of Lemke's checked motion ``q*`` and ``|w_T - q*| + (tau + delta) |N_T^-1|_1``
+  of the seed ``q*`` (Lemke's checked motion, or the held vertex's, checked
+  the same way) and ``|w_T - q*| + (tau + delta) |N_T^-1|_1``
   within ``DISTINCT_TWIST / 2`` at ``tau = ZERO`` and within ``DISTINCT_TWIST``
   at ``tau = LP_FEASIBILITY`` (the box the SCIP search excludes around a
   motion, as :func:`~.cheap.kinematically_unique` bounds it; a cell's vertices
@@ -77,9 +78,11 @@ the loads):
 
 A sign of ``n_p . e`` within round-off is taken as 0, which only adds loads
 (it can keep a ray from being excluded, never exclude one). Three normals whose
-determinant is within round-off of 0 are taken as dependent
-(:data:`ARRANGEMENT_ROUNDOFF`): the one round-off assumption, as the branch and
-bound takes lines within round-off of parallel as parallel.
+determinant is within round-off of 0 are taken as dependent, and two within
+round-off of parallel as meeting in no line (:data:`ARRANGEMENT_ROUNDOFF`): the
+one round-off assumption, as the branch and bound takes lines within round-off
+of parallel as parallel. A seed with every vertex excluded, which the claims
+say cannot be, proves nothing.
 
 **Cheaply.** All triples at once: the triple products ``n_p . (n_a x n_b)``
 of every plane with every pair are one table (two matrix products), from which
@@ -90,7 +93,10 @@ each load; the normals of the planes two loads span, both ways: the directions
 the least-squares residual of ``-g`` from any cone of loads can take), the set
 of loads each excludes, as a bit mask; a set of loads is excluded when one
 direction's mask holds it (one bitwise test per pair). When no forces at all
-balance the load (every load excluded) no twist is needed to say so. Without
+balance the load (every load excluded) no twist is needed to say so; for either
+"no motion", an exact vertex that keeps every contact closed or opening tells
+:func:`~.diagnose.diagnose` that no kinematic certificate exists, so it skips
+that LP (:func:`~.diagnose.admits_no_multipliers`). Without
 Lemke's point, the held vertex best computed becomes the seed when its twist
 with non-negative least-squares forces on its loads satisfies every law of the
 form (:func:`~.cheap.satisfies_form`, as Lemke's point is checked). Anything
