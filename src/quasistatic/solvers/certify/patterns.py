@@ -177,6 +177,10 @@ class _Mode:
     keep: np.ndarray  # bool (K,): the contact's load columns its force may use
     children: tuple[_Mode, ...] = ()
     separating: bool = False  # no force, the gap row stays an inequality (as at the root)
+    # The same sets as bits (bit j: bank row or load column j), which a node combines in integer operations.
+    equal_bits: int = 0
+    at_least_bits: int = 0
+    removes: int = 0  # the contact's load columns its force may not use
 
 
 @dataclass(frozen=True, slots=True)
@@ -212,8 +216,9 @@ class _Rows:
     levels: tuple[_Level, ...]
     budget: int  # most nodes
     farkas: _FarkasVectors
+    fits: _Fits = field(default_factory=lambda: _Fits())
     proof: PatternProof = field(default_factory=lambda: PatternProof(PatternVerdict.UNDECIDED))
-    closed_sets: dict[bytes, _ClosedSet | _Twists] = field(default_factory=dict)  # by which bank rows are closed
+    closed_sets: dict[int, _ClosedSet | _Twists] = field(default_factory=dict)  # by which bank rows are closed (bits)
     max_motions: int = 16
     remaining: Callable[[], float] | None = None  # seconds left to the caller
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
@@ -223,37 +228,48 @@ class _Rows:
         """Load columns per contact (the form's edges)."""
         return self.form.n_edges
 
+    def columns(self, bits: int) -> np.ndarray:
+        """Load columns as a boolean mask."""
+        return _mask(bits, self.loads.shape[1])
+
+    def row_mask(self, bits: int) -> np.ndarray:
+        """Bank rows as a boolean mask."""
+        return _mask(bits, self.bank.shape[0])
+
 
 @dataclass(frozen=True, slots=True)
 class _Node:
-    """Which bank rows hold as equalities and inequalities, which load columns may carry force, each contact's
-    current set of modes, how deep."""
+    """Which bank rows hold as equalities and inequalities, which load columns may carry force (bit sets: bit
+    ``j`` for row or column ``j``), each contact's current set of modes, how deep."""
 
-    equal: np.ndarray
-    at_least: np.ndarray
-    columns: np.ndarray
+    equal: int
+    at_least: int
+    columns: int
     modes: tuple[_Mode, ...]
     depth: int
-    closed_rows: int = 0  # how many entries of ``equal`` are set
+    closed_rows: int = 0  # how many rows ``equal`` holds
 
-    def child(self, rows: _Rows, contact: int, mode: _Mode) -> _Node:
-        columns = self.columns.copy()
-        K = rows.width
-        columns[K * contact : K * contact + K] &= mode.keep
+    def child(self, contact: int, mode: _Mode) -> _Node:
+        columns = self.columns & ~mode.removes
         modes = (*self.modes[:contact], mode, *self.modes[contact + 1 :])
-        new_equal = mode.equal[~self.equal[mode.equal]]
-        new_at_least = mode.at_least[~self.at_least[mode.at_least]]
-        if not (new_equal.size or new_at_least.size):  # the parent's twist rows: its arrays, shared (no node writes them)
-            return _Node(self.equal, self.at_least, columns, modes, self.depth + 1, self.closed_rows)
-        equal, at_least = self.equal.copy(), self.at_least.copy()
-        at_least[new_equal] = False
-        equal[new_equal] = True
-        at_least[new_at_least] = True
-        return _Node(equal, at_least, columns, modes, self.depth + 1, self.closed_rows + new_equal.size)
+        new_equal = mode.equal_bits & ~self.equal
+        at_least = (self.at_least & ~new_equal) | (mode.at_least_bits & ~self.at_least)
+        return _Node(self.equal | new_equal, at_least, columns, modes, self.depth + 1, self.closed_rows + new_equal.bit_count())
 
     def deeper(self) -> _Node:
         """The same node one level down (a level that does not apply to it)."""
         return _Node(self.equal, self.at_least, self.columns, self.modes, self.depth + 1, self.closed_rows)
+
+
+def _bits(mask: np.ndarray) -> int:
+    """A boolean array as a bit set (bit ``j`` set where ``mask[j]``)."""
+    return int.from_bytes(np.packbits(mask, bitorder="little").tobytes(), "little")
+
+
+def _mask(bits: int, size: int) -> np.ndarray:
+    """A bit set as a boolean array of ``size`` entries (the inverse of :func:`_bits`)."""
+    packed = np.frombuffer(bits.to_bytes((size + 7) // 8, "little"), dtype=np.uint8)
+    return np.unpackbits(packed, count=size, bitorder="little").view(bool)
 
 
 @dataclass(frozen=True, slots=True)
@@ -264,8 +280,14 @@ class _Ball:
     radius: float
 
 
-def _mode(equal: list[int], at_least: list[int], keep: np.ndarray, children: tuple[_Mode, ...] = (), separating: bool = False) -> _Mode:
-    return _Mode(np.array(equal, dtype=int), np.array(at_least, dtype=int), keep, children, separating)
+def _mode(
+    contact: int, equal: list[int], at_least: list[int], keep: np.ndarray, children: tuple[_Mode, ...] = (), separating: bool = False
+) -> _Mode:
+    """Contact ``contact``'s set of modes (``keep``: its block of ``K = keep.size`` load columns)."""
+    K = keep.size
+    removes = sum(1 << (K * contact + k) for k in range(K) if not keep[k])
+    equal_bits, at_least_bits = sum(1 << r for r in set(equal)), sum(1 << r for r in set(at_least))
+    return _Mode(np.array(equal, dtype=int), np.array(at_least, dtype=int), keep, children, separating, equal_bits, at_least_bits, removes)
 
 
 def _planar_layout(problem: Problem, order: list[int]) -> _Layout:
@@ -280,12 +302,12 @@ def _planar_layout(problem: Problem, order: list[int]) -> _Layout:
     both, plus, minus, none = np.array([True, True]), np.array([True, False]), np.array([False, True]), np.array([False, False])
     roots = []
     for i in range(m):
-        separating = _mode([], [], none, separating=True)
+        separating = _mode(i, [], [], none, separating=True)
         if problem.mu[i] <= 0.0:  # frictionless: both columns are the normal
-            modes: tuple[_Mode, ...] = (_mode([i], [], plus), separating)
+            modes: tuple[_Mode, ...] = (_mode(i, [i], [], plus), separating)
         else:
-            modes = (_mode([i, m + i], [], both), _mode([i], [2 * m + i], plus), _mode([i], [3 * m + i], minus), separating)
-        roots.append(_mode([], [], both, modes))
+            modes = (_mode(i, [i, m + i], [], both), _mode(i, [i], [2 * m + i], plus), _mode(i, [i], [3 * m + i], minus), separating)
+        roots.append(_mode(i, [], [], both, modes))
     bank, rhs = np.vstack([Jn, Jt, -Jt, Jt]), np.concatenate([bn, bt, -bt, bt])
     return _Layout(bank, rhs, loads, tuple(roots), tuple(_Level(i) for i in order))
 
@@ -327,14 +349,14 @@ def _contact_tree(i: int, m: int, K: int, frictional: bool) -> _Mode:
     (its gap row an equality); closed and frictional: rolling (both tangent rows), or sliding in one of the
     arcs of at most ``K / 2`` sectors (a half-plane at most, so their rows are its two boundary rays)."""
     every, none = np.ones(K, dtype=bool), np.zeros(K, dtype=bool)
-    separating = _mode([], [], none, separating=True)
+    separating = _mode(i, [], [], none, separating=True)
     if not frictional:  # its closed modes are one: its columns are all the normal, so one of them is kept
-        return _mode([], [], every, (_mode([i], [], np.arange(K) == 0), separating))
+        return _mode(i, [], [], every, (_mode(i, [i], [], np.arange(K) == 0), separating))
     parts = 2 if K % 2 == 0 else 3
     bounds = [round(K * p / parts) for p in range(parts + 1)]
     arcs = tuple(_arc(i, m, K, bounds[p], bounds[p + 1] - 1) for p in range(parts))
-    closed = _mode([i], [], every, (_mode([i, m + i, 2 * m + i], [], every), *arcs))
-    return _mode([], [], every, (closed, separating))
+    closed = _mode(i, [i], [], every, (_mode(i, [i, m + i, 2 * m + i], [], every), *arcs))
+    return _mode(i, [], [], every, (closed, separating))
 
 
 def _arc(i: int, m: int, K: int, first: int, last: int) -> _Mode:
@@ -347,11 +369,11 @@ def _arc(i: int, m: int, K: int, first: int, last: int) -> _Mode:
     rows = [sector_prev + first % K, sector_next + last % K]
     if first == last:
         j, edge = first % K, np.eye(K, dtype=bool)
-        vertex = _mode([i], [sector_next + j, sector_prev + j], edge[j])
-        face = _mode([i, face_equal + j], [face_sign + j], edge[j] | edge[(j + 1) % K])
-        return _mode([i], rows, keep, (vertex, face))
+        vertex = _mode(i, [i], [sector_next + j, sector_prev + j], edge[j])
+        face = _mode(i, [i, face_equal + j], [face_sign + j], edge[j] | edge[(j + 1) % K])
+        return _mode(i, [i], rows, keep, (vertex, face))
     middle = (first + last) // 2
-    return _mode([i], rows, keep, (_arc(i, m, K, first, middle), _arc(i, m, K, middle + 1, last)))
+    return _mode(i, [i], rows, keep, (_arc(i, m, K, first, middle), _arc(i, m, K, middle + 1, last)))
 
 
 def _tree_depth(mode: _Mode) -> int:
@@ -389,10 +411,9 @@ def prove_by_patterns(
     )
     rows.proof.seed = seed_x
     m = problem.n_contacts
-    n_rows = layout.bank.shape[0]
-    root = _Node(np.zeros(n_rows, dtype=bool), np.arange(n_rows) < m, np.ones(layout.loads.shape[1], dtype=bool), roots, 0)
-    fit = _forces(rows, root.columns, None)
-    rows.proof.equilibrium = False if fit is None else _balances(rows, fit)
+    root = _Node(0, (1 << m) - 1, (1 << layout.loads.shape[1]) - 1, roots, 0)
+    fit = _fitted_forces(rows, root.columns)
+    rows.proof.equilibrium = False if fit is None else _balances(rows, fit.forces)
     closed = fit is None or _search(rows, _past_settled(rows, root), fit, _UNKNOWN)
     rows.proof.verdict = _verdict(rows, closed)
     return rows.proof
@@ -454,7 +475,7 @@ def _order(problem: Problem, seed_x: np.ndarray | None, n_q: int) -> list[int]:
     return [int(i) for i in np.argsort(-seed_x[n_q : n_q + m], kind="stable")]
 
 
-def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
+def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
     """True when every mode assignment below ``node`` is pruned, or its motions listed (``rows.found``).
 
     ``fit``: forces on the node's columns with ``|G fit + g|`` within the margin; ``twists``: what the node's
@@ -465,7 +486,7 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
         return False  # a leaf that survived: another motion may exist
     contact = rows.levels[node.depth].contact
     modes = _possible_modes(rows, node.modes[contact].children, twists.ball)
-    excluded = rows.farkas.excludes(node.columns, contact, rows.width, modes)
+    excluded = rows.farkas.excludes(node.columns, modes)
     blocked = False  # a closed sibling's Farkas vector also holds for separating, which keeps fewer columns
     for mode, known_empty in zip(modes, excluded, strict=True):
         rows.proof.nodes += 1
@@ -474,25 +495,27 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
         if known_empty or (mode.separating and blocked):
             blocked |= not mode.separating
             continue  # no equilibrium below this node
-        child = _past_settled(rows, node.child(rows, contact, mode))
-        child_fit = _forces(rows, child.columns, fit)
+        child = _past_settled(rows, node.child(contact, mode))
+        child_fit = _known_forces(rows, child.columns, fit)
+        child_twists = _child_twists(rows, node, child, mode, twists)
+        if child_twists.pruned:
+            continue  # before a new fit: the twists cost less
+        if child_fit is None:
+            child_fit = _fitted_forces(rows, child.columns)
         if child_fit is None:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
-        child_twists = _child_twists(rows, child, mode, twists)
-        if child_twists.pruned:
-            continue
         if child.depth == leaf:
             if child_twists is twists:  # every row counted: a tighter ball, perhaps the seed's
                 child_twists = _twist(rows, child)
                 if child_twists.pruned:
                     continue
-            if child_twists.point and child_twists.ball is not None and _adopted(rows, child_twists.ball.center, child_fit):
+            if child_twists.point and child_twists.ball is not None and _adopted(rows, child_twists.ball.center, child_fit.forces):
                 continue
             if child_twists.point and child_twists.ball is not None:
-                listed = _record_point(rows, child_twists.ball.center, child_fit, child.columns)
+                listed = _record_point(rows, child_twists.ball.center, child_fit.forces, rows.columns(child.columns))
             else:
-                listed = _record_polyhedron(rows, child, child_fit)
+                listed = _record_polyhedron(rows, child, child_fit.forces)
             if not listed:
                 return False  # too close to call, or too many motions
             continue
@@ -514,13 +537,18 @@ def _past_settled(rows: _Rows, node: _Node) -> _Node:
     return node
 
 
-def _child_twists(rows: _Rows, child: _Node, mode: _Mode, parent: _Twists) -> _Twists:
+def _child_twists(rows: _Rows, node: _Node, child: _Node, mode: _Mode, parent: _Twists) -> _Twists:
     """The child's twists: the parent's when its rows are the same (a separating contact, as a free one) or
-    already pin one twist (the child's lie in the same ball, and its modes were filtered against it)."""
+    already pin one twist (the child's lie in the same ball, and its modes were filtered against it). A child
+    that keeps its parent's closed rows and adds inequalities narrows the parent's line or polygon by them
+    (:func:`_narrowed`); others are worked out from their rows (:func:`_twist`)."""
     if not (mode.separating or parent.point):
-        own = _twist(rows, child)
-        if own is _UNKNOWN and parent.ball is not None:
-            return _Twists(False, parent.ball)  # the child's twists are among the parent's
+        if parent.shape is not None and child.equal == node.equal:
+            own = _narrowed(rows, parent, parent.shape, child.at_least & ~node.at_least)
+        else:
+            own = _twist(rows, child)
+        if own.ball is None and not own.pruned and parent.ball is not None:
+            return _Twists(False, parent.ball, shape=own.shape)  # the child's twists are among the parent's
         return own
     ball, spread = parent.ball, parent.spread
     if parent.point and ball is not None and spread is not None and _near_seed(rows, ball.center, ball.center, spread):
@@ -562,7 +590,8 @@ _PARALLEL = 1e-13  # sine of the angle below which two twist rows' lines in a pl
 _SKEW = 1e-9  # sine above which two such lines meet at a vertex computed well; between the two, too close to call
 ROUNDOFF_SLACK = 1e-12  # relative leniency of a computed polygon vertex on its rows, and of its bounding radius
 CLOCK_NODES = 256  # nodes between two looks at the caller's clock (~10 ms)
-FARKAS_KEPT = 8  # Farkas vectors tried before a new non-negative fit (each check: one masked max)
+FARKAS_KEPT = 8  # Farkas vectors tried before a new non-negative fit (each check: one integer operation)
+FITS_KEPT = 16  # balancing fits tried before a new non-negative fit (each check: one integer operation)
 
 _Region = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # a leaf's twist rows: E q = e, A q >= a
 
@@ -606,8 +635,9 @@ def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
     extreme: a single motion there. Else a continuum: its extremes, its free directions, and a point inside it
     (every inequality as slack as it can be), each with the leaf's forces and checked on every law of the form.
     False when a check or an LP fails (too close to call) or there are too many motions."""
-    E, e = rows.bank[node.equal], rows.rhs[node.equal]
-    A, a = rows.bank[node.at_least], rows.rhs[node.at_least]
+    equal, at_least = rows.row_mask(node.equal), rows.row_mask(node.at_least)
+    E, e = rows.bank[equal], rows.rhs[equal]
+    A, a = rows.bank[at_least], rows.rhs[at_least]
     n = rows.g.size
     model = WarmLP(np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
     extremes: list[np.ndarray] = []
@@ -628,13 +658,13 @@ def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
     if not free and seed is not None and all(np.max(np.abs(p - seed)) <= 0.5 * SAME_TWIST for p in extremes):
         return True  # the seed's twist alone
     if not free and len(extremes) == 1:
-        return _record_point(rows, extremes[0], fit, node.columns)
+        return _record_point(rows, extremes[0], fit, rows.columns(node.columns))
     if rows.width > 2:
         # 3-D: a pyramid's continua come in families whose faces (a contact rolling at the end of its slip, on
         # the same edge) are continua of other patterns; SCIP lists the family once (its cut leaves each listed
         # polyhedron), this search would list each face. Until faces are merged, SCIP lists them.
         return False
-    return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit, node.columns)
+    return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit, rows.columns(node.columns))
 
 
 def _record_continuum(
@@ -719,84 +749,118 @@ def _balances(rows: _Rows, fit: np.ndarray) -> bool | None:
     return True if float(np.linalg.norm(rows.loads @ fit + rows.g)) <= _margin(rows) else None
 
 
-def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndarray | None:
-    """Non-negative forces on ``columns`` balancing the load within the margin, or None with a checked Farkas vector
-    (kept in ``rows.farkas``: it may exclude the next nodes' columns too).
+@dataclass(frozen=True, slots=True)
+class _Fit:
+    """Non-negative forces on the load columns (``forces``), and which columns they use (``support``, bits)."""
 
-    ``fit``: the parent's forces; kept when they use none of the columns taken away.
-    """
-    margin = _margin(rows)
-    if fit is not None and not fit[~columns].any():
+    forces: np.ndarray
+    support: int
+
+
+def _known_forces(rows: _Rows, columns: int, fit: _Fit) -> _Fit | None:
+    """Forces on ``columns`` (bits) known without a new fit: the parent's ``fit`` when it uses none of the columns
+    taken away, else a balancing fit found at an earlier node (``rows.fits``) that uses only ``columns`` (forces
+    balancing the load on fewer columns balance it on more); None when there is none."""
+    if not fit.support & ~columns:
         return fit
-    G = rows.loads[:, columns]
-    lam = np.zeros(columns.size)
+    return rows.fits.usable(columns)
+
+
+def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
+    """Non-negative forces on ``columns`` (bits) by a non-negative least-squares fit, balancing the load within
+    the margin, or None with a checked Farkas vector (kept in ``rows.farkas``: it may exclude the next nodes'
+    columns too); a fit that does neither is returned (the node is not excluded)."""
+    index = rows.columns(columns)
+    G = rows.loads[:, index]
+    lam = np.zeros(index.size)
     if G.shape[1]:
-        lam[columns], residual = nnls(G, -rows.g)
+        lam[index], residual = nnls(G, -rows.g)
     else:
         residual = float(np.linalg.norm(rows.g))
-    if residual <= margin:
-        return lam
-    return None if rows.farkas.add(-(rows.loads @ lam + rows.g), columns) else lam
+    found = _Fit(lam, _bits(lam > 0.0))
+    if residual <= _margin(rows):
+        rows.fits.add(found)
+        return found
+    return None if rows.farkas.add(-(rows.loads @ lam + rows.g), columns) else found
+
+
+@dataclass
+class _Fits:
+    """The last balancing fits found (:data:`FITS_KEPT`, newest first)."""
+
+    kept: list[_Fit] = field(default_factory=list)
+
+    def add(self, fit: _Fit) -> None:
+        self.kept.insert(0, fit)
+        del self.kept[FITS_KEPT:]
+
+    def usable(self, columns: int) -> _Fit | None:
+        """A kept fit that uses only ``columns`` (bits), or None."""
+        return next((fit for fit in self.kept if not fit.support & ~columns), None)
 
 
 @dataclass
 class _FarkasVectors:
-    """The last Farkas vectors found, each a certificate that no forces on some load columns balance the load:
-    ``per_column`` holds ``G^T y`` per column, ``reserve`` is ``-g.y - margin |y|``.
+    """The last Farkas vectors found, each a certificate that no forces on some load columns balance the load.
 
     For ``lam >= 0``: ``y.(G lam + g) <= max(G^T y) sum(lam) + g.y``, while ``|G lam + g| <= margin`` needs it
-    ``>= -margin |y|``; so ``reserve > max(G_S^T y, 0) FORCE_CEILING`` excludes every balancing ``lam`` on the
-    columns ``S`` whose sum is below :data:`FORCE_CEILING`. One vector often excludes a node's siblings and
-    cousins: each is tried on a node's children at once, before any non-negative fit."""
+    ``>= -margin |y|``; so with ``reserve = -g.y - margin |y|``, ``reserve > max(G_S^T y, 0) FORCE_CEILING``
+    excludes every balancing ``lam`` on the columns ``S`` whose sum is below :data:`FORCE_CEILING`. A vector is
+    kept as the columns it cannot exclude (``blockers``, bits: ``(G^T y)_j FORCE_CEILING >= reserve``, and it is
+    kept only with ``reserve > 0``): it excludes ``S`` exactly when ``S`` holds none of them. One vector often
+    excludes a node's siblings and cousins: each is tried on a node's children at once, before any fit."""
 
     loads: np.ndarray
     g: np.ndarray
     margin: float
-    per_column: np.ndarray = field(init=False)
-    reserve: np.ndarray = field(init=False)
+    blockers: list[int] = field(default_factory=list)  # newest last
     count: int = 0
 
-    def __post_init__(self) -> None:
-        self.per_column = np.zeros((FARKAS_KEPT, self.loads.shape[1]))
-        self.reserve = np.full(FARKAS_KEPT, -np.inf)
-
-    def add(self, y: np.ndarray, columns: np.ndarray) -> bool:
-        """Keep ``y`` when it excludes ``columns`` (then True)."""
-        per_column = self.loads.T @ y
+    def add(self, y: np.ndarray, columns: int) -> bool:
+        """Keep ``y`` when it excludes ``columns`` (bits; then True)."""
         reserve = -float(self.g @ y) - self.margin * float(np.linalg.norm(y))
-        if reserve <= max(float(np.max(per_column[columns], initial=0.0)), 0.0) * FORCE_CEILING:
+        if not reserve > 0.0:
             return False
-        slot = self.count % FARKAS_KEPT
-        self.per_column[slot], self.reserve[slot] = per_column, reserve
+        blockers = _bits(self.loads.T @ y * FORCE_CEILING >= reserve)
+        if blockers & columns:
+            return False
+        if len(self.blockers) < FARKAS_KEPT:
+            self.blockers.append(blockers)
+        else:
+            self.blockers[self.count % FARKAS_KEPT] = blockers
         self.count += 1
         return True
 
-    def excludes(self, columns: np.ndarray, contact: int, K: int, modes: tuple[_Mode, ...]) -> np.ndarray:
-        """For each of ``modes`` of ``contact``: whether a kept vector excludes ``columns`` with the contact's
-        block of ``K`` columns narrowed to the mode's."""
-        if not self.count or not modes:
-            return np.zeros(len(modes), dtype=bool)
-        block = slice(K * contact, K * contact + K)
-        outside = columns.copy()
-        outside[block] = False
-        values = self.per_column[: min(self.count, FARKAS_KEPT)]
-        worst_outside = np.max(np.where(outside, values, -np.inf), axis=1)  # (F,)
-        keeps = np.array([mode.keep for mode in modes]) & columns[block]  # (M, K)
-        worst_inside = np.max(np.where(keeps[None], values[:, None, block], -np.inf), axis=2)  # (F, M)
-        worst = np.maximum(np.maximum(worst_outside[:, None], worst_inside), 0.0) * FORCE_CEILING
-        return np.any(self.reserve[: values.shape[0], None] > worst, axis=0)
+    def excludes(self, columns: int, modes: tuple[_Mode, ...]) -> list[bool]:
+        """For each of ``modes``: whether a kept vector excludes ``columns`` (bits) narrowed to the mode's."""
+        return [any(not blockers & columns & ~mode.removes for blockers in self.blockers) for mode in modes]
 
 
 @dataclass(frozen=True, slots=True)
 class _Twists:
     """What a node's twists are known to be: ``pruned`` (empty, or the seed's); else within ``ball`` (2-norm,
     for filtering modes) when known, and ``point`` when the closed rows leave one twist (a leaf there is another
-    motion)."""
+    motion); ``shape``: where on its closed rows' line or plane they lie, which a child narrows."""
 
     pruned: bool
     ball: _Ball | None = None
     point: bool = False
     spread: np.ndarray | None = None  # of a point: how far, per entry, a loosened twist may lie from it
+    shape: _Shape | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class _Shape:
+    """A node's loosened twists on what its closed rows leave (``closed``): ``q0 + t direction`` with ``t`` in
+    ``interval`` (a line), or ``q0 + x plane`` with ``x`` in the hull of ``vertices`` (a plane, (V, 2)), each
+    within the closed set's ``radius`` off it."""
+
+    closed: _ClosedSet
+    interval: tuple[float, float] | None = None
+    vertices: _Vertices | None = None
+
+
+_Vertices = list[tuple[float, float]]  # a polygon's points in a plane (few: plain floats cost less than arrays)
 
 
 _PRUNED, _UNKNOWN = _Twists(True), _Twists(False)
@@ -813,22 +877,61 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     plane = k == n - 2 and rows.width > 2  # 3-D pyramids: a plane of twists is bounded exactly (planar: as before)
     if (k < n - 1 and not plane) or k == 0:
         return _UNKNOWN
-    key = node.equal.tobytes()
-    closed = rows.closed_sets.get(key)
+    closed = rows.closed_sets.get(node.equal)
     if closed is None:
-        closed = rows.closed_sets[key] = _closed_set(rows, node.equal, k)
+        closed = rows.closed_sets[node.equal] = _closed_set(rows, rows.row_mask(node.equal), k)
     if isinstance(closed, _Twists):
         return closed
-    reserve = closed.reserve[node.at_least]
+    at_least = rows.row_mask(node.at_least)
+    reserve = closed.reserve[at_least]
     if plane:
-        return _on_plane(rows, closed, rows.bank[node.at_least] @ closed.plane.T, reserve)
+        return _on_plane(rows, closed, rows.bank[at_least] @ closed.plane.T, reserve)
     if closed.slope is not None:
-        return _on_line(rows, closed.q0, closed.direction, closed.radius, closed.spread, closed.slope[node.at_least], reserve)
+        return _on_line(rows, closed, closed.slope[at_least], reserve, (-np.inf, np.inf))
     if (reserve < 0.0).any():
         return _PRUNED  # an open gap or slip sign fails on the whole set
     if _near_seed(rows, closed.q0, closed.q0, closed.spread):
         return _PRUNED
     return _Twists(False, _Ball(closed.q0, closed.radius), point=True, spread=closed.spread)
+
+
+def _narrowed(rows: _Rows, parent: _Twists, shape: _Shape, new_rows: int) -> _Twists:
+    """A node's twists from its ``parent``'s (their ``shape``: the same closed rows) and its inequality rows not
+    in the parent's (``new_rows``, bits): the parent's line or polygon cut by each; the parent's own when none
+    cuts it."""
+    closed = shape.closed
+    reserve, rates = closed.row_reserve, closed.row_rates
+    if shape.interval is not None:
+        low, high = shape.interval
+        for j in _indices(new_rows):
+            rate, slack = rates[j], reserve[j]
+            assert isinstance(rate, float)
+            if rate > 0.0:
+                low = max(low, -slack / rate)
+            elif rate < 0.0:
+                high = min(high, -slack / rate)
+            elif slack < 0.0:
+                return _PRUNED
+        return parent if (low, high) == shape.interval else _line(rows, closed, low, high)
+    vertices = shape.vertices
+    assert vertices is not None
+    for j in _indices(new_rows):
+        rate = rates[j]
+        assert isinstance(rate, tuple)
+        vertices = _cut(vertices, rate, reserve[j])
+        if not vertices:
+            return _PRUNED
+    return parent if vertices is shape.vertices else _polygon(rows, closed, vertices)
+
+
+def _indices(bits: int) -> list[int]:
+    """The positions of a bit set's bits (few: a node's new rows)."""
+    index = []
+    while bits:
+        low = bits & -bits
+        index.append(low.bit_length() - 1)
+        bits ^= low
+    return index
 
 
 @dataclass(frozen=True, slots=True)
@@ -844,6 +947,10 @@ class _ClosedSet:
     direction: np.ndarray
     slope: np.ndarray | None
     plane: np.ndarray  # (2, n): orthonormal directions of what ``n - 2`` rows leave (the last two of E's full ``vt``)
+    # The same per bank row as plain floats, read a few at a time by :func:`_narrowed`: ``reserve``, and the
+    # row's rate along the line (``slope``) or in the plane (``bank plane^T``, on ``n - 2`` rows); else empty.
+    row_reserve: list[float]
+    row_rates: list[float] | list[tuple[float, float]]
 
 
 def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
@@ -860,7 +967,7 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     leave a line ``q0 + t d``, on which every inequality row bounds ``t``.
     """
     n = rows.g.size
-    E, e = rows.bank[equal], rows.rhs[equal]
+    E, e = rows.bank[equal], rows.rhs[equal]  # ``equal``: a boolean mask of the bank's rows
     u, sigma, vt = np.linalg.svd(E, full_matrices=k < n)  # a line's direction is the last row of the full vt
     if sigma[-1] <= MOTION_RANK or k > n and sigma[n - 1] <= MOTION_RANK:
         return _UNKNOWN
@@ -877,26 +984,36 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     reserve = bank @ q0 + LP_FEASIBILITY * np.abs(bank @ pseudo_inverse).sum(axis=1) - rows.rhs + LP_FEASIBILITY
     direction = vt[-1]
     slope = bank @ direction if k < n else None
-    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:])
+    rates: list[float] | list[tuple[float, float]] = []
+    if k == n - 1 and slope is not None:
+        rates = slope.tolist()
+    elif k == n - 2:
+        rates = [(x, y) for x, y in (bank @ vt[-2:].T).tolist()]
+    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], reserve.tolist(), rates)
 
 
-def _on_line(
-    rows: _Rows, q0: np.ndarray, d: np.ndarray, radius: float, spread: np.ndarray, slope: np.ndarray, reserve: np.ndarray
-) -> _Twists:
-    """Twists ``q0 + t d`` (within ``spread`` per entry) with ``slope t + reserve >= 0`` for every inequality row."""
+def _on_line(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.ndarray, interval: tuple[float, float]) -> _Twists:
+    """Twists ``q0 + t d`` (within ``spread`` per entry) with ``t`` in ``interval`` and ``slope t + reserve >= 0``
+    for every inequality row given."""
     if (reserve[slope == 0.0] < 0.0).any():
         return _PRUNED
     rising, falling = slope > 0.0, slope < 0.0
-    low = float(np.max(-reserve[rising] / slope[rising], initial=-np.inf))
-    high = float(np.min(-reserve[falling] / slope[falling], initial=np.inf))
+    low = max(interval[0], float(np.max(-reserve[rising] / slope[rising], initial=-np.inf)))
+    high = min(interval[1], float(np.min(-reserve[falling] / slope[falling], initial=np.inf)))
+    return _line(rows, closed, low, high)
+
+
+def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
+    """The twists ``q0 + t d`` with ``low <= t <= high`` (within the closed set's ``spread`` per entry)."""
     if low > high:
         return _PRUNED
-    if not (np.isfinite(low) and np.isfinite(high)):
-        return _UNKNOWN
-    ends = q0 + low * d, q0 + high * d
-    if _near_seed(rows, *ends, spread):
+    shape = _Shape(closed, interval=(low, high))
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return _Twists(False, shape=shape)
+    ends = closed.q0 + low * closed.direction, closed.q0 + high * closed.direction
+    if _near_seed(rows, *ends, closed.spread):
         return _PRUNED
-    return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + radius))
+    return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + closed.radius), shape=shape)
 
 
 def _on_plane(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.ndarray) -> _Twists:
@@ -931,12 +1048,43 @@ def _on_plane(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.nd
     vertices = points[:, (values >= -lenient).all(axis=0)].T
     if not vertices.size:
         return _PRUNED
-    twists = closed.q0 + vertices @ closed.plane
+    return _polygon(rows, closed, [(x, y) for x, y in vertices.tolist()])
+
+
+def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Vertices:
+    """The points whose hull is the hull of ``vertices`` cut by ``rate.x + reserve >= 0``: the vertices that meet
+    it (with round-off's leniency, as :func:`_on_plane`'s), and the two ends of the cut, the outermost points where
+    a segment between a vertex above the line and one below crosses it (every edge of the hull is such a segment,
+    so the cut's ends are among them, whatever order the vertices come in). ``vertices`` itself when none is
+    below the line."""
+    a, b = rate
+    values = [a * x + b * y + reserve for x, y in vertices]
+    if min(values) >= 0.0:
+        return vertices
+    size = math.hypot(a, b)
+    kept = [v for v, value in zip(vertices, values, strict=True) if value >= -ROUNDOFF_SLACK * (size * math.hypot(*v) + abs(reserve))]
+    above = [(v, value) for v, value in zip(vertices, values, strict=True) if value > 0.0]
+    below = [(v, value) for v, value in zip(vertices, values, strict=True) if value < 0.0]
+    if not above:
+        return kept
+    crossings = [
+        (x + t * (u - x), y + t * (w - y))
+        for (x, y), va in above
+        for (u, w), vb in below
+        for t in (va / (va - vb),)
+    ]
+    along = [b * x - a * y for x, y in crossings]  # position along the line
+    return [*kept, crossings[along.index(min(along))], crossings[along.index(max(along))]]
+
+
+def _polygon(rows: _Rows, closed: _ClosedSet, vertices: _Vertices) -> _Twists:
+    """The twists over the hull of ``vertices`` (in the closed set's plane): the seed's (pruned), or a ball."""
+    twists = closed.q0 + np.array(vertices) @ closed.plane
     if _all_near_seed(rows, twists, closed.spread):
         return _PRUNED
     center = 0.5 * (twists.min(axis=0) + twists.max(axis=0))
     reach = float(np.sqrt(np.max(np.sum((twists - center) ** 2, axis=1))))
-    return _Twists(False, _Ball(center, reach * (1.0 + ROUNDOFF_SLACK) + closed.radius))
+    return _Twists(False, _Ball(center, reach * (1.0 + ROUNDOFF_SLACK) + closed.radius), shape=_Shape(closed, vertices=vertices))
 
 
 @functools.cache
