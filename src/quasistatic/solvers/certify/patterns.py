@@ -217,6 +217,8 @@ class _Rows:
     budget: int  # most nodes
     farkas: _FarkasVectors
     fits: _Fits = field(default_factory=lambda: _Fits())
+    filters: dict[int, _ModeFilter] = field(default_factory=dict)  # by the ``id`` of a tuple of the tree's modes
+    outside: list[int] = field(default_factory=list)  # per contact: the load columns not its own (bits)
     proof: PatternProof = field(default_factory=lambda: PatternProof(PatternVerdict.UNDECIDED))
     closed_sets: dict[int, _ClosedSet | _Twists] = field(default_factory=dict)  # by which bank rows are closed (bits)
     max_motions: int = 16
@@ -411,6 +413,8 @@ def prove_by_patterns(
     )
     rows.proof.seed = seed_x
     m = problem.n_contacts
+    every, block = (1 << layout.loads.shape[1]) - 1, (1 << rows.width) - 1
+    rows.outside = [every & ~(block << (rows.width * i)) for i in range(m)]
     root = _Node(0, (1 << m) - 1, (1 << layout.loads.shape[1]) - 1, roots, 0)
     fit = _fitted_forces(rows, root.columns)
     rows.proof.equilibrium = False if fit is None else _balances(rows, fit.forces)
@@ -486,7 +490,7 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
         return False  # a leaf that survived: another motion may exist
     contact = rows.levels[node.depth].contact
     modes = _possible_modes(rows, node.modes[contact].children, twists.ball)
-    excluded = rows.farkas.excludes(node.columns, modes)
+    excluded = rows.farkas.excludes(node.columns, rows.outside[contact], modes)
     blocked = False  # a closed sibling's Farkas vector also holds for separating, which keeps fewer columns
     for mode, known_empty in zip(modes, excluded, strict=True):
         rows.proof.nodes += 1
@@ -590,7 +594,7 @@ _PARALLEL = 1e-13  # sine of the angle below which two twist rows' lines in a pl
 _SKEW = 1e-9  # sine above which two such lines meet at a vertex computed well; between the two, too close to call
 ROUNDOFF_SLACK = 1e-12  # relative leniency of a computed polygon vertex on its rows, and of its bounding radius
 CLOCK_NODES = 256  # nodes between two looks at the caller's clock (~10 ms)
-FARKAS_KEPT = 8  # Farkas vectors tried before a new non-negative fit (each check: one integer operation)
+FARKAS_KEPT = 32  # Farkas vectors tried before a new non-negative fit (each check: one integer operation)
 FITS_KEPT = 16  # balancing fits tried before a new non-negative fit (each check: one integer operation)
 
 _Region = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # a leaf's twist rows: E q = e, A q >= a
@@ -733,10 +737,36 @@ def _possible_modes(rows: _Rows, modes: tuple[_Mode, ...], ball: _Ball | None) -
     of them without one. Separating is always kept (its gap row was checked as the parent's)."""
     if ball is None:
         return modes
-    slack = rows.bank @ ball.center - rows.rhs
-    reach = rows.norms * ball.radius + LP_FEASIBILITY
-    meets, above = np.abs(slack) <= reach, slack >= -reach
-    return tuple(mode for mode in modes if mode.separating or (meets[mode.equal].all() and above[mode.at_least].all()))
+    filter_ = rows.filters.get(id(modes))
+    if filter_ is None:
+        filter_ = rows.filters[id(modes)] = _ModeFilter.of(rows, modes)
+    slack = filter_.bank @ ball.center - filter_.rhs
+    reach = filter_.norms * ball.radius + LP_FEASIBILITY
+    meets, above = (np.abs(slack) <= reach).tolist(), (slack >= -reach).tolist()
+    return tuple(
+        mode
+        for mode, equal, at_least in zip(modes, filter_.equal, filter_.at_least, strict=True)
+        if mode.separating or (all(meets[j] for j in equal) and all(above[j] for j in at_least))
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class _ModeFilter:
+    """The bank rows of a node's modes (``bank``, ``rhs``, ``norms``: their union), and each mode's among them."""
+
+    bank: np.ndarray
+    rhs: np.ndarray
+    norms: np.ndarray
+    equal: tuple[list[int], ...]
+    at_least: tuple[list[int], ...]
+
+    @classmethod
+    def of(cls, rows: _Rows, modes: tuple[_Mode, ...]) -> _ModeFilter:
+        union = sorted({int(r) for mode in modes for r in (*mode.equal, *mode.at_least)})
+        where = {r: j for j, r in enumerate(union)}
+        equal = tuple([where[int(r)] for r in mode.equal] for mode in modes)
+        at_least = tuple([where[int(r)] for r in mode.at_least] for mode in modes)
+        return cls(rows.bank[union], rows.rhs[union], rows.norms[union], equal, at_least)
 
 
 def _margin(rows: _Rows) -> float:
@@ -831,9 +861,14 @@ class _FarkasVectors:
         self.count += 1
         return True
 
-    def excludes(self, columns: int, modes: tuple[_Mode, ...]) -> list[bool]:
-        """For each of ``modes``: whether a kept vector excludes ``columns`` (bits) narrowed to the mode's."""
-        return [any(not blockers & columns & ~mode.removes for blockers in self.blockers) for mode in modes]
+    def excludes(self, columns: int, outside: int, modes: tuple[_Mode, ...]) -> list[bool]:
+        """For each of ``modes`` (of one contact; ``outside``: every column not in its block, bits): whether a kept
+        vector excludes ``columns`` (bits) narrowed to the mode's."""
+        left = [blockers & columns for blockers in self.blockers]  # the blockers a node's columns hold
+        if 0 in left:
+            return [True] * len(modes)  # a vector excludes the node itself
+        inside = [blockers for blockers in left if not blockers & outside]  # a mode's narrowing may remove these
+        return [any(not blockers & ~mode.removes for blockers in inside) for mode in modes]
 
 
 @dataclass(frozen=True, slots=True)
@@ -882,12 +917,13 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
         closed = rows.closed_sets[node.equal] = _closed_set(rows, rows.row_mask(node.equal), k)
     if isinstance(closed, _Twists):
         return closed
+    if closed.slope is not None and not plane:
+        interval = _interval(closed, (-math.inf, math.inf), node.at_least)
+        return _PRUNED if interval is None else _line(rows, closed, *interval)
     at_least = rows.row_mask(node.at_least)
     reserve = closed.reserve[at_least]
     if plane:
         return _on_plane(rows, closed, rows.bank[at_least] @ closed.plane.T, reserve)
-    if closed.slope is not None:
-        return _on_line(rows, closed, closed.slope[at_least], reserve, (-np.inf, np.inf))
     if (reserve < 0.0).any():
         return _PRUNED  # an open gap or slip sign fails on the whole set
     if _near_seed(rows, closed.q0, closed.q0, closed.spread):
@@ -900,28 +936,38 @@ def _narrowed(rows: _Rows, parent: _Twists, shape: _Shape, new_rows: int) -> _Tw
     in the parent's (``new_rows``, bits): the parent's line or polygon cut by each; the parent's own when none
     cuts it."""
     closed = shape.closed
-    reserve, rates = closed.row_reserve, closed.row_rates
     if shape.interval is not None:
-        low, high = shape.interval
-        for j in _indices(new_rows):
-            rate, slack = rates[j], reserve[j]
-            assert isinstance(rate, float)
-            if rate > 0.0:
-                low = max(low, -slack / rate)
-            elif rate < 0.0:
-                high = min(high, -slack / rate)
-            elif slack < 0.0:
-                return _PRUNED
-        return parent if (low, high) == shape.interval else _line(rows, closed, low, high)
+        interval = _interval(closed, shape.interval, new_rows)
+        if interval is None:
+            return _PRUNED
+        return parent if interval == shape.interval else _line(rows, closed, *interval)
+    reserve, rates = closed.row_reserve, closed.row_rates
     vertices = shape.vertices
     assert vertices is not None
     for j in _indices(new_rows):
         rate = rates[j]
-        assert isinstance(rate, tuple)
+        assert isinstance(rate, list)
         vertices = _cut(vertices, rate, reserve[j])
         if not vertices:
             return _PRUNED
     return parent if vertices is shape.vertices else _polygon(rows, closed, vertices)
+
+
+def _interval(closed: _ClosedSet, interval: tuple[float, float], at_least: int) -> tuple[float, float] | None:
+    """The part of ``interval`` of the closed set's line ``q0 + t d`` where the rows ``at_least`` (bits) hold,
+    ``rate t + reserve >= 0`` each; None when it is empty."""
+    low, high = interval
+    reserve, rates = closed.row_reserve, closed.row_rates
+    for j in _indices(at_least):
+        rate, slack = rates[j], reserve[j]
+        assert isinstance(rate, float)
+        if rate > 0.0:
+            low = max(low, -slack / rate)
+        elif rate < 0.0:
+            high = min(high, -slack / rate)
+        elif slack < 0.0:
+            return None
+    return None if low > high else (low, high)
 
 
 def _indices(bits: int) -> list[int]:
@@ -950,7 +996,7 @@ class _ClosedSet:
     # The same per bank row as plain floats, read a few at a time by :func:`_narrowed`: ``reserve``, and the
     # row's rate along the line (``slope``) or in the plane (``bank plane^T``, on ``n - 2`` rows); else empty.
     row_reserve: list[float]
-    row_rates: list[float] | list[tuple[float, float]]
+    row_rates: list[float] | list[list[float]]
 
 
 def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
@@ -984,23 +1030,12 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     reserve = bank @ q0 + LP_FEASIBILITY * np.abs(bank @ pseudo_inverse).sum(axis=1) - rows.rhs + LP_FEASIBILITY
     direction = vt[-1]
     slope = bank @ direction if k < n else None
-    rates: list[float] | list[tuple[float, float]] = []
+    rates: list[float] | list[list[float]] = []  # for a line or a plane only (a point's children keep it)
     if k == n - 1 and slope is not None:
         rates = slope.tolist()
     elif k == n - 2:
-        rates = [(x, y) for x, y in (bank @ vt[-2:].T).tolist()]
-    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], reserve.tolist(), rates)
-
-
-def _on_line(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.ndarray, interval: tuple[float, float]) -> _Twists:
-    """Twists ``q0 + t d`` (within ``spread`` per entry) with ``t`` in ``interval`` and ``slope t + reserve >= 0``
-    for every inequality row given."""
-    if (reserve[slope == 0.0] < 0.0).any():
-        return _PRUNED
-    rising, falling = slope > 0.0, slope < 0.0
-    low = max(interval[0], float(np.max(-reserve[rising] / slope[rising], initial=-np.inf)))
-    high = min(interval[1], float(np.min(-reserve[falling] / slope[falling], initial=np.inf)))
-    return _line(rows, closed, low, high)
+        rates = (bank @ vt[-2:].T).tolist()
+    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], reserve.tolist() if rates else [], rates)
 
 
 def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
@@ -1051,7 +1086,7 @@ def _on_plane(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.nd
     return _polygon(rows, closed, [(x, y) for x, y in vertices.tolist()])
 
 
-def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Vertices:
+def _cut(vertices: _Vertices, rate: list[float], reserve: float) -> _Vertices:
     """The points whose hull is the hull of ``vertices`` cut by ``rate.x + reserve >= 0``: the vertices that meet
     it (with round-off's leniency, as :func:`_on_plane`'s), and the two ends of the cut, the outermost points where
     a segment between a vertex above the line and one below crosses it (every edge of the hull is such a segment,
@@ -1067,12 +1102,7 @@ def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Ver
     below = [(v, value) for v, value in zip(vertices, values, strict=True) if value < 0.0]
     if not above:
         return kept
-    crossings = [
-        (x + t * (u - x), y + t * (w - y))
-        for (x, y), va in above
-        for (u, w), vb in below
-        for t in (va / (va - vb),)
-    ]
+    crossings = [(x + t * (u - x), y + t * (w - y)) for (x, y), va in above for (u, w), vb in below for t in (va / (va - vb),)]
     along = [b * x - a * y for x, y in crossings]  # position along the line
     return [*kept, crossings[along.index(min(along))], crossings[along.index(max(along))]]
 
