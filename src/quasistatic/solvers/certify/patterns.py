@@ -69,6 +69,16 @@ contain those of every assignment below it, and a node is pruned when
 - at a leaf whose rows leave a polyhedron of twists, HiGHS finds it empty
   (LP status), or all its extremes within ``SAME_TWIST / 2`` of ``q*``.
 
+**Reuse.** A child that keeps its parent's closed rows (an arc halved, a vertex) has the parent's twists cut by
+its new inequality rows: the line's interval narrowed, or the polygon's points cut by each row, keeping the
+points that meet it (with the same round-off leniency) and the two outermost points where a segment between a
+point above the row's line and one below crosses it. Every edge of the hull is such a segment, so the hull of
+the points kept holds the cut polygon, and the child is pruned and bounded from it as from its own rows. A fit
+found at an earlier node that balances the load serves every node whose columns hold the columns it uses;
+a Farkas vector is kept as the columns that stop it from excluding (it excludes a node's columns exactly
+when they hold none of them). ``reuse=False`` works every node out from its own rows instead: the same nodes
+and verdicts, for cross-checks.
+
 Without a seed, the first surviving leaf whose twist and forces satisfy every law
 of the form (checked as Lemke's point is, :func:`~.cheap.satisfies_form`) becomes
 the seed, and the search goes on: nodes pruned before did not depend on it.
@@ -161,6 +171,7 @@ class PatternProof:
     seed: np.ndarray | None = None
     nodes: int = 0
     lps: int = 0
+    fits: int = 0  # non-negative least-squares fits made
     motions: tuple[RawMotion, ...] = ()
     equilibrium: bool | None = None  # at the root: True, a balancing fit; False, a checked Farkas vector; None, neither
 
@@ -212,7 +223,7 @@ class _Rows:
     loads: np.ndarray
     g: np.ndarray
     seed: np.ndarray | None  # the seed's twist
-    form: LCPForm
+    form: LCPForm | None  # None: the sector relaxation of exact cones (:func:`relaxation_excluded`)
     levels: tuple[_Level, ...]
     budget: int  # most nodes
     farkas: _FarkasVectors
@@ -223,12 +234,17 @@ class _Rows:
     closed_sets: dict[int, _ClosedSet | _Twists] = field(default_factory=dict)  # by which bank rows are closed (bits)
     max_motions: int = 16
     remaining: Callable[[], float] | None = None  # seconds left to the caller
+    reuse: bool = True  # narrow a node's twists from its parent's; try earlier nodes' fits (see prove_by_patterns)
+    width: int = 2  # load columns per contact
+    survivor: _Node | None = None  # the sector relaxation's leaf whose twists and forces were not excluded
+    survivor_twist: np.ndarray | None = None  # a twist of it (None: its LP did not answer)
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
 
     @property
-    def width(self) -> int:
-        """Load columns per contact (the form's edges)."""
-        return self.form.n_edges
+    def lcp(self) -> LCPForm:
+        """The polyhedral laws searched (a motion search, not the sector relaxation's)."""
+        assert self.form is not None
+        return self.form
 
     def columns(self, bits: int) -> np.ndarray:
         """Load columns as a boolean mask."""
@@ -301,17 +317,21 @@ def _planar_layout(problem: Problem, order: list[int]) -> _Layout:
     Jn, Jt, bn, bt = problem.Jn, problem.Jt[:, 0, :], problem.bn, problem.bt[:, 0]
     mu = problem.mu[:, None]
     loads = np.stack([Jn + mu * Jt, Jn - mu * Jt], axis=1).reshape(-1, problem.n_dof).T
-    both, plus, minus, none = np.array([True, True]), np.array([True, False]), np.array([False, True]), np.array([False, False])
-    roots = []
-    for i in range(m):
-        separating = _mode(i, [], [], none, separating=True)
-        if problem.mu[i] <= 0.0:  # frictionless: both columns are the normal
-            modes: tuple[_Mode, ...] = (_mode(i, [i], [], plus), separating)
-        else:
-            modes = (_mode(i, [i, m + i], [], both), _mode(i, [i], [2 * m + i], plus), _mode(i, [i], [3 * m + i], minus), separating)
-        roots.append(_mode(i, [], [], both, modes))
+    roots = tuple(_planar_tree(i, m, bool(problem.mu[i] > 0.0)) for i in range(m))
     bank, rhs = np.vstack([Jn, Jt, -Jt, Jt]), np.concatenate([bn, bt, -bt, bt])
-    return _Layout(bank, rhs, loads, tuple(roots), tuple(_Level(i) for i in order))
+    return _Layout(bank, rhs, loads, roots, tuple(_Level(i) for i in order))
+
+
+@functools.lru_cache(maxsize=4096)
+def _planar_tree(i: int, m: int, frictional: bool) -> _Mode:
+    """Contact ``i``'s planar modes (bank rows as in :func:`_planar_layout`); the same for every problem of
+    ``m`` contacts, so made once (no node writes a mode)."""
+    both, plus, minus, none = np.array([True, True]), np.array([True, False]), np.array([False, True]), np.array([False, False])
+    separating = _mode(i, [], [], none, separating=True)
+    if not frictional:  # both columns are the normal
+        return _mode(i, [], [], both, (_mode(i, [i], [], plus), separating))
+    modes = (_mode(i, [i, m + i], [], both), _mode(i, [i], [2 * m + i], plus), _mode(i, [i], [3 * m + i], minus), separating)
+    return _mode(i, [], [], both, modes)
 
 
 def _pyramid_layout(form: LCPForm, groups: list[list[int]]) -> _Layout:
@@ -346,10 +366,12 @@ def _pyramid_layout(form: LCPForm, groups: list[list[int]]) -> _Layout:
     return _Layout(bank, rhs, loads, roots, tuple(levels))
 
 
+@functools.lru_cache(maxsize=1024)
 def _contact_tree(i: int, m: int, K: int, frictional: bool) -> _Mode:
     """Contact ``i``'s modes as a tree of sets (bank rows as in :func:`_pyramid_layout`): separating, or closed
     (its gap row an equality); closed and frictional: rolling (both tangent rows), or sliding in one of the
-    arcs of at most ``K / 2`` sectors (a half-plane at most, so their rows are its two boundary rays)."""
+    arcs of at most ``K / 2`` sectors (a half-plane at most, so their rows are its two boundary rays). The same
+    for every problem of ``m`` contacts and ``K`` edges, so made once (no node writes a mode)."""
     every, none = np.ones(K, dtype=bool), np.zeros(K, dtype=bool)
     separating = _mode(i, [], [], none, separating=True)
     if not frictional:  # its closed modes are one: its columns are all the normal, so one of them is kept
@@ -382,13 +404,176 @@ def _tree_depth(mode: _Mode) -> int:
     return 1 + max((_tree_depth(child) for child in mode.children), default=-1)
 
 
+@dataclass(frozen=True)
+class RelaxationProof:
+    """The mode branch and bound on the sector relaxation of exact cones (:func:`relaxation_excluded`).
+
+    ``excluded``: no pattern holds a point of the relaxation (then no exact motion exists). Otherwise
+    ``sectors`` names, per contact, the sector a surviving pattern slides in (-1: rolling, separating or
+    frictionless), with a twist ``q`` of it; ``sectors`` is None when the search gave no answer (budget, time,
+    an LP that did not answer).
+    """
+
+    excluded: bool
+    sectors: tuple[int, ...] | None = None
+    q: np.ndarray | None = None
+    nodes: int = 0
+
+
+ROLLING_POLYGON = 16  # tangents of the circle bounding a rolling contact's force in the sector relaxation
+
+
+def relaxation_excluded(problem: Problem, sectors: list[np.ndarray], remaining: Callable[[], float] | None = None) -> RelaxationProof:
+    """Whether the sector relaxation of the exact 3-D laws (:mod:`.wedge`) has no point, by the mode branch and bound.
+
+    ``sectors``: per contact, the increasing angles ``theta_0 < ... < theta_S = theta_0 + 2 pi`` that split its
+    tangent plane (each sector narrower than a half-turn). The relaxation's disjunction is a choice of mode per
+    contact, each linear rows on the twist times a cone of forces: separating (``wn >= 0``, no force), rolling
+    (``wn = 0``, no slip, ``-c_t`` in the 16-gon around the circle: its vertices' columns) or sliding in sector
+    ``k`` (``wn = 0``, the slip between the sector's two boundary rays, ``-c_t`` in the hull of the arc's ends
+    and the meeting points of the tangents at its ends and middle: the four vertices of the wedge's polygon of
+    chord and tangents, which holds the arc). With the modes fixed the twist and the forces share no unknown,
+    as in the pyramid's search: a pattern is excluded by a checked Farkas vector, by its twist rows (every row
+    loosened by ``LP_FEASIBILITY``), or at a leaf by a HiGHS LP on its twist rows. A leaf that survives is
+    returned (its sectors, and a twist of it): the caller refines them.
+    """
+    layout, sector_of = _sector_layout(problem, sectors)
+    width = layout.loads.shape[1] // problem.n_contacts
+    rows = _Rows(
+        layout.bank,
+        layout.rhs,
+        np.linalg.norm(layout.bank, axis=1),
+        layout.loads,
+        problem.g,
+        None,
+        None,
+        layout.levels,
+        PYRAMID_PATTERN_NODES,
+        _FarkasVectors(layout.loads, problem.g, math.sqrt(problem.g.size) * LP_FEASIBILITY),
+        remaining=remaining,
+        width=width,
+    )
+    m = problem.n_contacts
+    every, block = (1 << layout.loads.shape[1]) - 1, (1 << width) - 1
+    rows.outside = [every & ~(block << (width * i)) for i in range(m)]
+    root_columns = functools.reduce(lambda bits, mode: bits & ~mode.removes, layout.roots, every)  # no padding
+    root = _Node(0, (1 << m) - 1, root_columns, layout.roots, 0)
+    fit = _fitted_forces(rows, root.columns)
+    closed = fit is None or _search(rows, _past_settled(rows, root), fit, _UNKNOWN)
+    nodes = rows.proof.nodes
+    if closed:
+        return RelaxationProof(True, nodes=nodes)
+    survivor, q = rows.survivor, rows.survivor_twist
+    if survivor is None or q is None:
+        return RelaxationProof(False, nodes=nodes)  # out of nodes or time, or an LP that did not answer
+    return RelaxationProof(False, tuple(sector_of.get(id(mode), -1) for mode in survivor.modes), q, nodes)
+
+
+def _relaxed_twist(rows: _Rows, node: _Node) -> tuple[str, np.ndarray]:
+    """The LP status of a leaf's twist rows (HiGHS, to ``LP_FEASIBILITY``) and, when ``optimal``, a twist meeting them."""
+    equal, at_least = rows.row_mask(node.equal), rows.row_mask(node.at_least)
+    E, e, A, a = rows.bank[equal], rows.rhs[equal], rows.bank[at_least], rows.rhs[at_least]
+    rows.proof.lps += 1
+    lp = solve_lp(np.zeros(rows.g.size), np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
+    return lp.status, lp.x
+
+
+def _sector_layout(problem: Problem, sectors: list[np.ndarray]) -> tuple[_Layout, dict[int, int]]:
+    """The sector relaxation's rows and columns (see :func:`relaxation_excluded`), and the sector each leaf mode
+    slides in (by the mode's ``id``). ``bank``: the normal rows (``i``), the two tangent rows (``m + i``,
+    ``2 m + i``), then per contact and boundary angle ``theta`` the rows ``a(theta) x u >= 0`` and its negation,
+    with ``u = Jt q - bt``. ``loads``: per contact a block of columns (the widest contact's count; the others
+    padded with columns no mode keeps): a unit normal force with ``-c_t`` at each vertex of the rolling 16-gon,
+    at the circle's point on each boundary ray, and at the two tangent points of each sector."""
+    m, n = problem.n_contacts, problem.n_dof
+    Jn, Jt, bn, bt, mu = problem.Jn, problem.Jt, problem.bn, problem.bt, problem.mu
+    width = ROLLING_POLYGON + 3 * max(len(bounds) - 1 for bounds in sectors)
+    loads = np.zeros((n, m * width))
+    bank, rhs = [Jn, Jt[:, 0], Jt[:, 1]], [bn, bt[:, 0], bt[:, 1]]
+    first_row, roots, sector_of = 3 * m, [], dict[int, int]()
+    for i, bounds in enumerate(sectors):
+        angles = np.asarray(bounds, dtype=float)
+        cos, sin = np.cos(angles), np.sin(angles)
+        crossing = cos[:, None] * Jt[i, 1] - sin[:, None] * Jt[i, 0]  # a(theta) x u, per boundary
+        values = cos * bt[i, 1] - sin * bt[i, 0]
+        bank += [crossing, -crossing]
+        rhs += [values, -values]
+        tangents = _friction_points(float(mu[i]), angles)
+        loads[:, i * width : i * width + len(tangents)] = Jn[i][:, None] - Jt[i].T @ tangents.T
+        roots.append(_sector_tree(i, m, width, len(angles) - 1, angles, first_row, bool(mu[i] > 0.0), sector_of))
+        first_row += 2 * len(angles)
+    rounds = max(_tree_depth(root) for root in roots)
+    levels = tuple(_Level(i) for _ in range(rounds) for i in range(m))
+    return _Layout(np.vstack(bank), np.concatenate(rhs), loads, tuple(roots), levels), sector_of
+
+
+def _friction_points(mu: float, angles: np.ndarray) -> np.ndarray:
+    """``-c_t`` per unit normal force at each column of a contact (:func:`_sector_layout`): the rolling 16-gon's
+    vertices, the circle's point on each boundary ray but the last (the first's), each sector's two tangent points."""
+    corners = 2.0 * np.pi * (np.arange(ROLLING_POLYGON) + 0.5) / ROLLING_POLYGON
+    lo, hi = angles[:-1], angles[1:]
+    quarter = 0.25 * (hi - lo)  # the tangents at lo and mid meet at angle lo + quarter, mu / cos(quarter) out
+    points = [
+        (mu / np.cos(np.pi / ROLLING_POLYGON), corners),
+        (mu * np.ones(lo.size), lo),
+        (np.repeat(mu / np.cos(quarter), 2), np.stack([lo + quarter, hi - quarter], axis=1).ravel()),
+    ]
+    return np.concatenate([np.stack([r * np.cos(a), r * np.sin(a)], axis=1) for r, a in points])
+
+
+def _sector_tree(
+    i: int, m: int, width: int, count: int, angles: np.ndarray, first_row: int, frictional: bool, sector_of: dict[int, int]
+) -> _Mode:
+    """Contact ``i``'s modes in the sector relaxation (rows and columns as in :func:`_sector_layout`): separating,
+    or closed; closed and frictional: rolling, or sliding in an arc of sectors of at most a half-turn (its two
+    boundary rows; the columns of its sectors' polygons), halved down to one sector."""
+    none = np.zeros(width, dtype=bool)
+    real = none.copy()
+    real[: ROLLING_POLYGON + 3 * count] = True
+    separating = _mode(i, [], [], none, separating=True)
+    if not frictional:  # every column is the normal: one is kept
+        return _mode(i, [], [], real, (_mode(i, [i], [], np.arange(width) == 0), separating))
+    rolling_columns = none.copy()
+    rolling_columns[:ROLLING_POLYGON] = True
+
+    def piece(first: int, last: int) -> np.ndarray:
+        keep = none.copy()
+        keep[ROLLING_POLYGON + (np.arange(first, last + 2) % count)] = True  # the circle's points on its rays
+        keep[ROLLING_POLYGON + count + 2 * first : ROLLING_POLYGON + count + 2 * last + 2] = True  # tangent points
+        return keep
+
+    def arc(first: int, last: int) -> _Mode:
+        rows = [first_row + first, first_row + len(angles) + last + 1]  # a(lo) x u >= 0, u x a(hi) >= 0
+        if first == last:
+            leaf = _mode(i, [i], rows, piece(first, last))
+            sector_of[id(leaf)] = first
+            return leaf
+        middle = (first + last) // 2
+        return _mode(i, [i], rows, piece(first, last), (arc(first, middle), arc(middle + 1, last)))
+
+    groups, start = [], 0
+    for k in range(1, count + 1):  # arcs of at most a half-turn
+        if k == count or angles[k + 1] - angles[start] > np.pi:
+            groups.append(arc(start, k - 1))
+            start = k
+    closed = _mode(i, [i], [], real, (_mode(i, [i, m + i, 2 * m + i], [], rolling_columns), *groups))
+    return _mode(i, [], [], real, (closed, separating))
+
+
 def prove_by_patterns(
-    form: LCPForm, seed_x: np.ndarray | None, max_motions: int = 16, remaining: Callable[[], float] | None = None
+    form: LCPForm,
+    seed_x: np.ndarray | None,
+    max_motions: int = 16,
+    remaining: Callable[[], float] | None = None,
+    reuse: bool = True,
 ) -> PatternProof:
     """Every motion of the polyhedral laws ``form`` (planar, two edges per contact, or a 3-D pyramid): whether
     each has the twist of ``seed_x`` (a point ``[q, cn, beta, lam]`` of it), or of a seed found on the way, or,
     without one, whether no motion exists; else every motion listed (at most ``max_motions``); see the module
-    docstring. ``remaining``: seconds left to the caller (the search gives up, undecided, once none are)."""
+    docstring. ``remaining``: seconds left to the caller (the search gives up, undecided, once none are).
+    ``reuse``: a node's twists narrowed from its parent's line or polygon, and balancing fits of earlier nodes
+    tried before a new one (False: each node's twists from all its rows, a new fit wherever the parent's uses a
+    column taken away; the same proof, slower, for cross-checks)."""
     problem, n_q = form.problem, form.n_q
     planar = problem.dimension == 2
     if not planar and form.n_edges < 3:  # frictionless 3-D (no edges): its normals are no pyramid's columns
@@ -410,6 +595,8 @@ def prove_by_patterns(
         _FarkasVectors(layout.loads, problem.g, math.sqrt(problem.g.size) * LP_FEASIBILITY),
         max_motions=max_motions,
         remaining=remaining,
+        reuse=reuse,
+        width=2 if planar else form.n_edges,
     )
     rows.proof.seed = seed_x
     m = problem.n_contacts
@@ -437,22 +624,22 @@ def _seed_modes_first(layout: _Layout, form: LCPForm, seed_x: np.ndarray) -> tup
     separating: see :func:`_search`)."""
     q, _, beta, _ = form.split(seed_x)
     slack = layout.bank @ q - layout.rhs
-    scale = np.linalg.norm(layout.bank, axis=1) + 1.0
+    tolerance = ZERO * (np.linalg.norm(layout.bank, axis=1) + 1.0)
+    meets, above = _bits(np.abs(slack) <= tolerance), _bits(slack >= -tolerance)
+    loaded = _bits(beta > ZERO)  # the load columns the seed's forces use
 
-    def holds(mode: _Mode, loaded: np.ndarray) -> bool:
-        return (
-            bool(np.all(np.abs(slack[mode.equal]) <= ZERO * scale[mode.equal]))
-            and bool(np.all(slack[mode.at_least] >= -ZERO * scale[mode.at_least]))
-            and not np.any(loaded & ~mode.keep)
-        )
+    def holds(mode: _Mode) -> bool:
+        return not (mode.equal_bits & ~meets or mode.at_least_bits & ~above or loaded & mode.removes)
 
-    def reorder(mode: _Mode, loaded: np.ndarray) -> _Mode:
-        children = tuple(reorder(child, loaded) for child in mode.children)
+    def reorder(mode: _Mode) -> _Mode:
+        children = tuple(reorder(child) for child in mode.children)
         if not any(child.separating for child in children):
-            children = tuple(sorted(children, key=lambda child: not holds(child, loaded)))
+            children = tuple(sorted(children, key=lambda child: not holds(child)))
+        if all(new is old for new, old in zip(children, mode.children, strict=True)):
+            return mode  # the shared tree's own (nothing moved below it)
         return dataclasses.replace(mode, children=children)
 
-    return tuple(reorder(root, beta[i] > ZERO) for i, root in enumerate(layout.roots))
+    return tuple(reorder(root) for root in layout.roots)
 
 
 def _verdict(rows: _Rows, closed: bool) -> PatternVerdict:
@@ -464,7 +651,7 @@ def _verdict(rows: _Rows, closed: bool) -> PatternVerdict:
         return PatternVerdict.NONE if seed_x is None else PatternVerdict.UNIQUE
     found = list(rows.found)
     if seed_x is not None and not any(_on_continuum(rows, f, rows.seed) for f in found):  # unless a continuum has it
-        found.insert(0, _Found(RawMotion(seed_x[: rows.form.n_q], rows.form.forces(seed_x)), np.zeros(0, dtype=bool)))
+        found.insert(0, _Found(RawMotion(seed_x[: rows.lcp.n_q], rows.lcp.forces(seed_x)), np.zeros(0, dtype=bool)))
     if len(found) > rows.max_motions:
         return PatternVerdict.UNDECIDED  # the SCIP search lists as many as asked and says the list is incomplete
     rows.proof.motions = tuple(f.motion for f in found)
@@ -509,6 +696,12 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
         if child_fit is None:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
+        if child.depth == leaf and rows.form is None:  # the sector relaxation: a leaf with a twist is a point of it
+            status, q = _relaxed_twist(rows, child)
+            if status == "infeasible":
+                continue
+            rows.survivor, rows.survivor_twist = child, (q if status == "optimal" else None)
+            return False
         if child.depth == leaf:
             if child_twists is twists:  # every row counted: a tighter ball, perhaps the seed's
                 child_twists = _twist(rows, child)
@@ -547,7 +740,7 @@ def _child_twists(rows: _Rows, node: _Node, child: _Node, mode: _Mode, parent: _
     that keeps its parent's closed rows and adds inequalities narrows the parent's line or polygon by them
     (:func:`_narrowed`); others are worked out from their rows (:func:`_twist`)."""
     if not (mode.separating or parent.point):
-        if parent.shape is not None and child.equal == node.equal:
+        if rows.reuse and parent.shape is not None and child.equal == node.equal:
             own = _narrowed(rows, parent, parent.shape, child.at_least & ~node.at_least)
         else:
             own = _twist(rows, child)
@@ -576,7 +769,7 @@ def _form_point(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> np.ndarray | Non
 
     ``fit`` holds a unit normal force on each edge (``K`` per contact): ``cn`` their sum, ``beta = mu fit``; the
     slip speed ``lam`` is the least the edges accept, ``max(0, max_k -d_k.u)`` (in 2-D, ``|s|``)."""
-    form = rows.form
+    form = rows.lcp
     m, K = form.edges.shape[:2]
     mu = form.problem.mu
     per_edge = fit.reshape(m, K)
@@ -587,7 +780,7 @@ def _form_point(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> np.ndarray | Non
     # the search reads a point's pattern from which of each pair is nearer zero.
     pairs_part = x[q.size :]  # a view: forces and slip speeds, all >= 0
     pairs_part[pairs_part <= ZERO] = 0.0
-    return x if satisfies_form(rows.form, x) else None
+    return x if satisfies_form(rows.lcp, x) else None
 
 
 _PARALLEL = 1e-13  # sine of the angle below which two twist rows' lines in a plane are parallel (round-off)
@@ -617,7 +810,7 @@ def _record_point(rows: _Rows, q: np.ndarray, fit: np.ndarray, columns: np.ndarr
     if x is None:
         return False
     if not _known_point(rows, q, columns):
-        rows.found.append(_Found(RawMotion(q, rows.form.forces(x)), columns))
+        rows.found.append(_Found(RawMotion(q, rows.lcp.forces(x)), columns))
     return len(rows.found) <= rows.max_motions
 
 
@@ -685,7 +878,7 @@ def _record_continuum(
     x = _form_point(rows, inside, fit) if np.all(np.isfinite(inside)) else None
     if x is None or any(_form_point(rows, p, fit) is None for p in extremes):
         return False
-    motion = RawMotion(inside, rows.form.forces(x), tuple(extremes), bool(free), free, extremes_share_forces=True)
+    motion = RawMotion(inside, rows.lcp.forces(x), tuple(extremes), bool(free), free, extremes_share_forces=True)
     if not any(_same_continuum(motion, f.motion) for f in rows.found):
         listed = _Found(motion, columns, region)
         rows.found[:] = [f for f in rows.found if f.motion.continuum or not _holds(rows, listed, f.motion.q, f.columns)]
@@ -721,7 +914,7 @@ def _on_continuum(rows: _Rows, found: _Found, q: np.ndarray | None) -> bool:
         return False
     E, e, A, a = found.region
     inside = np.all(np.abs(E @ q - e) <= LP_FEASIBILITY) and np.all(A @ q - a >= -LP_FEASIBILITY)
-    problem = rows.form.problem
+    problem = rows.lcp.problem
     return bool(inside) and contact_modes(problem, q) == contact_modes(problem, found.motion.q)
 
 
@@ -793,13 +986,14 @@ def _known_forces(rows: _Rows, columns: int, fit: _Fit) -> _Fit | None:
     balancing the load on fewer columns balance it on more); None when there is none."""
     if not fit.support & ~columns:
         return fit
-    return rows.fits.usable(columns)
+    return rows.fits.usable(columns) if rows.reuse else None
 
 
 def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
     """Non-negative forces on ``columns`` (bits) by a non-negative least-squares fit, balancing the load within
     the margin, or None with a checked Farkas vector (kept in ``rows.farkas``: it may exclude the next nodes'
     columns too); a fit that does neither is returned (the node is not excluded)."""
+    rows.proof.fits += 1
     index = rows.columns(columns)
     G = rows.loads[:, index]
     lam = np.zeros(index.size)
@@ -941,13 +1135,11 @@ def _narrowed(rows: _Rows, parent: _Twists, shape: _Shape, new_rows: int) -> _Tw
         if interval is None:
             return _PRUNED
         return parent if interval == shape.interval else _line(rows, closed, *interval)
-    reserve, rates = closed.row_reserve, closed.row_rates
+    reserve, (first, second) = closed.row_reserve, closed.row_rates
     vertices = shape.vertices
     assert vertices is not None
     for j in _indices(new_rows):
-        rate = rates[j]
-        assert isinstance(rate, list)
-        vertices = _cut(vertices, rate, reserve[j])
+        vertices = _cut(vertices, (first[j], second[j]), reserve[j])
         if not vertices:
             return _PRUNED
     return parent if vertices is shape.vertices else _polygon(rows, closed, vertices)
@@ -957,10 +1149,9 @@ def _interval(closed: _ClosedSet, interval: tuple[float, float], at_least: int) 
     """The part of ``interval`` of the closed set's line ``q0 + t d`` where the rows ``at_least`` (bits) hold,
     ``rate t + reserve >= 0`` each; None when it is empty."""
     low, high = interval
-    reserve, rates = closed.row_reserve, closed.row_rates
+    reserve, (rates,) = closed.row_reserve, closed.row_rates
     for j in _indices(at_least):
         rate, slack = rates[j], reserve[j]
-        assert isinstance(rate, float)
         if rate > 0.0:
             low = max(low, -slack / rate)
         elif rate < 0.0:
@@ -994,9 +1185,9 @@ class _ClosedSet:
     slope: np.ndarray | None
     plane: np.ndarray  # (2, n): orthonormal directions of what ``n - 2`` rows leave (the last two of E's full ``vt``)
     # The same per bank row as plain floats, read a few at a time by :func:`_narrowed`: ``reserve``, and the
-    # row's rate along the line (``slope``) or in the plane (``bank plane^T``, on ``n - 2`` rows); else empty.
+    # row's rate along the line (``slope``) or along each of the plane's directions (on ``n - 2`` rows); else empty.
     row_reserve: list[float]
-    row_rates: list[float] | list[list[float]]
+    row_rates: tuple[list[float], ...]
 
 
 def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
@@ -1030,11 +1221,11 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     reserve = bank @ q0 + LP_FEASIBILITY * np.abs(bank @ pseudo_inverse).sum(axis=1) - rows.rhs + LP_FEASIBILITY
     direction = vt[-1]
     slope = bank @ direction if k < n else None
-    rates: list[float] | list[list[float]] = []  # for a line or a plane only (a point's children keep it)
+    rates: tuple[list[float], ...] = ()  # for a line or a plane only (a point's children keep it)
     if k == n - 1 and slope is not None:
-        rates = slope.tolist()
+        rates = (slope.tolist(),)
     elif k == n - 2:
-        rates = (bank @ vt[-2:].T).tolist()
+        rates = ((bank @ vt[-2]).tolist(), (bank @ vt[-1]).tolist())
     return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], reserve.tolist() if rates else [], rates)
 
 
@@ -1086,7 +1277,7 @@ def _on_plane(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.nd
     return _polygon(rows, closed, [(x, y) for x, y in vertices.tolist()])
 
 
-def _cut(vertices: _Vertices, rate: list[float], reserve: float) -> _Vertices:
+def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Vertices:
     """The points whose hull is the hull of ``vertices`` cut by ``rate.x + reserve >= 0``: the vertices that meet
     it (with round-off's leniency, as :func:`_on_plane`'s), and the two ends of the cut, the outermost points where
     a segment between a vertex above the line and one below crosses it (every edge of the hull is such a segment,
@@ -1113,7 +1304,7 @@ def _polygon(rows: _Rows, closed: _ClosedSet, vertices: _Vertices) -> _Twists:
     if _all_near_seed(rows, twists, closed.spread):
         return _PRUNED
     center = 0.5 * (twists.min(axis=0) + twists.max(axis=0))
-    reach = float(np.sqrt(np.max(np.sum((twists - center) ** 2, axis=1))))
+    reach = math.sqrt(float(((twists - center) ** 2).sum(axis=1).max()))
     return _Twists(False, _Ball(center, reach * (1.0 + ROUNDOFF_SLACK) + closed.radius), shape=_Shape(closed, vertices=vertices))
 
 
@@ -1127,7 +1318,7 @@ def _all_near_seed(rows: _Rows, twists: np.ndarray, spread: np.ndarray) -> bool:
     """Whether every twist of ``twists`` (rows; their hull) lies within the seed's box, as :func:`_near_seed`."""
     if rows.seed is None:
         return False
-    offset = np.max(np.abs(twists - rows.seed), axis=0)
+    offset = np.abs(twists - rows.seed).max(axis=0)
     return bool(offset.max() <= 0.5 * SAME_TWIST and (offset + spread).max() <= 0.5 * DISTINCT_TWIST)
 
 
