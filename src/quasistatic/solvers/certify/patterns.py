@@ -110,6 +110,13 @@ empty, or its twists the seed's, which is listed) or listed as above. So the
 list holds every motion, to the tolerances above; the seed is listed first,
 unless a listed continuum holds it with the continuum's own contact modes.
 
+**The sector relaxation of exact cones** (:func:`relaxation_excluded`, for :mod:`.wedge`) is searched by the
+same tree with other modes: per contact separating, rolling (force in a 16-gon around the circle) or sliding
+with its slip in one sector (force in that sector's polygon of chord and tangents), arcs of sectors halved
+down to one. Its nodes are pruned as above; a leaf is pruned only by an LP on its twist rows (infeasible),
+and the first that survives ends the search with its sectors (no seed, nothing listed): a closed tree proves
+that no point of the relaxation exists, within :data:`PYRAMID_PATTERN_NODES` nodes.
+
 A leaf whose point or extremes fail the form's check (too close to call), an
 LP that does not answer, more motions than asked for, or more than
 :data:`PATTERN_NODES` (3-D: :data:`PYRAMID_PATTERN_NODES`) nodes give no answer: the caller runs the SCIP search
@@ -255,7 +262,7 @@ class _Rows:
         return _mask(bits, self.bank.shape[0])
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
 class _Node:
     """Which bank rows hold as equalities and inequalities, which load columns may carry force (bit sets: bit
     ``j`` for row or column ``j``), each contact's current set of modes, how deep."""
@@ -290,7 +297,7 @@ def _mask(bits: int, size: int) -> np.ndarray:
     return np.unpackbits(packed, count=size, bitorder="little").view(bool)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
 class _Ball:
     """Every loosened twist of a node lies within ``radius`` (2-norm) of ``center``."""
 
@@ -972,7 +979,7 @@ def _balances(rows: _Rows, fit: np.ndarray) -> bool | None:
     return True if float(np.linalg.norm(rows.loads @ fit + rows.g)) <= _margin(rows) else None
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
 class _Fit:
     """Non-negative forces on the load columns (``forces``), and which columns they use (``support``, bits)."""
 
@@ -1065,7 +1072,7 @@ class _FarkasVectors:
         return [any(not blockers & ~mode.removes for blockers in inside) for mode in modes]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
 class _Twists:
     """What a node's twists are known to be: ``pruned`` (empty, or the seed's); else within ``ball`` (2-norm,
     for filtering modes) when known, and ``point`` when the closed rows leave one twist (a leaf there is another
@@ -1078,7 +1085,7 @@ class _Twists:
     shape: _Shape | None = None
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
 class _Shape:
     """A node's loosened twists on what its closed rows leave (``closed``): ``q0 + t direction`` with ``t`` in
     ``interval`` (a line), or ``q0 + x plane`` with ``x`` in the hull of ``vertices`` (a plane, (V, 2)), each
