@@ -152,7 +152,17 @@ from ..numerics.highs import WarmLP, solve_lp
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
-__all__ = ["PatternVerdict", "PatternProof", "prove_by_patterns", "PATTERN_PROOF", "NO_MOTION_PROOF", "ENUMERATION_PROOF"]
+__all__ = [
+    "PatternVerdict",
+    "PatternProof",
+    "prove_by_patterns",
+    "PATTERN_PROOF",
+    "NO_MOTION_PROOF",
+    "ENUMERATION_PROOF",
+    "RelaxationProof",
+    "relaxation_excluded",
+    "ROLLING_POLYGON",
+]
 
 PATTERN_PROOF = "every contact-mode pattern excluded or holding the found twist alone (mode branch and bound, LPs and Farkas vectors)"
 NO_MOTION_PROOF = "no contact-mode pattern holds a motion (mode branch and bound, LPs and Farkas vectors)"

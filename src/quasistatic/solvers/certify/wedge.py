@@ -52,7 +52,7 @@ from ...solution import Mode
 from ...tolerances import EXACT_SECTOR_FRICTION, MODE_SPEED, SECTOR_ACTIVE
 from ..numerics.scip_model import linear, new_model, optimize
 from ..result import Options
-from .patterns import relaxation_excluded
+from .patterns import ROLLING_POLYGON, relaxation_excluded
 
 __all__ = ["exact_cones_jam", "SECTORS", "FINEST", "BRANCH_AND_BOUND_ROUNDS", "BY_BRANCH_AND_BOUND", "BY_SCIP"]
 
@@ -61,7 +61,6 @@ FINEST = 2.0 * np.pi / 256  # narrowest sector [rad] the refinement makes
 BRANCH_AND_BOUND_ROUNDS = 24  # refinements decided by the mode branch and bound before SCIP's loop goes on
 BY_BRANCH_AND_BOUND = "mode branch and bound, Farkas vectors and LPs"  # what decided a proof, for its certificate
 BY_SCIP = "SCIP, complete search"
-_ROLLING_POLYGON = 16  # tangents of the circle bounding a rolling contact's force
 
 
 def exact_cones_jam(
@@ -188,7 +187,7 @@ def _friction(
     # The rolling part: no slip, p inside the circle's tangents.
     cn_roll = scip.addVar(lb=0.0, ub=0.0 if mode == "sliding" else None, name=f"cn_roll{name}")
     p_roll = [scip.addVar(lb=None, ub=None, name=f"p_roll{name}_{t}") for t in range(2)]
-    for angle in 2.0 * np.pi * np.arange(_ROLLING_POLYGON) / _ROLLING_POLYGON:
+    for angle in 2.0 * np.pi * np.arange(ROLLING_POLYGON) / ROLLING_POLYGON:
         scip.addCons(np.cos(angle) * p_roll[0] + np.sin(angle) * p_roll[1] <= mu * cn_roll)
     cn_parts, p_parts, u_parts, sizes, parts = [cn_roll], [p_roll], [], [], []
     for k in range(len(bounds) - 1 if mode != "rolling" else 0):
