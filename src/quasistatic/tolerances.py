@@ -154,7 +154,8 @@ PYRAMID_PATTERN_NODES = 8192
 """Most nodes of the 3-D pyramid's mode branch and bound (:mod:`quasistatic.solvers.certify.patterns`) before it
 gives the proof to the SCIP search [-]: measured on the 8-edge pyramid, the benchmark's 3-D grasps of 4-8 contacts
 need 208-4822 (0.03-0.6 s), where SCIP took 0.2-30 s; of 240 random scenes of 2-4 contacts, 235 were decided
-within it. A node costs 90-130 us, so the budget wastes at most about a second before SCIP."""
+within it. A node costs 55-90 us (about 64 on those grasps), so the budget wastes at most about 0.6 s before SCIP.
+The same budget bounds the search of the exact cones' sector relaxation (``patterns.relaxation_excluded``)."""
 
 ARRANGEMENT_CONTACTS = 16
 """Most contacts of a planar one-body problem the vertex certificate (:mod:`quasistatic.solvers.certify.arrangement`)

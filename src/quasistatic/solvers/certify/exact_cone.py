@@ -100,10 +100,10 @@ def _no_motion(problem: Problem, options: Options, proof: str) -> BackendResult:
 
 def _wedge_proof(problem: Problem, options: Options) -> str:
     """A certificate that the exact cones admit no motion (a sector relaxation of the exact laws is infeasible), or ''."""
-    proven, sectors = exact_cones_jam(problem, options, options.modes, lambda q: _exact_forces(problem, q) is not None)
+    proven, sectors, method = exact_cones_jam(problem, options, options.modes, lambda q: _exact_forces(problem, q) is not None)
     if not proven:
         return ""
-    return f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; SCIP, complete search)"
+    return f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; {method})"
 
 
 def _exact_forces(problem: Problem, q: np.ndarray) -> np.ndarray | None:

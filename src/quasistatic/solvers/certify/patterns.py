@@ -69,6 +69,16 @@ contain those of every assignment below it, and a node is pruned when
 - at a leaf whose rows leave a polyhedron of twists, HiGHS finds it empty
   (LP status), or all its extremes within ``SAME_TWIST / 2`` of ``q*``.
 
+**Reuse.** A child that keeps its parent's closed rows (an arc halved, a vertex) has the parent's twists cut by
+its new inequality rows: the line's interval narrowed, or the polygon's points cut by each row, keeping the
+points that meet it (with the same round-off leniency) and the two outermost points where a segment between a
+point above the row's line and one below crosses it. Every edge of the hull is such a segment, so the hull of
+the points kept holds the cut polygon, and the child is pruned and bounded from it as from its own rows. A fit
+found at an earlier node that balances the load serves every node whose columns hold the columns it uses;
+a Farkas vector is kept as the columns that stop it from excluding (it excludes a node's columns exactly
+when they hold none of them). ``reuse=False`` works every node out from its own rows instead: the same nodes
+and verdicts, for cross-checks.
+
 Without a seed, the first surviving leaf whose twist and forces satisfy every law
 of the form (checked as Lemke's point is, :func:`~.cheap.satisfies_form`) becomes
 the seed, and the search goes on: nodes pruned before did not depend on it.
@@ -99,6 +109,13 @@ lies in some leaf's ``Q x F``; every leaf is either pruned (its ``F`` or ``Q``
 empty, or its twists the seed's, which is listed) or listed as above. So the
 list holds every motion, to the tolerances above; the seed is listed first,
 unless a listed continuum holds it with the continuum's own contact modes.
+
+**The sector relaxation of exact cones** (:func:`relaxation_excluded`, for :mod:`.wedge`) is searched by the
+same tree with other modes: per contact separating, rolling (force in a 16-gon around the circle) or sliding
+with its slip in one sector (force in that sector's polygon of chord and tangents), arcs of sectors halved
+down to one. Its nodes are pruned as above; a leaf is pruned only by an LP on its twist rows (infeasible),
+and the first that survives ends the search with its sectors (no seed, nothing listed): a closed tree proves
+that no point of the relaxation exists, within :data:`PYRAMID_PATTERN_NODES` nodes.
 
 A leaf whose point or extremes fail the form's check (too close to call), an
 LP that does not answer, more motions than asked for, or more than
@@ -135,7 +152,17 @@ from ..numerics.highs import WarmLP, solve_lp
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
-__all__ = ["PatternVerdict", "PatternProof", "prove_by_patterns", "PATTERN_PROOF", "NO_MOTION_PROOF", "ENUMERATION_PROOF"]
+__all__ = [
+    "PatternVerdict",
+    "PatternProof",
+    "prove_by_patterns",
+    "PATTERN_PROOF",
+    "NO_MOTION_PROOF",
+    "ENUMERATION_PROOF",
+    "RelaxationProof",
+    "relaxation_excluded",
+    "ROLLING_POLYGON",
+]
 
 PATTERN_PROOF = "every contact-mode pattern excluded or holding the found twist alone (mode branch and bound, LPs and Farkas vectors)"
 NO_MOTION_PROOF = "no contact-mode pattern holds a motion (mode branch and bound, LPs and Farkas vectors)"
@@ -161,6 +188,7 @@ class PatternProof:
     seed: np.ndarray | None = None
     nodes: int = 0
     lps: int = 0
+    fits: int = 0  # non-negative least-squares fits made
     motions: tuple[RawMotion, ...] = ()
     equilibrium: bool | None = None  # at the root: True, a balancing fit; False, a checked Farkas vector; None, neither
 
@@ -177,6 +205,10 @@ class _Mode:
     keep: np.ndarray  # bool (K,): the contact's load columns its force may use
     children: tuple[_Mode, ...] = ()
     separating: bool = False  # no force, the gap row stays an inequality (as at the root)
+    # The same sets as bits (bit j: bank row or load column j), which a node combines in integer operations.
+    equal_bits: int = 0
+    at_least_bits: int = 0
+    removes: int = 0  # the contact's load columns its force may not use
 
 
 @dataclass(frozen=True, slots=True)
@@ -208,55 +240,74 @@ class _Rows:
     loads: np.ndarray
     g: np.ndarray
     seed: np.ndarray | None  # the seed's twist
-    form: LCPForm
+    form: LCPForm | None  # None: the sector relaxation of exact cones (:func:`relaxation_excluded`)
     levels: tuple[_Level, ...]
     budget: int  # most nodes
     farkas: _FarkasVectors
+    fits: _Fits = field(default_factory=lambda: _Fits())
+    filters: dict[int, _ModeFilter] = field(default_factory=dict)  # by the ``id`` of a tuple of the tree's modes
+    outside: list[int] = field(default_factory=list)  # per contact: the load columns not its own (bits)
     proof: PatternProof = field(default_factory=lambda: PatternProof(PatternVerdict.UNDECIDED))
-    closed_sets: dict[bytes, _ClosedSet | _Twists] = field(default_factory=dict)  # by which bank rows are closed
+    closed_sets: dict[int, _ClosedSet | _Twists] = field(default_factory=dict)  # by which bank rows are closed (bits)
     max_motions: int = 16
     remaining: Callable[[], float] | None = None  # seconds left to the caller
+    reuse: bool = True  # narrow a node's twists from its parent's; try earlier nodes' fits (see prove_by_patterns)
+    width: int = 2  # load columns per contact
+    survivor: _Node | None = None  # the sector relaxation's leaf whose twists and forces were not excluded
+    survivor_twist: np.ndarray | None = None  # a twist of it (None: its LP did not answer)
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
 
     @property
-    def width(self) -> int:
-        """Load columns per contact (the form's edges)."""
-        return self.form.n_edges
+    def lcp(self) -> LCPForm:
+        """The polyhedral laws searched (a motion search, not the sector relaxation's)."""
+        assert self.form is not None
+        return self.form
+
+    def columns(self, bits: int) -> np.ndarray:
+        """Load columns as a boolean mask."""
+        return _mask(bits, self.loads.shape[1])
+
+    def row_mask(self, bits: int) -> np.ndarray:
+        """Bank rows as a boolean mask."""
+        return _mask(bits, self.bank.shape[0])
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
 class _Node:
-    """Which bank rows hold as equalities and inequalities, which load columns may carry force, each contact's
-    current set of modes, how deep."""
+    """Which bank rows hold as equalities and inequalities, which load columns may carry force (bit sets: bit
+    ``j`` for row or column ``j``), each contact's current set of modes, how deep."""
 
-    equal: np.ndarray
-    at_least: np.ndarray
-    columns: np.ndarray
+    equal: int
+    at_least: int
+    columns: int
     modes: tuple[_Mode, ...]
     depth: int
-    closed_rows: int = 0  # how many entries of ``equal`` are set
+    closed_rows: int = 0  # how many rows ``equal`` holds
 
-    def child(self, rows: _Rows, contact: int, mode: _Mode) -> _Node:
-        columns = self.columns.copy()
-        K = rows.width
-        columns[K * contact : K * contact + K] &= mode.keep
+    def child(self, contact: int, mode: _Mode) -> _Node:
+        columns = self.columns & ~mode.removes
         modes = (*self.modes[:contact], mode, *self.modes[contact + 1 :])
-        new_equal = mode.equal[~self.equal[mode.equal]]
-        new_at_least = mode.at_least[~self.at_least[mode.at_least]]
-        if not (new_equal.size or new_at_least.size):  # the parent's twist rows: its arrays, shared (no node writes them)
-            return _Node(self.equal, self.at_least, columns, modes, self.depth + 1, self.closed_rows)
-        equal, at_least = self.equal.copy(), self.at_least.copy()
-        at_least[new_equal] = False
-        equal[new_equal] = True
-        at_least[new_at_least] = True
-        return _Node(equal, at_least, columns, modes, self.depth + 1, self.closed_rows + new_equal.size)
+        new_equal = mode.equal_bits & ~self.equal
+        at_least = (self.at_least & ~new_equal) | (mode.at_least_bits & ~self.at_least)
+        return _Node(self.equal | new_equal, at_least, columns, modes, self.depth + 1, self.closed_rows + new_equal.bit_count())
 
     def deeper(self) -> _Node:
         """The same node one level down (a level that does not apply to it)."""
         return _Node(self.equal, self.at_least, self.columns, self.modes, self.depth + 1, self.closed_rows)
 
 
-@dataclass(frozen=True, slots=True)
+def _bits(mask: np.ndarray) -> int:
+    """A boolean array as a bit set (bit ``j`` set where ``mask[j]``)."""
+    return int.from_bytes(np.packbits(mask, bitorder="little").tobytes(), "little")
+
+
+def _mask(bits: int, size: int) -> np.ndarray:
+    """A bit set as a boolean array of ``size`` entries (the inverse of :func:`_bits`)."""
+    packed = np.frombuffer(bits.to_bytes((size + 7) // 8, "little"), dtype=np.uint8)
+    return np.unpackbits(packed, count=size, bitorder="little").view(bool)
+
+
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
 class _Ball:
     """Every loosened twist of a node lies within ``radius`` (2-norm) of ``center``."""
 
@@ -264,8 +315,14 @@ class _Ball:
     radius: float
 
 
-def _mode(equal: list[int], at_least: list[int], keep: np.ndarray, children: tuple[_Mode, ...] = (), separating: bool = False) -> _Mode:
-    return _Mode(np.array(equal, dtype=int), np.array(at_least, dtype=int), keep, children, separating)
+def _mode(
+    contact: int, equal: list[int], at_least: list[int], keep: np.ndarray, children: tuple[_Mode, ...] = (), separating: bool = False
+) -> _Mode:
+    """Contact ``contact``'s set of modes (``keep``: its block of ``K = keep.size`` load columns)."""
+    K = keep.size
+    removes = sum(1 << (K * contact + k) for k in range(K) if not keep[k])
+    equal_bits, at_least_bits = sum(1 << r for r in set(equal)), sum(1 << r for r in set(at_least))
+    return _Mode(np.array(equal, dtype=int), np.array(at_least, dtype=int), keep, children, separating, equal_bits, at_least_bits, removes)
 
 
 def _planar_layout(problem: Problem, order: list[int]) -> _Layout:
@@ -277,17 +334,21 @@ def _planar_layout(problem: Problem, order: list[int]) -> _Layout:
     Jn, Jt, bn, bt = problem.Jn, problem.Jt[:, 0, :], problem.bn, problem.bt[:, 0]
     mu = problem.mu[:, None]
     loads = np.stack([Jn + mu * Jt, Jn - mu * Jt], axis=1).reshape(-1, problem.n_dof).T
-    both, plus, minus, none = np.array([True, True]), np.array([True, False]), np.array([False, True]), np.array([False, False])
-    roots = []
-    for i in range(m):
-        separating = _mode([], [], none, separating=True)
-        if problem.mu[i] <= 0.0:  # frictionless: both columns are the normal
-            modes: tuple[_Mode, ...] = (_mode([i], [], plus), separating)
-        else:
-            modes = (_mode([i, m + i], [], both), _mode([i], [2 * m + i], plus), _mode([i], [3 * m + i], minus), separating)
-        roots.append(_mode([], [], both, modes))
+    roots = tuple(_planar_tree(i, m, bool(problem.mu[i] > 0.0)) for i in range(m))
     bank, rhs = np.vstack([Jn, Jt, -Jt, Jt]), np.concatenate([bn, bt, -bt, bt])
-    return _Layout(bank, rhs, loads, tuple(roots), tuple(_Level(i) for i in order))
+    return _Layout(bank, rhs, loads, roots, tuple(_Level(i) for i in order))
+
+
+@functools.lru_cache(maxsize=4096)
+def _planar_tree(i: int, m: int, frictional: bool) -> _Mode:
+    """Contact ``i``'s planar modes (bank rows as in :func:`_planar_layout`); the same for every problem of
+    ``m`` contacts, so made once (no node writes a mode)."""
+    both, plus, minus, none = np.array([True, True]), np.array([True, False]), np.array([False, True]), np.array([False, False])
+    separating = _mode(i, [], [], none, separating=True)
+    if not frictional:  # both columns are the normal
+        return _mode(i, [], [], both, (_mode(i, [i], [], plus), separating))
+    modes = (_mode(i, [i, m + i], [], both), _mode(i, [i], [2 * m + i], plus), _mode(i, [i], [3 * m + i], minus), separating)
+    return _mode(i, [], [], both, modes)
 
 
 def _pyramid_layout(form: LCPForm, groups: list[list[int]]) -> _Layout:
@@ -322,19 +383,21 @@ def _pyramid_layout(form: LCPForm, groups: list[list[int]]) -> _Layout:
     return _Layout(bank, rhs, loads, roots, tuple(levels))
 
 
+@functools.lru_cache(maxsize=1024)
 def _contact_tree(i: int, m: int, K: int, frictional: bool) -> _Mode:
     """Contact ``i``'s modes as a tree of sets (bank rows as in :func:`_pyramid_layout`): separating, or closed
     (its gap row an equality); closed and frictional: rolling (both tangent rows), or sliding in one of the
-    arcs of at most ``K / 2`` sectors (a half-plane at most, so their rows are its two boundary rays)."""
+    arcs of at most ``K / 2`` sectors (a half-plane at most, so their rows are its two boundary rays). The same
+    for every problem of ``m`` contacts and ``K`` edges, so made once (no node writes a mode)."""
     every, none = np.ones(K, dtype=bool), np.zeros(K, dtype=bool)
-    separating = _mode([], [], none, separating=True)
+    separating = _mode(i, [], [], none, separating=True)
     if not frictional:  # its closed modes are one: its columns are all the normal, so one of them is kept
-        return _mode([], [], every, (_mode([i], [], np.arange(K) == 0), separating))
+        return _mode(i, [], [], every, (_mode(i, [i], [], np.arange(K) == 0), separating))
     parts = 2 if K % 2 == 0 else 3
     bounds = [round(K * p / parts) for p in range(parts + 1)]
     arcs = tuple(_arc(i, m, K, bounds[p], bounds[p + 1] - 1) for p in range(parts))
-    closed = _mode([i], [], every, (_mode([i, m + i, 2 * m + i], [], every), *arcs))
-    return _mode([], [], every, (closed, separating))
+    closed = _mode(i, [i], [], every, (_mode(i, [i, m + i, 2 * m + i], [], every), *arcs))
+    return _mode(i, [], [], every, (closed, separating))
 
 
 def _arc(i: int, m: int, K: int, first: int, last: int) -> _Mode:
@@ -347,24 +410,187 @@ def _arc(i: int, m: int, K: int, first: int, last: int) -> _Mode:
     rows = [sector_prev + first % K, sector_next + last % K]
     if first == last:
         j, edge = first % K, np.eye(K, dtype=bool)
-        vertex = _mode([i], [sector_next + j, sector_prev + j], edge[j])
-        face = _mode([i, face_equal + j], [face_sign + j], edge[j] | edge[(j + 1) % K])
-        return _mode([i], rows, keep, (vertex, face))
+        vertex = _mode(i, [i], [sector_next + j, sector_prev + j], edge[j])
+        face = _mode(i, [i, face_equal + j], [face_sign + j], edge[j] | edge[(j + 1) % K])
+        return _mode(i, [i], rows, keep, (vertex, face))
     middle = (first + last) // 2
-    return _mode([i], rows, keep, (_arc(i, m, K, first, middle), _arc(i, m, K, middle + 1, last)))
+    return _mode(i, [i], rows, keep, (_arc(i, m, K, first, middle), _arc(i, m, K, middle + 1, last)))
 
 
 def _tree_depth(mode: _Mode) -> int:
     return 1 + max((_tree_depth(child) for child in mode.children), default=-1)
 
 
+@dataclass(frozen=True)
+class RelaxationProof:
+    """The mode branch and bound on the sector relaxation of exact cones (:func:`relaxation_excluded`).
+
+    ``excluded``: no pattern holds a point of the relaxation (then no exact motion exists). Otherwise
+    ``sectors`` names, per contact, the sector a surviving pattern slides in (-1: rolling, separating or
+    frictionless), with a twist ``q`` of it; ``sectors`` is None when the search gave no answer (budget, time,
+    an LP that did not answer).
+    """
+
+    excluded: bool
+    sectors: tuple[int, ...] | None = None
+    q: np.ndarray | None = None
+    nodes: int = 0
+
+
+ROLLING_POLYGON = 16  # tangents of the circle bounding a rolling contact's force in the sector relaxation
+
+
+def relaxation_excluded(problem: Problem, sectors: list[np.ndarray], remaining: Callable[[], float] | None = None) -> RelaxationProof:
+    """Whether the sector relaxation of the exact 3-D laws (:mod:`.wedge`) has no point, by the mode branch and bound.
+
+    ``sectors``: per contact, the increasing angles ``theta_0 < ... < theta_S = theta_0 + 2 pi`` that split its
+    tangent plane (each sector narrower than a half-turn). The relaxation's disjunction is a choice of mode per
+    contact, each linear rows on the twist times a cone of forces: separating (``wn >= 0``, no force), rolling
+    (``wn = 0``, no slip, ``-c_t`` in the 16-gon around the circle: its vertices' columns) or sliding in sector
+    ``k`` (``wn = 0``, the slip between the sector's two boundary rays, ``-c_t`` in the hull of the arc's ends
+    and the meeting points of the tangents at its ends and middle: the four vertices of the wedge's polygon of
+    chord and tangents, which holds the arc). With the modes fixed the twist and the forces share no unknown,
+    as in the pyramid's search: a pattern is excluded by a checked Farkas vector, by its twist rows (every row
+    loosened by ``LP_FEASIBILITY``), or at a leaf by a HiGHS LP on its twist rows. A leaf that survives is
+    returned (its sectors, and a twist of it): the caller refines them.
+    """
+    layout, sector_of = _sector_layout(problem, sectors)
+    width = layout.loads.shape[1] // problem.n_contacts
+    rows = _Rows(
+        layout.bank,
+        layout.rhs,
+        np.linalg.norm(layout.bank, axis=1),
+        layout.loads,
+        problem.g,
+        None,
+        None,
+        layout.levels,
+        PYRAMID_PATTERN_NODES,
+        _FarkasVectors(layout.loads, problem.g, math.sqrt(problem.g.size) * LP_FEASIBILITY),
+        remaining=remaining,
+        width=width,
+    )
+    m = problem.n_contacts
+    every, block = (1 << layout.loads.shape[1]) - 1, (1 << width) - 1
+    rows.outside = [every & ~(block << (width * i)) for i in range(m)]
+    root_columns = functools.reduce(lambda bits, mode: bits & ~mode.removes, layout.roots, every)  # no padding
+    root = _Node(0, (1 << m) - 1, root_columns, layout.roots, 0)
+    fit = _fitted_forces(rows, root.columns)
+    closed = fit is None or _search(rows, _past_settled(rows, root), fit, _UNKNOWN)
+    nodes = rows.proof.nodes
+    if closed:
+        return RelaxationProof(True, nodes=nodes)
+    survivor, q = rows.survivor, rows.survivor_twist
+    if survivor is None or q is None:
+        return RelaxationProof(False, nodes=nodes)  # out of nodes or time, or an LP that did not answer
+    return RelaxationProof(False, tuple(sector_of.get(id(mode), -1) for mode in survivor.modes), q, nodes)
+
+
+def _relaxed_twist(rows: _Rows, node: _Node) -> tuple[str, np.ndarray]:
+    """The LP status of a leaf's twist rows (HiGHS, to ``LP_FEASIBILITY``) and, when ``optimal``, a twist meeting them."""
+    equal, at_least = rows.row_mask(node.equal), rows.row_mask(node.at_least)
+    E, e, A, a = rows.bank[equal], rows.rhs[equal], rows.bank[at_least], rows.rhs[at_least]
+    rows.proof.lps += 1
+    lp = solve_lp(np.zeros(rows.g.size), np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
+    return lp.status, lp.x
+
+
+def _sector_layout(problem: Problem, sectors: list[np.ndarray]) -> tuple[_Layout, dict[int, int]]:
+    """The sector relaxation's rows and columns (see :func:`relaxation_excluded`), and the sector each leaf mode
+    slides in (by the mode's ``id``). ``bank``: the normal rows (``i``), the two tangent rows (``m + i``,
+    ``2 m + i``), then per contact and boundary angle ``theta`` the rows ``a(theta) x u >= 0`` and its negation,
+    with ``u = Jt q - bt``. ``loads``: per contact a block of columns (the widest contact's count; the others
+    padded with columns no mode keeps): a unit normal force with ``-c_t`` at each vertex of the rolling 16-gon,
+    at the circle's point on each boundary ray, and at the two tangent points of each sector."""
+    m, n = problem.n_contacts, problem.n_dof
+    Jn, Jt, bn, bt, mu = problem.Jn, problem.Jt, problem.bn, problem.bt, problem.mu
+    width = ROLLING_POLYGON + 3 * max(len(bounds) - 1 for bounds in sectors)
+    loads = np.zeros((n, m * width))
+    bank, rhs = [Jn, Jt[:, 0], Jt[:, 1]], [bn, bt[:, 0], bt[:, 1]]
+    first_row, roots, sector_of = 3 * m, [], dict[int, int]()
+    for i, bounds in enumerate(sectors):
+        angles = np.asarray(bounds, dtype=float)
+        cos, sin = np.cos(angles), np.sin(angles)
+        crossing = cos[:, None] * Jt[i, 1] - sin[:, None] * Jt[i, 0]  # a(theta) x u, per boundary
+        values = cos * bt[i, 1] - sin * bt[i, 0]
+        bank += [crossing, -crossing]
+        rhs += [values, -values]
+        tangents = _friction_points(float(mu[i]), angles)
+        loads[:, i * width : i * width + len(tangents)] = Jn[i][:, None] - Jt[i].T @ tangents.T
+        roots.append(_sector_tree(i, m, width, len(angles) - 1, angles, first_row, bool(mu[i] > 0.0), sector_of))
+        first_row += 2 * len(angles)
+    rounds = max(_tree_depth(root) for root in roots)
+    levels = tuple(_Level(i) for _ in range(rounds) for i in range(m))
+    return _Layout(np.vstack(bank), np.concatenate(rhs), loads, tuple(roots), levels), sector_of
+
+
+def _friction_points(mu: float, angles: np.ndarray) -> np.ndarray:
+    """``-c_t`` per unit normal force at each column of a contact (:func:`_sector_layout`): the rolling 16-gon's
+    vertices, the circle's point on each boundary ray but the last (the first's), each sector's two tangent points."""
+    corners = 2.0 * np.pi * (np.arange(ROLLING_POLYGON) + 0.5) / ROLLING_POLYGON
+    lo, hi = angles[:-1], angles[1:]
+    quarter = 0.25 * (hi - lo)  # the tangents at lo and mid meet at angle lo + quarter, mu / cos(quarter) out
+    points = [
+        (mu / np.cos(np.pi / ROLLING_POLYGON), corners),
+        (mu * np.ones(lo.size), lo),
+        (np.repeat(mu / np.cos(quarter), 2), np.stack([lo + quarter, hi - quarter], axis=1).ravel()),
+    ]
+    return np.concatenate([np.stack([r * np.cos(a), r * np.sin(a)], axis=1) for r, a in points])
+
+
+def _sector_tree(
+    i: int, m: int, width: int, count: int, angles: np.ndarray, first_row: int, frictional: bool, sector_of: dict[int, int]
+) -> _Mode:
+    """Contact ``i``'s modes in the sector relaxation (rows and columns as in :func:`_sector_layout`): separating,
+    or closed; closed and frictional: rolling, or sliding in an arc of sectors of at most a half-turn (its two
+    boundary rows; the columns of its sectors' polygons), halved down to one sector."""
+    none = np.zeros(width, dtype=bool)
+    real = none.copy()
+    real[: ROLLING_POLYGON + 3 * count] = True
+    separating = _mode(i, [], [], none, separating=True)
+    if not frictional:  # every column is the normal: one is kept
+        return _mode(i, [], [], real, (_mode(i, [i], [], np.arange(width) == 0), separating))
+    rolling_columns = none.copy()
+    rolling_columns[:ROLLING_POLYGON] = True
+
+    def piece(first: int, last: int) -> np.ndarray:
+        keep = none.copy()
+        keep[ROLLING_POLYGON + (np.arange(first, last + 2) % count)] = True  # the circle's points on its rays
+        keep[ROLLING_POLYGON + count + 2 * first : ROLLING_POLYGON + count + 2 * last + 2] = True  # tangent points
+        return keep
+
+    def arc(first: int, last: int) -> _Mode:
+        rows = [first_row + first, first_row + len(angles) + last + 1]  # a(lo) x u >= 0, u x a(hi) >= 0
+        if first == last:
+            leaf = _mode(i, [i], rows, piece(first, last))
+            sector_of[id(leaf)] = first
+            return leaf
+        middle = (first + last) // 2
+        return _mode(i, [i], rows, piece(first, last), (arc(first, middle), arc(middle + 1, last)))
+
+    groups, start = [], 0
+    for k in range(1, count + 1):  # arcs of at most a half-turn
+        if k == count or angles[k + 1] - angles[start] > np.pi:
+            groups.append(arc(start, k - 1))
+            start = k
+    closed = _mode(i, [i], [], real, (_mode(i, [i, m + i, 2 * m + i], [], rolling_columns), *groups))
+    return _mode(i, [], [], real, (closed, separating))
+
+
 def prove_by_patterns(
-    form: LCPForm, seed_x: np.ndarray | None, max_motions: int = 16, remaining: Callable[[], float] | None = None
+    form: LCPForm,
+    seed_x: np.ndarray | None,
+    max_motions: int = 16,
+    remaining: Callable[[], float] | None = None,
+    reuse: bool = True,
 ) -> PatternProof:
     """Every motion of the polyhedral laws ``form`` (planar, two edges per contact, or a 3-D pyramid): whether
     each has the twist of ``seed_x`` (a point ``[q, cn, beta, lam]`` of it), or of a seed found on the way, or,
     without one, whether no motion exists; else every motion listed (at most ``max_motions``); see the module
-    docstring. ``remaining``: seconds left to the caller (the search gives up, undecided, once none are)."""
+    docstring. ``remaining``: seconds left to the caller (the search gives up, undecided, once none are).
+    ``reuse``: a node's twists narrowed from its parent's line or polygon, and balancing fits of earlier nodes
+    tried before a new one (False: each node's twists from all its rows, a new fit wherever the parent's uses a
+    column taken away; the same proof, slower, for cross-checks)."""
     problem, n_q = form.problem, form.n_q
     planar = problem.dimension == 2
     if not planar and form.n_edges < 3:  # frictionless 3-D (no edges): its normals are no pyramid's columns
@@ -386,13 +612,16 @@ def prove_by_patterns(
         _FarkasVectors(layout.loads, problem.g, math.sqrt(problem.g.size) * LP_FEASIBILITY),
         max_motions=max_motions,
         remaining=remaining,
+        reuse=reuse,
+        width=2 if planar else form.n_edges,
     )
     rows.proof.seed = seed_x
     m = problem.n_contacts
-    n_rows = layout.bank.shape[0]
-    root = _Node(np.zeros(n_rows, dtype=bool), np.arange(n_rows) < m, np.ones(layout.loads.shape[1], dtype=bool), roots, 0)
-    fit = _forces(rows, root.columns, None)
-    rows.proof.equilibrium = False if fit is None else _balances(rows, fit)
+    every, block = (1 << layout.loads.shape[1]) - 1, (1 << rows.width) - 1
+    rows.outside = [every & ~(block << (rows.width * i)) for i in range(m)]
+    root = _Node(0, (1 << m) - 1, (1 << layout.loads.shape[1]) - 1, roots, 0)
+    fit = _fitted_forces(rows, root.columns)
+    rows.proof.equilibrium = False if fit is None else _balances(rows, fit.forces)
     closed = fit is None or _search(rows, _past_settled(rows, root), fit, _UNKNOWN)
     rows.proof.verdict = _verdict(rows, closed)
     return rows.proof
@@ -412,22 +641,22 @@ def _seed_modes_first(layout: _Layout, form: LCPForm, seed_x: np.ndarray) -> tup
     separating: see :func:`_search`)."""
     q, _, beta, _ = form.split(seed_x)
     slack = layout.bank @ q - layout.rhs
-    scale = np.linalg.norm(layout.bank, axis=1) + 1.0
+    tolerance = ZERO * (np.linalg.norm(layout.bank, axis=1) + 1.0)
+    meets, above = _bits(np.abs(slack) <= tolerance), _bits(slack >= -tolerance)
+    loaded = _bits(beta > ZERO)  # the load columns the seed's forces use
 
-    def holds(mode: _Mode, loaded: np.ndarray) -> bool:
-        return (
-            bool(np.all(np.abs(slack[mode.equal]) <= ZERO * scale[mode.equal]))
-            and bool(np.all(slack[mode.at_least] >= -ZERO * scale[mode.at_least]))
-            and not np.any(loaded & ~mode.keep)
-        )
+    def holds(mode: _Mode) -> bool:
+        return not (mode.equal_bits & ~meets or mode.at_least_bits & ~above or loaded & mode.removes)
 
-    def reorder(mode: _Mode, loaded: np.ndarray) -> _Mode:
-        children = tuple(reorder(child, loaded) for child in mode.children)
+    def reorder(mode: _Mode) -> _Mode:
+        children = tuple(reorder(child) for child in mode.children)
         if not any(child.separating for child in children):
-            children = tuple(sorted(children, key=lambda child: not holds(child, loaded)))
+            children = tuple(sorted(children, key=lambda child: not holds(child)))
+        if all(new is old for new, old in zip(children, mode.children, strict=True)):
+            return mode  # the shared tree's own (nothing moved below it)
         return dataclasses.replace(mode, children=children)
 
-    return tuple(reorder(root, beta[i] > ZERO) for i, root in enumerate(layout.roots))
+    return tuple(reorder(root) for root in layout.roots)
 
 
 def _verdict(rows: _Rows, closed: bool) -> PatternVerdict:
@@ -439,7 +668,7 @@ def _verdict(rows: _Rows, closed: bool) -> PatternVerdict:
         return PatternVerdict.NONE if seed_x is None else PatternVerdict.UNIQUE
     found = list(rows.found)
     if seed_x is not None and not any(_on_continuum(rows, f, rows.seed) for f in found):  # unless a continuum has it
-        found.insert(0, _Found(RawMotion(seed_x[: rows.form.n_q], rows.form.forces(seed_x)), np.zeros(0, dtype=bool)))
+        found.insert(0, _Found(RawMotion(seed_x[: rows.lcp.n_q], rows.lcp.forces(seed_x)), np.zeros(0, dtype=bool)))
     if len(found) > rows.max_motions:
         return PatternVerdict.UNDECIDED  # the SCIP search lists as many as asked and says the list is incomplete
     rows.proof.motions = tuple(f.motion for f in found)
@@ -454,7 +683,7 @@ def _order(problem: Problem, seed_x: np.ndarray | None, n_q: int) -> list[int]:
     return [int(i) for i in np.argsort(-seed_x[n_q : n_q + m], kind="stable")]
 
 
-def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
+def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
     """True when every mode assignment below ``node`` is pruned, or its motions listed (``rows.found``).
 
     ``fit``: forces on the node's columns with ``|G fit + g|`` within the margin; ``twists``: what the node's
@@ -465,7 +694,7 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
         return False  # a leaf that survived: another motion may exist
     contact = rows.levels[node.depth].contact
     modes = _possible_modes(rows, node.modes[contact].children, twists.ball)
-    excluded = rows.farkas.excludes(node.columns, contact, rows.width, modes)
+    excluded = rows.farkas.excludes(node.columns, rows.outside[contact], modes)
     blocked = False  # a closed sibling's Farkas vector also holds for separating, which keeps fewer columns
     for mode, known_empty in zip(modes, excluded, strict=True):
         rows.proof.nodes += 1
@@ -474,25 +703,33 @@ def _search(rows: _Rows, node: _Node, fit: np.ndarray, twists: _Twists) -> bool:
         if known_empty or (mode.separating and blocked):
             blocked |= not mode.separating
             continue  # no equilibrium below this node
-        child = _past_settled(rows, node.child(rows, contact, mode))
-        child_fit = _forces(rows, child.columns, fit)
+        child = _past_settled(rows, node.child(contact, mode))
+        child_fit = _known_forces(rows, child.columns, fit)
+        child_twists = _child_twists(rows, node, child, mode, twists)
+        if child_twists.pruned:
+            continue  # before a new fit: the twists cost less
+        if child_fit is None:
+            child_fit = _fitted_forces(rows, child.columns)
         if child_fit is None:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
-        child_twists = _child_twists(rows, child, mode, twists)
-        if child_twists.pruned:
-            continue
+        if child.depth == leaf and rows.form is None:  # the sector relaxation: a leaf with a twist is a point of it
+            status, q = _relaxed_twist(rows, child)
+            if status == "infeasible":
+                continue
+            rows.survivor, rows.survivor_twist = child, (q if status == "optimal" else None)
+            return False
         if child.depth == leaf:
             if child_twists is twists:  # every row counted: a tighter ball, perhaps the seed's
                 child_twists = _twist(rows, child)
                 if child_twists.pruned:
                     continue
-            if child_twists.point and child_twists.ball is not None and _adopted(rows, child_twists.ball.center, child_fit):
+            if child_twists.point and child_twists.ball is not None and _adopted(rows, child_twists.ball.center, child_fit.forces):
                 continue
             if child_twists.point and child_twists.ball is not None:
-                listed = _record_point(rows, child_twists.ball.center, child_fit, child.columns)
+                listed = _record_point(rows, child_twists.ball.center, child_fit.forces, rows.columns(child.columns))
             else:
-                listed = _record_polyhedron(rows, child, child_fit)
+                listed = _record_polyhedron(rows, child, child_fit.forces)
             if not listed:
                 return False  # too close to call, or too many motions
             continue
@@ -514,13 +751,18 @@ def _past_settled(rows: _Rows, node: _Node) -> _Node:
     return node
 
 
-def _child_twists(rows: _Rows, child: _Node, mode: _Mode, parent: _Twists) -> _Twists:
+def _child_twists(rows: _Rows, node: _Node, child: _Node, mode: _Mode, parent: _Twists) -> _Twists:
     """The child's twists: the parent's when its rows are the same (a separating contact, as a free one) or
-    already pin one twist (the child's lie in the same ball, and its modes were filtered against it)."""
+    already pin one twist (the child's lie in the same ball, and its modes were filtered against it). A child
+    that keeps its parent's closed rows and adds inequalities narrows the parent's line or polygon by them
+    (:func:`_narrowed`); others are worked out from their rows (:func:`_twist`)."""
     if not (mode.separating or parent.point):
-        own = _twist(rows, child)
-        if own is _UNKNOWN and parent.ball is not None:
-            return _Twists(False, parent.ball)  # the child's twists are among the parent's
+        if rows.reuse and parent.shape is not None and child.equal == node.equal:
+            own = _narrowed(rows, parent, parent.shape, child.at_least & ~node.at_least)
+        else:
+            own = _twist(rows, child)
+        if own.ball is None and not own.pruned and parent.ball is not None:
+            return _Twists(False, parent.ball, shape=own.shape)  # the child's twists are among the parent's
         return own
     ball, spread = parent.ball, parent.spread
     if parent.point and ball is not None and spread is not None and _near_seed(rows, ball.center, ball.center, spread):
@@ -544,7 +786,7 @@ def _form_point(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> np.ndarray | Non
 
     ``fit`` holds a unit normal force on each edge (``K`` per contact): ``cn`` their sum, ``beta = mu fit``; the
     slip speed ``lam`` is the least the edges accept, ``max(0, max_k -d_k.u)`` (in 2-D, ``|s|``)."""
-    form = rows.form
+    form = rows.lcp
     m, K = form.edges.shape[:2]
     mu = form.problem.mu
     per_edge = fit.reshape(m, K)
@@ -555,14 +797,15 @@ def _form_point(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> np.ndarray | Non
     # the search reads a point's pattern from which of each pair is nearer zero.
     pairs_part = x[q.size :]  # a view: forces and slip speeds, all >= 0
     pairs_part[pairs_part <= ZERO] = 0.0
-    return x if satisfies_form(rows.form, x) else None
+    return x if satisfies_form(rows.lcp, x) else None
 
 
 _PARALLEL = 1e-13  # sine of the angle below which two twist rows' lines in a plane are parallel (round-off)
 _SKEW = 1e-9  # sine above which two such lines meet at a vertex computed well; between the two, too close to call
 ROUNDOFF_SLACK = 1e-12  # relative leniency of a computed polygon vertex on its rows, and of its bounding radius
 CLOCK_NODES = 256  # nodes between two looks at the caller's clock (~10 ms)
-FARKAS_KEPT = 8  # Farkas vectors tried before a new non-negative fit (each check: one masked max)
+FARKAS_KEPT = 32  # Farkas vectors tried before a new non-negative fit (each check: one integer operation)
+FITS_KEPT = 16  # balancing fits tried before a new non-negative fit (each check: one integer operation)
 
 _Region = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # a leaf's twist rows: E q = e, A q >= a
 
@@ -584,7 +827,7 @@ def _record_point(rows: _Rows, q: np.ndarray, fit: np.ndarray, columns: np.ndarr
     if x is None:
         return False
     if not _known_point(rows, q, columns):
-        rows.found.append(_Found(RawMotion(q, rows.form.forces(x)), columns))
+        rows.found.append(_Found(RawMotion(q, rows.lcp.forces(x)), columns))
     return len(rows.found) <= rows.max_motions
 
 
@@ -606,8 +849,9 @@ def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
     extreme: a single motion there. Else a continuum: its extremes, its free directions, and a point inside it
     (every inequality as slack as it can be), each with the leaf's forces and checked on every law of the form.
     False when a check or an LP fails (too close to call) or there are too many motions."""
-    E, e = rows.bank[node.equal], rows.rhs[node.equal]
-    A, a = rows.bank[node.at_least], rows.rhs[node.at_least]
+    equal, at_least = rows.row_mask(node.equal), rows.row_mask(node.at_least)
+    E, e = rows.bank[equal], rows.rhs[equal]
+    A, a = rows.bank[at_least], rows.rhs[at_least]
     n = rows.g.size
     model = WarmLP(np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
     extremes: list[np.ndarray] = []
@@ -628,13 +872,13 @@ def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
     if not free and seed is not None and all(np.max(np.abs(p - seed)) <= 0.5 * SAME_TWIST for p in extremes):
         return True  # the seed's twist alone
     if not free and len(extremes) == 1:
-        return _record_point(rows, extremes[0], fit, node.columns)
+        return _record_point(rows, extremes[0], fit, rows.columns(node.columns))
     if rows.width > 2:
         # 3-D: a pyramid's continua come in families whose faces (a contact rolling at the end of its slip, on
         # the same edge) are continua of other patterns; SCIP lists the family once (its cut leaves each listed
         # polyhedron), this search would list each face. Until faces are merged, SCIP lists them.
         return False
-    return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit, node.columns)
+    return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit, rows.columns(node.columns))
 
 
 def _record_continuum(
@@ -651,7 +895,7 @@ def _record_continuum(
     x = _form_point(rows, inside, fit) if np.all(np.isfinite(inside)) else None
     if x is None or any(_form_point(rows, p, fit) is None for p in extremes):
         return False
-    motion = RawMotion(inside, rows.form.forces(x), tuple(extremes), bool(free), free, extremes_share_forces=True)
+    motion = RawMotion(inside, rows.lcp.forces(x), tuple(extremes), bool(free), free, extremes_share_forces=True)
     if not any(_same_continuum(motion, f.motion) for f in rows.found):
         listed = _Found(motion, columns, region)
         rows.found[:] = [f for f in rows.found if f.motion.continuum or not _holds(rows, listed, f.motion.q, f.columns)]
@@ -687,7 +931,7 @@ def _on_continuum(rows: _Rows, found: _Found, q: np.ndarray | None) -> bool:
         return False
     E, e, A, a = found.region
     inside = np.all(np.abs(E @ q - e) <= LP_FEASIBILITY) and np.all(A @ q - a >= -LP_FEASIBILITY)
-    problem = rows.form.problem
+    problem = rows.lcp.problem
     return bool(inside) and contact_modes(problem, q) == contact_modes(problem, found.motion.q)
 
 
@@ -703,10 +947,36 @@ def _possible_modes(rows: _Rows, modes: tuple[_Mode, ...], ball: _Ball | None) -
     of them without one. Separating is always kept (its gap row was checked as the parent's)."""
     if ball is None:
         return modes
-    slack = rows.bank @ ball.center - rows.rhs
-    reach = rows.norms * ball.radius + LP_FEASIBILITY
-    meets, above = np.abs(slack) <= reach, slack >= -reach
-    return tuple(mode for mode in modes if mode.separating or (meets[mode.equal].all() and above[mode.at_least].all()))
+    filter_ = rows.filters.get(id(modes))
+    if filter_ is None:
+        filter_ = rows.filters[id(modes)] = _ModeFilter.of(rows, modes)
+    slack = filter_.bank @ ball.center - filter_.rhs
+    reach = filter_.norms * ball.radius + LP_FEASIBILITY
+    meets, above = (np.abs(slack) <= reach).tolist(), (slack >= -reach).tolist()
+    return tuple(
+        mode
+        for mode, equal, at_least in zip(modes, filter_.equal, filter_.at_least, strict=True)
+        if mode.separating or (all(meets[j] for j in equal) and all(above[j] for j in at_least))
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class _ModeFilter:
+    """The bank rows of a node's modes (``bank``, ``rhs``, ``norms``: their union), and each mode's among them."""
+
+    bank: np.ndarray
+    rhs: np.ndarray
+    norms: np.ndarray
+    equal: tuple[list[int], ...]
+    at_least: tuple[list[int], ...]
+
+    @classmethod
+    def of(cls, rows: _Rows, modes: tuple[_Mode, ...]) -> _ModeFilter:
+        union = sorted({int(r) for mode in modes for r in (*mode.equal, *mode.at_least)})
+        where = {r: j for j, r in enumerate(union)}
+        equal = tuple([where[int(r)] for r in mode.equal] for mode in modes)
+        at_least = tuple([where[int(r)] for r in mode.at_least] for mode in modes)
+        return cls(rows.bank[union], rows.rhs[union], rows.norms[union], equal, at_least)
 
 
 def _margin(rows: _Rows) -> float:
@@ -719,84 +989,124 @@ def _balances(rows: _Rows, fit: np.ndarray) -> bool | None:
     return True if float(np.linalg.norm(rows.loads @ fit + rows.g)) <= _margin(rows) else None
 
 
-def _forces(rows: _Rows, columns: np.ndarray, fit: np.ndarray | None) -> np.ndarray | None:
-    """Non-negative forces on ``columns`` balancing the load within the margin, or None with a checked Farkas vector
-    (kept in ``rows.farkas``: it may exclude the next nodes' columns too).
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
+class _Fit:
+    """Non-negative forces on the load columns (``forces``), and which columns they use (``support``, bits)."""
 
-    ``fit``: the parent's forces; kept when they use none of the columns taken away.
-    """
-    margin = _margin(rows)
-    if fit is not None and not fit[~columns].any():
+    forces: np.ndarray
+    support: int
+
+
+def _known_forces(rows: _Rows, columns: int, fit: _Fit) -> _Fit | None:
+    """Forces on ``columns`` (bits) known without a new fit: the parent's ``fit`` when it uses none of the columns
+    taken away, else a balancing fit found at an earlier node (``rows.fits``) that uses only ``columns`` (forces
+    balancing the load on fewer columns balance it on more); None when there is none."""
+    if not fit.support & ~columns:
         return fit
-    G = rows.loads[:, columns]
-    lam = np.zeros(columns.size)
+    return rows.fits.usable(columns) if rows.reuse else None
+
+
+def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
+    """Non-negative forces on ``columns`` (bits) by a non-negative least-squares fit, balancing the load within
+    the margin, or None with a checked Farkas vector (kept in ``rows.farkas``: it may exclude the next nodes'
+    columns too); a fit that does neither is returned (the node is not excluded)."""
+    rows.proof.fits += 1
+    index = rows.columns(columns)
+    G = rows.loads[:, index]
+    lam = np.zeros(index.size)
     if G.shape[1]:
-        lam[columns], residual = nnls(G, -rows.g)
+        lam[index], residual = nnls(G, -rows.g)
     else:
         residual = float(np.linalg.norm(rows.g))
-    if residual <= margin:
-        return lam
-    return None if rows.farkas.add(-(rows.loads @ lam + rows.g), columns) else lam
+    found = _Fit(lam, _bits(lam > 0.0))
+    if residual <= _margin(rows):
+        rows.fits.add(found)
+        return found
+    return None if rows.farkas.add(-(rows.loads @ lam + rows.g), columns) else found
+
+
+@dataclass
+class _Fits:
+    """The last balancing fits found (:data:`FITS_KEPT`, newest first)."""
+
+    kept: list[_Fit] = field(default_factory=list)
+
+    def add(self, fit: _Fit) -> None:
+        self.kept.insert(0, fit)
+        del self.kept[FITS_KEPT:]
+
+    def usable(self, columns: int) -> _Fit | None:
+        """A kept fit that uses only ``columns`` (bits), or None."""
+        return next((fit for fit in self.kept if not fit.support & ~columns), None)
 
 
 @dataclass
 class _FarkasVectors:
-    """The last Farkas vectors found, each a certificate that no forces on some load columns balance the load:
-    ``per_column`` holds ``G^T y`` per column, ``reserve`` is ``-g.y - margin |y|``.
+    """The last Farkas vectors found, each a certificate that no forces on some load columns balance the load.
 
     For ``lam >= 0``: ``y.(G lam + g) <= max(G^T y) sum(lam) + g.y``, while ``|G lam + g| <= margin`` needs it
-    ``>= -margin |y|``; so ``reserve > max(G_S^T y, 0) FORCE_CEILING`` excludes every balancing ``lam`` on the
-    columns ``S`` whose sum is below :data:`FORCE_CEILING`. One vector often excludes a node's siblings and
-    cousins: each is tried on a node's children at once, before any non-negative fit."""
+    ``>= -margin |y|``; so with ``reserve = -g.y - margin |y|``, ``reserve > max(G_S^T y, 0) FORCE_CEILING``
+    excludes every balancing ``lam`` on the columns ``S`` whose sum is below :data:`FORCE_CEILING`. A vector is
+    kept as the columns it cannot exclude (``blockers``, bits: ``(G^T y)_j FORCE_CEILING >= reserve``, and it is
+    kept only with ``reserve > 0``): it excludes ``S`` exactly when ``S`` holds none of them. One vector often
+    excludes a node's siblings and cousins: each is tried on a node's children at once, before any fit."""
 
     loads: np.ndarray
     g: np.ndarray
     margin: float
-    per_column: np.ndarray = field(init=False)
-    reserve: np.ndarray = field(init=False)
+    blockers: list[int] = field(default_factory=list)  # newest last
     count: int = 0
 
-    def __post_init__(self) -> None:
-        self.per_column = np.zeros((FARKAS_KEPT, self.loads.shape[1]))
-        self.reserve = np.full(FARKAS_KEPT, -np.inf)
-
-    def add(self, y: np.ndarray, columns: np.ndarray) -> bool:
-        """Keep ``y`` when it excludes ``columns`` (then True)."""
-        per_column = self.loads.T @ y
+    def add(self, y: np.ndarray, columns: int) -> bool:
+        """Keep ``y`` when it excludes ``columns`` (bits; then True)."""
         reserve = -float(self.g @ y) - self.margin * float(np.linalg.norm(y))
-        if reserve <= max(float(np.max(per_column[columns], initial=0.0)), 0.0) * FORCE_CEILING:
+        if not reserve > 0.0:
             return False
-        slot = self.count % FARKAS_KEPT
-        self.per_column[slot], self.reserve[slot] = per_column, reserve
+        blockers = _bits(self.loads.T @ y * FORCE_CEILING >= reserve)
+        if blockers & columns:
+            return False
+        if len(self.blockers) < FARKAS_KEPT:
+            self.blockers.append(blockers)
+        else:
+            self.blockers[self.count % FARKAS_KEPT] = blockers
         self.count += 1
         return True
 
-    def excludes(self, columns: np.ndarray, contact: int, K: int, modes: tuple[_Mode, ...]) -> np.ndarray:
-        """For each of ``modes`` of ``contact``: whether a kept vector excludes ``columns`` with the contact's
-        block of ``K`` columns narrowed to the mode's."""
-        if not self.count or not modes:
-            return np.zeros(len(modes), dtype=bool)
-        block = slice(K * contact, K * contact + K)
-        outside = columns.copy()
-        outside[block] = False
-        values = self.per_column[: min(self.count, FARKAS_KEPT)]
-        worst_outside = np.max(np.where(outside, values, -np.inf), axis=1)  # (F,)
-        keeps = np.array([mode.keep for mode in modes]) & columns[block]  # (M, K)
-        worst_inside = np.max(np.where(keeps[None], values[:, None, block], -np.inf), axis=2)  # (F, M)
-        worst = np.maximum(np.maximum(worst_outside[:, None], worst_inside), 0.0) * FORCE_CEILING
-        return np.any(self.reserve[: values.shape[0], None] > worst, axis=0)
+    def excludes(self, columns: int, outside: int, modes: tuple[_Mode, ...]) -> list[bool]:
+        """For each of ``modes`` (of one contact; ``outside``: every column not in its block, bits): whether a kept
+        vector excludes ``columns`` (bits) narrowed to the mode's."""
+        left = [blockers & columns for blockers in self.blockers]  # the blockers a node's columns hold
+        if 0 in left:
+            return [True] * len(modes)  # a vector excludes the node itself
+        inside = [blockers for blockers in left if not blockers & outside]  # a mode's narrowing may remove these
+        return [any(not blockers & ~mode.removes for blockers in inside) for mode in modes]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
 class _Twists:
     """What a node's twists are known to be: ``pruned`` (empty, or the seed's); else within ``ball`` (2-norm,
     for filtering modes) when known, and ``point`` when the closed rows leave one twist (a leaf there is another
-    motion)."""
+    motion); ``shape``: where on its closed rows' line or plane they lie, which a child narrows."""
 
     pruned: bool
     ball: _Ball | None = None
     point: bool = False
     spread: np.ndarray | None = None  # of a point: how far, per entry, a loosened twist may lie from it
+    shape: _Shape | None = None
+
+
+@dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
+class _Shape:
+    """A node's loosened twists on what its closed rows leave (``closed``): ``q0 + t direction`` with ``t`` in
+    ``interval`` (a line), or ``q0 + x plane`` with ``x`` in the hull of ``vertices`` (a plane, (V, 2)), each
+    within the closed set's ``radius`` off it."""
+
+    closed: _ClosedSet
+    interval: tuple[float, float] | None = None
+    vertices: _Vertices | None = None
+
+
+_Vertices = list[tuple[float, float]]  # a polygon's points in a plane (few: plain floats cost less than arrays)
 
 
 _PRUNED, _UNKNOWN = _Twists(True), _Twists(False)
@@ -813,22 +1123,69 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     plane = k == n - 2 and rows.width > 2  # 3-D pyramids: a plane of twists is bounded exactly (planar: as before)
     if (k < n - 1 and not plane) or k == 0:
         return _UNKNOWN
-    key = node.equal.tobytes()
-    closed = rows.closed_sets.get(key)
+    closed = rows.closed_sets.get(node.equal)
     if closed is None:
-        closed = rows.closed_sets[key] = _closed_set(rows, node.equal, k)
+        closed = rows.closed_sets[node.equal] = _closed_set(rows, rows.row_mask(node.equal), k)
     if isinstance(closed, _Twists):
         return closed
-    reserve = closed.reserve[node.at_least]
+    if closed.slope is not None and not plane:
+        interval = _interval(closed, (-math.inf, math.inf), node.at_least)
+        return _PRUNED if interval is None else _line(rows, closed, *interval)
+    at_least = rows.row_mask(node.at_least)
+    reserve = closed.reserve[at_least]
     if plane:
-        return _on_plane(rows, closed, rows.bank[node.at_least] @ closed.plane.T, reserve)
-    if closed.slope is not None:
-        return _on_line(rows, closed.q0, closed.direction, closed.radius, closed.spread, closed.slope[node.at_least], reserve)
+        return _on_plane(rows, closed, rows.bank[at_least] @ closed.plane.T, reserve)
     if (reserve < 0.0).any():
         return _PRUNED  # an open gap or slip sign fails on the whole set
     if _near_seed(rows, closed.q0, closed.q0, closed.spread):
         return _PRUNED
     return _Twists(False, _Ball(closed.q0, closed.radius), point=True, spread=closed.spread)
+
+
+def _narrowed(rows: _Rows, parent: _Twists, shape: _Shape, new_rows: int) -> _Twists:
+    """A node's twists from its ``parent``'s (their ``shape``: the same closed rows) and its inequality rows not
+    in the parent's (``new_rows``, bits): the parent's line or polygon cut by each; the parent's own when none
+    cuts it."""
+    closed = shape.closed
+    if shape.interval is not None:
+        interval = _interval(closed, shape.interval, new_rows)
+        if interval is None:
+            return _PRUNED
+        return parent if interval == shape.interval else _line(rows, closed, *interval)
+    reserve, (first, second) = closed.row_reserve, closed.row_rates
+    vertices = shape.vertices
+    assert vertices is not None
+    for j in _indices(new_rows):
+        vertices = _cut(vertices, (first[j], second[j]), reserve[j])
+        if not vertices:
+            return _PRUNED
+    return parent if vertices is shape.vertices else _polygon(rows, closed, vertices)
+
+
+def _interval(closed: _ClosedSet, interval: tuple[float, float], at_least: int) -> tuple[float, float] | None:
+    """The part of ``interval`` of the closed set's line ``q0 + t d`` where the rows ``at_least`` (bits) hold,
+    ``rate t + reserve >= 0`` each; None when it is empty."""
+    low, high = interval
+    reserve, (rates,) = closed.row_reserve, closed.row_rates
+    for j in _indices(at_least):
+        rate, slack = rates[j], reserve[j]
+        if rate > 0.0:
+            low = max(low, -slack / rate)
+        elif rate < 0.0:
+            high = min(high, -slack / rate)
+        elif slack < 0.0:
+            return None
+    return None if low > high else (low, high)
+
+
+def _indices(bits: int) -> list[int]:
+    """The positions of a bit set's bits (few: a node's new rows)."""
+    index = []
+    while bits:
+        low = bits & -bits
+        index.append(low.bit_length() - 1)
+        bits ^= low
+    return index
 
 
 @dataclass(frozen=True, slots=True)
@@ -844,6 +1201,10 @@ class _ClosedSet:
     direction: np.ndarray
     slope: np.ndarray | None
     plane: np.ndarray  # (2, n): orthonormal directions of what ``n - 2`` rows leave (the last two of E's full ``vt``)
+    # The same per bank row as plain floats, read a few at a time by :func:`_narrowed`: ``reserve``, and the
+    # row's rate along the line (``slope``) or along each of the plane's directions (on ``n - 2`` rows); else empty.
+    row_reserve: list[float]
+    row_rates: tuple[list[float], ...]
 
 
 def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
@@ -860,7 +1221,7 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     leave a line ``q0 + t d``, on which every inequality row bounds ``t``.
     """
     n = rows.g.size
-    E, e = rows.bank[equal], rows.rhs[equal]
+    E, e = rows.bank[equal], rows.rhs[equal]  # ``equal``: a boolean mask of the bank's rows
     u, sigma, vt = np.linalg.svd(E, full_matrices=k < n)  # a line's direction is the last row of the full vt
     if sigma[-1] <= MOTION_RANK or k > n and sigma[n - 1] <= MOTION_RANK:
         return _UNKNOWN
@@ -877,26 +1238,25 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     reserve = bank @ q0 + LP_FEASIBILITY * np.abs(bank @ pseudo_inverse).sum(axis=1) - rows.rhs + LP_FEASIBILITY
     direction = vt[-1]
     slope = bank @ direction if k < n else None
-    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:])
+    rates: tuple[list[float], ...] = ()  # for a line or a plane only (a point's children keep it)
+    if k == n - 1 and slope is not None:
+        rates = (slope.tolist(),)
+    elif k == n - 2:
+        rates = ((bank @ vt[-2]).tolist(), (bank @ vt[-1]).tolist())
+    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], reserve.tolist() if rates else [], rates)
 
 
-def _on_line(
-    rows: _Rows, q0: np.ndarray, d: np.ndarray, radius: float, spread: np.ndarray, slope: np.ndarray, reserve: np.ndarray
-) -> _Twists:
-    """Twists ``q0 + t d`` (within ``spread`` per entry) with ``slope t + reserve >= 0`` for every inequality row."""
-    if (reserve[slope == 0.0] < 0.0).any():
-        return _PRUNED
-    rising, falling = slope > 0.0, slope < 0.0
-    low = float(np.max(-reserve[rising] / slope[rising], initial=-np.inf))
-    high = float(np.min(-reserve[falling] / slope[falling], initial=np.inf))
+def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
+    """The twists ``q0 + t d`` with ``low <= t <= high`` (within the closed set's ``spread`` per entry)."""
     if low > high:
         return _PRUNED
-    if not (np.isfinite(low) and np.isfinite(high)):
-        return _UNKNOWN
-    ends = q0 + low * d, q0 + high * d
-    if _near_seed(rows, *ends, spread):
+    shape = _Shape(closed, interval=(low, high))
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return _Twists(False, shape=shape)
+    ends = closed.q0 + low * closed.direction, closed.q0 + high * closed.direction
+    if _near_seed(rows, *ends, closed.spread):
         return _PRUNED
-    return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + radius))
+    return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + closed.radius), shape=shape)
 
 
 def _on_plane(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.ndarray) -> _Twists:
@@ -931,12 +1291,38 @@ def _on_plane(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.nd
     vertices = points[:, (values >= -lenient).all(axis=0)].T
     if not vertices.size:
         return _PRUNED
-    twists = closed.q0 + vertices @ closed.plane
+    return _polygon(rows, closed, [(x, y) for x, y in vertices.tolist()])
+
+
+def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Vertices:
+    """The points whose hull is the hull of ``vertices`` cut by ``rate.x + reserve >= 0``: the vertices that meet
+    it (with round-off's leniency, as :func:`_on_plane`'s), and the two ends of the cut, the outermost points where
+    a segment between a vertex above the line and one below crosses it (every edge of the hull is such a segment,
+    so the cut's ends are among them, whatever order the vertices come in). ``vertices`` itself when none is
+    below the line."""
+    a, b = rate
+    values = [a * x + b * y + reserve for x, y in vertices]
+    if min(values) >= 0.0:
+        return vertices
+    size = math.hypot(a, b)
+    kept = [v for v, value in zip(vertices, values, strict=True) if value >= -ROUNDOFF_SLACK * (size * math.hypot(*v) + abs(reserve))]
+    above = [(v, value) for v, value in zip(vertices, values, strict=True) if value > 0.0]
+    below = [(v, value) for v, value in zip(vertices, values, strict=True) if value < 0.0]
+    if not above:
+        return kept
+    crossings = [(x + t * (u - x), y + t * (w - y)) for (x, y), va in above for (u, w), vb in below for t in (va / (va - vb),)]
+    along = [b * x - a * y for x, y in crossings]  # position along the line
+    return [*kept, crossings[along.index(min(along))], crossings[along.index(max(along))]]
+
+
+def _polygon(rows: _Rows, closed: _ClosedSet, vertices: _Vertices) -> _Twists:
+    """The twists over the hull of ``vertices`` (in the closed set's plane): the seed's (pruned), or a ball."""
+    twists = closed.q0 + np.array(vertices) @ closed.plane
     if _all_near_seed(rows, twists, closed.spread):
         return _PRUNED
     center = 0.5 * (twists.min(axis=0) + twists.max(axis=0))
-    reach = float(np.sqrt(np.max(np.sum((twists - center) ** 2, axis=1))))
-    return _Twists(False, _Ball(center, reach * (1.0 + ROUNDOFF_SLACK) + closed.radius))
+    reach = math.sqrt(float(((twists - center) ** 2).sum(axis=1).max()))
+    return _Twists(False, _Ball(center, reach * (1.0 + ROUNDOFF_SLACK) + closed.radius), shape=_Shape(closed, vertices=vertices))
 
 
 @functools.cache
@@ -949,7 +1335,7 @@ def _all_near_seed(rows: _Rows, twists: np.ndarray, spread: np.ndarray) -> bool:
     """Whether every twist of ``twists`` (rows; their hull) lies within the seed's box, as :func:`_near_seed`."""
     if rows.seed is None:
         return False
-    offset = np.max(np.abs(twists - rows.seed), axis=0)
+    offset = np.abs(twists - rows.seed).max(axis=0)
     return bool(offset.max() <= 0.5 * SAME_TWIST and (offset + spread).max() <= 0.5 * DISTINCT_TWIST)
 
 

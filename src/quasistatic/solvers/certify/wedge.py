@@ -24,6 +24,20 @@ forces: a certificate. If it finds a point, the sectors its sliding contacts
 use are halved and it tries again (the relaxation tightens only where a
 point escaped), until a sector would be narrower than ``FINEST`` or the time
 runs out: then nothing is decided.
+
+Without prescribed modes the same relaxation is first decided by the mode
+branch and bound (:func:`~.patterns.relaxation_excluded`): "one piece per
+contact" is a choice of mode (separating, rolling, sliding in one sector), and
+with the modes fixed the twist's rows and the forces' cone share no unknown,
+so every pattern is excluded by a checked Farkas vector, by its twist rows
+(loosened by ``LP_FEASIBILITY``, as SCIP's) or by an LP; the forces each
+piece allows are the same polygon's (chord, tangents, the rolling 16-gon).
+A closed tree proves the relaxation infeasible, as SCIP would. A pattern that
+survives halves its sliding contacts' sectors, as SCIP's point does, for at
+most :data:`BRANCH_AND_BOUND_ROUNDS` rounds; where it gives no answer (a
+node budget, an LP without a status, no sector left to halve) the SCIP loop
+goes on from the sectors reached. A surviving pattern's twist that is an
+exact motion (``is_motion``) stops both, as a SCIP point's does.
 """
 
 from __future__ import annotations
@@ -38,12 +52,15 @@ from ...solution import Mode
 from ...tolerances import EXACT_SECTOR_FRICTION, MODE_SPEED, SECTOR_ACTIVE
 from ..numerics.scip_model import linear, new_model, optimize
 from ..result import Options
+from .patterns import ROLLING_POLYGON, relaxation_excluded
 
-__all__ = ["exact_cones_jam", "SECTORS", "FINEST"]
+__all__ = ["exact_cones_jam", "SECTORS", "FINEST", "BRANCH_AND_BOUND_ROUNDS", "BY_BRANCH_AND_BOUND", "BY_SCIP"]
 
 SECTORS = 8  # initial slip sectors per contact
 FINEST = 2.0 * np.pi / 256  # narrowest sector [rad] the refinement makes
-_ROLLING_POLYGON = 16  # tangents of the circle bounding a rolling contact's force
+BRANCH_AND_BOUND_ROUNDS = 24  # refinements decided by the mode branch and bound before SCIP's loop goes on
+BY_BRANCH_AND_BOUND = "mode branch and bound, Farkas vectors and LPs"  # what decided a proof, for its certificate
+BY_SCIP = "SCIP, complete search"
 
 
 def exact_cones_jam(
@@ -51,8 +68,9 @@ def exact_cones_jam(
     options: Options,
     modes: Sequence[Mode | None] | None = None,
     is_motion: Callable[[np.ndarray], bool] | None = None,
-) -> tuple[bool, int]:
-    """Whether the sector relaxation was proven infeasible (the exact cones admit no motion), and the most sectors used.
+) -> tuple[bool, int, str]:
+    """Whether the sector relaxation was proven infeasible (the exact cones admit no motion), the most sectors
+    used, and what decided it (:data:`BY_BRANCH_AND_BOUND` or :data:`BY_SCIP`).
 
     With ``modes`` (prescribed per contact, None free) the relaxation keeps
     them: True then proves that no exact motion has those modes. ``is_motion``
@@ -60,13 +78,37 @@ def exact_cones_jam(
     the refinement stops early, since nothing is left to prove.
     """
     sectors = [2.0 * np.pi * np.arange(SECTORS + 1) / SECTORS for _ in range(problem.n_contacts)]
+    if modes is None:
+        decided = _by_branch_and_bound(problem, options, sectors, is_motion)
+        if decided is not None:
+            return decided, max(len(s) - 1 for s in sectors), BY_BRANCH_AND_BOUND
     while options.remaining() > 0.0:
         status, active, q = _relaxation(problem, options, sectors, modes)
         if status == "infeasible":
-            return True, max(len(s) - 1 for s in sectors)
+            return True, max(len(s) - 1 for s in sectors), BY_SCIP
         if status != "feasible" or (is_motion is not None and is_motion(q)) or not _split(sectors, active):
             break  # out of time, or the point already satisfies the exact laws' friction: a motion is likely
-    return False, max(len(s) - 1 for s in sectors)
+    return False, max(len(s) - 1 for s in sectors), BY_SCIP
+
+
+def _by_branch_and_bound(
+    problem: Problem, options: Options, sectors: list[np.ndarray], is_motion: Callable[[np.ndarray], bool] | None
+) -> bool | None:
+    """The relaxation decided by the mode branch and bound, refining ``sectors`` in place: True, infeasible
+    (proven); False, a surviving pattern's twist is an exact motion; None, no answer (SCIP's loop goes on)."""
+    for _ in range(BRANCH_AND_BOUND_ROUNDS):
+        if options.remaining() <= 0.0:
+            return None
+        proof = relaxation_excluded(problem, sectors, options.remaining)
+        if proof.excluded:
+            return True
+        if proof.sectors is None or proof.q is None:
+            return None
+        if is_motion is not None and is_motion(proof.q):
+            return False
+        if not _split(sectors, list(proof.sectors)):
+            return None
+    return None
 
 
 def _split(sectors: list[np.ndarray], active: list[int]) -> bool:
@@ -145,7 +187,7 @@ def _friction(
     # The rolling part: no slip, p inside the circle's tangents.
     cn_roll = scip.addVar(lb=0.0, ub=0.0 if mode == "sliding" else None, name=f"cn_roll{name}")
     p_roll = [scip.addVar(lb=None, ub=None, name=f"p_roll{name}_{t}") for t in range(2)]
-    for angle in 2.0 * np.pi * np.arange(_ROLLING_POLYGON) / _ROLLING_POLYGON:
+    for angle in 2.0 * np.pi * np.arange(ROLLING_POLYGON) / ROLLING_POLYGON:
         scip.addCons(np.cos(angle) * p_roll[0] + np.sin(angle) * p_roll[1] <= mu * cn_roll)
     cn_parts, p_parts, u_parts, sizes, parts = [cn_roll], [p_roll], [], [], []
     for k in range(len(bounds) - 1 if mode != "rolling" else 0):

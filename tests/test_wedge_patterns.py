@@ -1,0 +1,79 @@
+"""The sector relaxation of exact cones (``certify/wedge.py``) decided by the mode branch and bound
+(``patterns.relaxation_excluded``) against SCIP's MILP of the same relaxation (``wedge._relaxation``).
+
+Soundness (random scenes, one set with every other contact frictionless): the branch and bound excludes the
+relaxation only where SCIP proves it infeasible, and never where the exact laws have a motion (the certified
+solve found one). It decides: on the random scenes SCIP calls infeasible it excludes most, and the jammed
+benchmark grasps get their wedge proof from it with SCIP's relaxation never built.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import quasistatic as qs
+import quasistatic.solvers.certify.wedge as wedge
+from quasistatic.solvers.certify.patterns import relaxation_excluded
+from quasistatic.solvers.result import Options
+from quasistatic.tools.bench.families import grasp_3d
+from random_scenes import random_scene
+
+
+def _scene(seed: int, frictionless_every: int = 0) -> qs.Scene:
+    """Odd seeds: a box on a table and fingers; even: an ellipsoid grasp; with ``frictionless_every``, every such
+    contact (the first, ...) frictionless."""
+    scene = random_scene(3, 3000 + seed, friction="exact") if seed % 2 else grasp_3d(2 + seed % 3, 3000 + seed)
+    if not frictionless_every:
+        return scene
+    contacts = tuple(dataclasses.replace(c, mu=0.0) if i % frictionless_every == 0 else c for i, c in enumerate(scene.contacts))
+    return dataclasses.replace(scene, contacts=contacts)
+
+
+def _uniform(problem: qs.Problem, count: int) -> list[np.ndarray]:
+    return [2.0 * np.pi * np.arange(count + 1) / count for _ in range(problem.n_contacts)]
+
+
+@pytest.mark.parametrize(("count", "frictionless_every"), [(8, 0), (16, 0), (8, 2)])
+def test_the_branch_and_bound_excludes_the_relaxation_only_where_scip_proves_it_infeasible(count: int, frictionless_every: int) -> None:
+    infeasible = excluded = 0
+    for seed in range(30):
+        problem = qs.assemble(_scene(seed, frictionless_every))
+        proof = relaxation_excluded(problem, _uniform(problem, count))
+        status = wedge._relaxation(problem, Options(time_limit=30.0).start_clock(), _uniform(problem, count), None)[0]
+        assert status in ("feasible", "infeasible")
+        if proof.excluded:
+            assert status == "infeasible", f"seed {seed}: excluded by the branch and bound, feasible for SCIP"
+        else:
+            assert proof.sectors is None or proof.q is not None
+        infeasible += status == "infeasible"
+        excluded += proof.excluded
+    assert infeasible >= 3 and excluded >= 0.8 * infeasible, f"{excluded} excluded of {infeasible} infeasible"
+
+
+def test_the_branch_and_bound_never_excludes_a_scene_with_an_exact_motion() -> None:
+    moving = 0
+    for seed in range(40):
+        scene = _scene(seed)
+        solution = qs.solve(scene)
+        if solution.status not in ("solved", "ambiguous"):
+            continue
+        moving += 1
+        problem = qs.assemble(scene)
+        for count in (8, 16, 32):
+            assert not relaxation_excluded(problem, _uniform(problem, count)).excluded, f"seed {seed}, {count} sectors"
+    assert moving >= 10
+
+
+@pytest.mark.parametrize("instance", [1, 2])
+def test_jammed_grasps_are_proven_by_the_branch_and_bound_without_scip(instance: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    def no_scip(*args: object) -> None:
+        raise AssertionError("SCIP's sector relaxation was built")
+
+    monkeypatch.setattr(wedge, "_relaxation", no_scip)
+    solution = qs.solve(grasp_3d(4, instance))
+    assert solution.status == "jammed" and solution.certified
+    assert solution.certificate is not None and solution.certificate.kind is qs.CertificateKind.SECTOR_RELAXATION
+    assert wedge.BY_BRANCH_AND_BOUND in solution.certificate.text
