@@ -7,17 +7,28 @@ rebuilt, must equal the scene read from the file with the values set, at every p
 
 from __future__ import annotations
 
+import copy
 import importlib
+import itertools
+import math
+from typing import Any
 
 import pytest
 
 import quasistatic as qs
+from quasistatic.errors import SceneError
+from quasistatic.model.io import scene_to_dict
 from quasistatic.sim import Inputs, SimModel, StepOptions, evaluate
 from quasistatic.sim.step import StepResult
+from quasistatic.sweeps.params import sweep_params
+from quasistatic.sweeps.result import SweepPoint, point_from_solution
+from quasistatic.sweeps.scenes import PointScenes, scene_at
 from quasistatic.tools.bench.simulation import planar_two_finger_push
+from quasistatic.tools.bench.sweep_bench import SWEEP_SCENE
 
 MESSAGE = StepResult.__dict__["message"]
 simulate_module = importlib.import_module("quasistatic.sim.simulate")  # the package re-exports the function by that name
+sweep_run = importlib.import_module("quasistatic.sweeps.run")
 
 
 def test_a_recorded_message_is_worked_out_when_read_and_equals_a_fresh_solve() -> None:
@@ -46,3 +57,75 @@ def test_a_long_run_holds_at_most_the_window_of_undecided_messages(monkeypatch: 
     trajectory = qs.simulate(planar_two_finger_push(), duration=0.3, dt=0.05)
     decided = [MESSAGE.decided(step) for step in trajectory.steps]
     assert all(decided[: len(decided) - 3]) and not any(decided[-2:])
+
+
+# --------------------------------------------------------------------------- sweeps
+
+SWEPT = {
+    "contacts[2].point[1]": [0.02, 0.2, 0.38],
+    "contacts[0].mu,contacts[1].mu": [0.0, 0.5],
+    "contacts[2].normal[1]": [0.0, 0.01],  # normalised by the Scene, from the file's own numbers
+    "bodies.box.mass": [1.0, 3.0],
+    "bodies.box.com[0]": [0.0, 0.02],
+    "movers.pusher.twist[0]": [0.01, 0.02],
+    "movers.pusher.origin[1]": [0.0, 0.1],
+    "gravity[0]": [0.0, 1.0],
+}
+
+
+def _box_data() -> dict[str, Any]:
+    data = copy.deepcopy(SWEEP_SCENE)
+    data["gravity"] = [0.0, -9.81]
+    data["movers"]["pusher"]["origin"] = [0.0, 0.0]
+    return data
+
+
+@pytest.mark.parametrize("first, second", list(itertools.combinations(SWEPT, 2)))
+def test_a_point_scene_equals_the_file_read_again_at_every_point(first: str, second: str) -> None:
+    data = _box_data()
+    axes = sweep_params(data, {first: SWEPT[first], second: SWEPT[second]})
+    scenes = PointScenes(data, ".", axes)
+    assert scenes.base is not None  # the reuse is on: these paths lead into parts it rebuilds alone
+    for values in itertools.product(SWEPT[first], SWEPT[second]):
+        assert scene_to_dict(scenes.at(values)) == scene_to_dict(scene_at(data, ".", axes, values))
+    assert data == _box_data()  # the file's data is never changed
+
+
+@pytest.mark.parametrize(
+    "params, values",
+    [
+        ({"contacts[2].normal[0]": [1.0, 0.0], "contacts[2].normal[1]": [0.0, 1.0]}, (0.0, 0.0)),  # no normal at all
+        ({"contacts[0].mu": [0.5, 0.6], "contacts[1].mu": [0.5, 0.6]}, (-0.1, 0.5)),
+        ({"bodies.box.mass": [1.0, 2.0], "movers.pusher.twist[0]": [0.01, 0.02]}, (1.0, math.inf)),
+        ({"gravity[1]": [-9.81, -1.0], "bodies.box.com[1]": [0.2, 0.3]}, (1e300, 0.2)),
+    ],
+)
+def test_a_rejected_point_gives_the_error_of_the_file_read_again(params: dict[str, list[float]], values: tuple[float, ...]) -> None:
+    data = _box_data()
+    axes = sweep_params(data, params)
+    with pytest.raises(SceneError) as fresh:
+        scene_at(data, ".", axes, values)
+    with pytest.raises(SceneError) as reused:
+        PointScenes(data, ".", axes).at(values)
+    assert (reused.value.field, reused.value.value, reused.value.reason) == (fresh.value.field, fresh.value.value, fresh.value.reason)
+    assert str(reused.value) == str(fresh.value)
+
+
+def test_a_sweep_equals_each_point_solved_from_the_file_and_leaves_messages_for_reading() -> None:
+    grid = {"contacts[2].point[1]": [0.05, 0.15, 0.3], "contacts[0].mu,contacts[1].mu": [0.2, 0.8]}
+    result = qs.sweep(SWEEP_SCENE, grid)
+    point_message = SweepPoint.__dict__["message"]
+    assert not any(point_message.decided(p) for p in result.points)
+    axes = sweep_params(SWEEP_SCENE, grid)
+    for point in result.points:
+        fresh = qs.solve(scene_at(SWEEP_SCENE, ".", axes, point.values))
+        assert point == point_from_solution(point.index, point.values, point.refinement, fresh)  # == reads the messages
+        assert point.message == fresh.message and "contact forces" in point.message
+
+
+def test_a_sweep_holds_at_most_the_window_of_undecided_messages(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(sweep_run, "UNDECIDED_MESSAGES", 3)
+    result = qs.sweep(SWEEP_SCENE, {"contacts[2].point[1]": [0.05, 0.1, 0.15, 0.3, 0.35]}, chunk_size=1)
+    assert all(p.status == "solved" for p in result.points)  # a claim about the forces in every message
+    decided = [SweepPoint.__dict__["message"].decided(p) for p in result.points]
+    assert decided == [True, True, False, False, False]

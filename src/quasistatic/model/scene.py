@@ -442,6 +442,41 @@ class Scene:
             values[key] = build(self)
         return cast(T, values[key])
 
+    def replaced(
+        self,
+        *,
+        bodies: Mapping[str, Body] | None = None,
+        movers: Mapping[str, Mover] | None = None,
+        contacts: Mapping[int, Contact] | None = None,
+        gravity: npt.ArrayLike | None = None,
+    ) -> Scene:
+        """This scene with some parts replaced by new ones of the same names (contacts by index), gravity too.
+
+        Only the new parts are checked, against this scene as the constructor checks them (the same errors);
+        the rest was checked when this scene was made. For a sweep that changes a few numbers at every point.
+
+        Raises
+        ------
+        SceneError
+            As :class:`Scene` would, for a new part or gravity; or naming a part this scene does not have.
+        """
+        parts = _Parts.of(self)
+        changes: dict[str, Any] = {"_derived": {}}
+        if bodies:
+            changes["bodies"] = _swapped(self.bodies, bodies, Body, "bodies", parts.body)
+        if movers:
+            changes["movers"] = _swapped(self.movers, movers, Mover, "movers", parts.mover)
+        if contacts:
+            unknown = sorted(set(contacts) - set(range(len(self.contacts))))
+            if unknown:
+                raise SceneError("contacts", unknown, f"the scene has {len(self.contacts)} contacts")
+            changes["contacts"] = tuple(
+                parts.contact(contacts[i], f"contacts[{i}]") if i in contacts else c for i, c in enumerate(self.contacts)
+            )
+        if gravity is not None:
+            changes["gravity"] = _sized(checked_array(gravity, "gravity"), self.dimension, "gravity")
+        return _checked_copy(self, **changes)
+
     def body_index(self, name: str) -> int:
         """Index of a free body by name."""
         return [b.name for b in self.bodies].index(name)
@@ -503,8 +538,30 @@ def _sized(vector: FloatArray, length: int, path: str) -> FloatArray:
     return vector
 
 
+def _swapped(kept: tuple[T, ...], new: Mapping[str, Any], kind: type, path: str, check: Callable[[Any], T]) -> tuple[T, ...]:
+    """``kept`` with the parts named in ``new`` replaced, each checked; a new part keeps its name."""
+    names = [cast(Any, part).name for part in kept]
+    for name, part in new.items():
+        if name not in names:
+            raise SceneError(f"{path}.{name}", name, _unknown(kind.__name__.lower(), name, names))
+        if not isinstance(part, kind) or getattr(part, "name", None) != name:
+            raise SceneError(f"{path}.{name}", type(part).__name__, f"expected a {kind.__name__} named {name!r}")
+    return tuple(check(new[name]) if name in new else part for name, part in zip(names, kept, strict=True))
+
+
 class _Parts:
     """The scene's bodies, movers and robots checked together, with their defaults filled in (new objects)."""
+
+    @classmethod
+    def of(cls, scene: Scene) -> _Parts:
+        """The context of an already checked scene, to check new parts against it (nothing is checked again)."""
+        parts = cls.__new__(cls)
+        parts.dimension, parts.stiffness, parts.twist_size = scene.dimension, scene.stiffness, scene.twist_size
+        parts.robots, parts.bodies, parts.movers = scene.robots, scene.bodies, scene.movers
+        parts.robot_joints = {r.name: r.joint_velocities.size for r in scene.robots}
+        parts.body_names = {b.name for b in scene.bodies}
+        parts.mover_robot = {m.name: m.robot for m in scene.movers}
+        return parts
 
     def __init__(
         self, dimension: int, bodies: tuple[Body, ...], movers: tuple[Mover, ...], robots: tuple[Robot, ...], stiffness: Stiffness | None
@@ -520,12 +577,12 @@ class _Parts:
         _check_unique_names(bodies, movers, robots)
         self.robots = robots
         self.robot_joints = {r.name: r.joint_velocities.size for r in robots}
-        self.bodies = tuple(self._body(b) for b in bodies)
-        self.movers = tuple(self._mover(m) for m in movers)
+        self.bodies = tuple(self.body(b) for b in bodies)
+        self.movers = tuple(self.mover(m) for m in movers)
         self.body_names = {b.name for b in bodies}
         self.mover_robot = {m.name: m.robot for m in movers}
 
-    def _body(self, body: Body) -> Body:
+    def body(self, body: Body) -> Body:
         path = f"bodies.{body.name}"
         wrench = np.zeros(self.twist_size) if body.wrench is None else body.wrench
         return _checked_copy(
@@ -534,7 +591,7 @@ class _Parts:
             wrench=_sized(checked_array(wrench, path), self.twist_size, f"{path}.wrench"),
         )
 
-    def _mover(self, mover: Mover) -> Mover:
+    def mover(self, mover: Mover) -> Mover:
         path = f"movers.{mover.name}"
         if mover.robot is not None:
             if mover.twist is not None:
