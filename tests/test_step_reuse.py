@@ -11,12 +11,16 @@ import copy
 import importlib
 import itertools
 import math
+from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import pytest
 
 import quasistatic as qs
+from quasistatic.adapters import planar_pose
 from quasistatic.errors import SceneError
+from quasistatic.model import Contact, Scene
 from quasistatic.model.io import scene_to_dict
 from quasistatic.sim import Inputs, SimModel, StepOptions, evaluate
 from quasistatic.sim.step import StepResult
@@ -50,6 +54,68 @@ def test_saving_a_run_writes_the_worked_out_messages(tmp_path) -> None:
     trajectory.save(path)
     back = qs.Trajectory.load(path)
     assert [s.message for s in back.steps] == [s.message for s in trajectory.steps]
+
+
+def _flat(trajectory: qs.Trajectory) -> list[Any]:
+    """Every number and word of a run, step by step (poses, statuses, messages, twists, contacts, events)."""
+    rows: list[Any] = []
+    for state, step in zip(trajectory.states, trajectory.steps, strict=True):
+        poses = {**state.bodies, **state.movers}
+        rows.append([(name, p.position.tolist(), p.rotation.tolist()) for name, p in sorted(poses.items())])
+        rows.append([step.time, step.dt, step.status, step.certified, step.message, step.choice, step.penetration])
+        rows.append([(name, t.tolist()) for name, t in sorted(step.twists.items())])
+        contacts = [(c.body, c.other, c.point.tolist(), c.normal.tolist(), c.gap, c.force.tolist(), c.mode) for c in step.contacts]
+        rows.append(contacts + [c.slip.tolist() for c in step.contacts])
+        rows.append([(e.time, e.kind, e.pair, e.detail) for e in step.events])
+    return rows
+
+
+TIPPING = Path(__file__).resolve().parents[1] / "examples" / "sim" / "tip_box_planar.yaml"
+
+
+@pytest.mark.parametrize("scene, duration", [(planar_two_finger_push, 1.0), (lambda: TIPPING, 3.0)])
+def test_a_run_restating_its_scenes_equals_one_building_each_scene_anew(
+    scene: Callable[[], Any], duration: float, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Step for step, with the reuse on and off: the push (4 contacts throughout) and the tipping box (a corner lifts)."""
+    reused = qs.simulate(scene(), duration=duration, dt=0.05)
+    restated: list[bool] = []
+    real = Scene.moved
+
+    def counted(self: Scene, *args: Any) -> Scene | None:
+        scene = real(self, *args)
+        restated.append(scene is not None)
+        return scene
+
+    monkeypatch.setattr(Scene, "moved", counted)
+    assert _flat(qs.simulate(scene(), duration=duration, dt=0.05)) == _flat(reused)
+    assert sum(restated) >= len(reused.steps) - 2  # the reuse was on: nearly every scene restated
+    monkeypatch.setattr(Scene, "moved", lambda self, *args: None)  # every scene built anew
+    assert _flat(qs.simulate(scene(), duration=duration, dt=0.05)) == _flat(reused)
+
+
+def test_a_restated_scene_equals_a_new_one_and_checks_the_new_numbers() -> None:
+    world = planar_two_finger_push()
+    first = world.scene()
+    moved = world.moved({"box": planar_pose([0.004, 0.05], 0.01)}, mover_poses={"finger_low": planar_pose([-0.05, 0.03])})
+    detection = moved.detect()
+    restated = moved.scene(detection)
+    fresh = Scene(
+        bodies=[b.body() for b in moved.bodies],
+        movers=[m.mover() for m in moved.movers],
+        contacts=detection.contacts,
+        dimension=2,
+        friction=moved.friction,
+    )
+    assert scene_to_dict(restated) == scene_to_dict(fresh) and scene_to_dict(restated) != scene_to_dict(first)
+    with pytest.raises(SceneError) as info:
+        first.moved([[math.nan, 0.0]], [(None, None)] * 3, first.contacts)
+    assert info.value.field == "bodies.box.com"
+    bent = [Contact.from_trusted_arrays(c.body, c.other, c.point, 2.0 * c.normal, c.mu) for c in first.contacts]
+    with pytest.raises(SceneError, match="must be a unit vector") as info:
+        first.moved([b.com for b in first.bodies], [(m.twist, m.origin) for m in first.movers], bent)
+    assert info.value.field == "contacts[0].normal"
+    assert first.moved([b.com for b in first.bodies], [(m.twist, m.origin) for m in first.movers], first.contacts[1:]) is None
 
 
 def test_a_long_run_holds_at_most_the_window_of_undecided_messages(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Callable, Collection, Iterable, Mapping
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar, cast
 
@@ -477,6 +477,30 @@ class Scene:
             changes["gravity"] = _sized(checked_array(gravity, "gravity"), self.dimension, "gravity")
         return _checked_copy(self, **changes)
 
+    def moved(
+        self,
+        coms: Sequence[npt.ArrayLike],
+        mover_places: Sequence[tuple[npt.ArrayLike | None, npt.ArrayLike | None]],
+        contacts: Sequence[Contact],
+    ) -> Scene | None:
+        """This scene at another instant: new centres of mass (one per body), mover ``(twist, origin)`` pairs (one
+        per mover) and contacts, or None when the contacts' pairs differ from this scene's (then make a Scene).
+
+        Each new number is checked as the constructor checks it (the same errors); what an instant does not change
+        (names, masses, wrenches, gravity, friction, which pairs touch) was checked when this scene was made. For a
+        simulation step, whose bodies move but whose structure mostly stays; scenes with robots are not restated.
+        """
+        if self.robots or [(c.body, c.other) for c in contacts] != [(c.body, c.other) for c in self.contacts]:
+            return None
+        parts, d = _Parts.of(self), self.dimension
+        bodies = tuple(
+            _checked_copy(body, com=_sized(checked_array(com, f"bodies.{body.name}.com"), d, f"bodies.{body.name}.com"))
+            for body, com in zip(self.bodies, coms, strict=True)
+        )
+        movers = tuple(parts.mover_numbers(mover, twist, origin) for mover, (twist, origin) in zip(self.movers, mover_places, strict=True))
+        checked = tuple(parts.contact_numbers(_contact_of(contact), f"contacts[{i}]") for i, contact in enumerate(contacts))
+        return _checked_copy(self, bodies=bodies, movers=movers, contacts=checked, _derived={})
+
     def body_index(self, name: str) -> int:
         """Index of a free body by name."""
         return [b.name for b in self.bodies].index(name)
@@ -536,6 +560,12 @@ def _sized(vector: FloatArray, length: int, path: str) -> FloatArray:
     if vector.shape != (length,):
         raise SceneError(path, vector.tolist(), f"expected a list of {length} numbers")
     return vector
+
+
+def _contact_of(contact: Any) -> Contact:
+    if not isinstance(contact, Contact):
+        raise SceneError("contacts", type(contact).__name__, "expected a Contact")
+    return contact
 
 
 def _swapped(kept: tuple[T, ...], new: Mapping[str, Any], kind: type, path: str, check: Callable[[Any], T]) -> tuple[T, ...]:
@@ -608,10 +638,23 @@ class _Parts:
             origin=_sized(checked_array(origin, path), self.dimension, f"{path}.origin"),
         )
 
+    def mover_numbers(self, mover: Mover, twist: npt.ArrayLike | None, origin: npt.ArrayLike | None) -> Mover:
+        """A checked rigid mover with a new twist and origin, each checked once as ``Mover`` and :meth:`mover` would."""
+        path = f"movers.{mover.name}"
+        twist = checked_array(np.zeros(self.twist_size) if twist is None else twist, f"{path}.twist")
+        origin = checked_array(np.zeros(self.dimension) if origin is None else origin, f"{path}.origin")
+        return _checked_copy(
+            mover, twist=_sized(twist, self.twist_size, f"{path}.twist"), origin=_sized(origin, self.dimension, f"{path}.origin")
+        )
+
     def contact(self, contact: Contact, path: str) -> Contact:
         if not isinstance(contact, Contact):
             raise SceneError(path, type(contact).__name__, "expected a Contact")
         self._check_pair(contact, path)
+        return self.contact_numbers(contact, path)
+
+    def contact_numbers(self, contact: Contact, path: str) -> Contact:
+        """A contact whose pair is known to be valid here: its point, unit normal, jacobian and stiffness checked."""
         point = _sized(contact.point, self.dimension, f"{path}.point")
         normal = _sized(contact.normal, self.dimension, f"{path}.normal")
         length = float(np.linalg.norm(normal))

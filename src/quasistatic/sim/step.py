@@ -366,7 +366,7 @@ def _reclosed(evaluation: Evaluation, state: State) -> State:
 def _was_closed(before: list[tuple[Contact, Mode]], contact: Contact, band: float) -> bool:
     """The contact of the same pair nearest to ``contact`` before the step lies within ``band`` and was rolling or sliding."""
     pair = (contact.body, contact.other)
-    same_pair = [(float(np.linalg.norm(c.point - contact.point)), mode) for c, mode in before if (c.body, c.other) == pair]
+    same_pair = [(math.dist(c.point, contact.point), mode) for c, mode in before if (c.body, c.other) == pair]
     if not same_pair:
         return False
     distance, mode = min(same_pair, key=lambda entry: entry[0])
