@@ -170,8 +170,8 @@ class Certificate:
     """
 
     kind: CertificateKind
-    text: str
-    data: tuple[float, ...] = ()
+    text: LaterField[str] = LaterField(required=True)  # each may be a Later: a certificate the verdict does not rest on
+    data: LaterField[tuple[float, ...]] = LaterField(())  # (the direction of a fall, an LP) is worked out when read
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind.value, "text": self.text, "data": [float(x) for x in self.data]}

@@ -1,8 +1,11 @@
-"""What a simulation step and a sweep point reuse or leave for later gives exactly what a fresh, eager answer gives.
+"""What a simulation step, a sweep point and a small solve reuse or leave for later gives exactly what a fresh, eager
+answer gives.
 
 A recorded step's message (its claim about the forces) is worked out when read; it must equal the message of the
-same state solved again. A sweep point's scene, made from the scene validated once with only the swept parts
-rebuilt, must equal the scene read from the file with the values set, at every point.
+same state solved again, and a whole run restating its scenes must equal one building every scene anew. A sweep
+point's scene, made from the scene validated once with only the swept parts rebuilt, must equal the scene read
+from the file with the values set, at every point, and reject what it rejects with the same error. An unstable
+answer's certificate (the fall direction, an LP) is worked out when read and equals the eager one.
 """
 
 from __future__ import annotations
@@ -11,6 +14,7 @@ import copy
 import importlib
 import itertools
 import math
+import pickle
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -20,13 +24,17 @@ import pytest
 import quasistatic as qs
 from quasistatic.adapters import planar_pose
 from quasistatic.errors import SceneError
+from quasistatic.laws.polyhedral import aligned_edges
 from quasistatic.model import Contact, Scene
 from quasistatic.model.io import scene_to_dict
 from quasistatic.sim import Inputs, SimModel, StepOptions, evaluate
 from quasistatic.sim.step import StepResult
+from quasistatic.solution import CertificateKind
+from quasistatic.solvers.certify.diagnose import fall_certificate
 from quasistatic.sweeps.params import sweep_params
 from quasistatic.sweeps.result import SweepPoint, point_from_solution
 from quasistatic.sweeps.scenes import PointScenes, scene_at
+from quasistatic.tools.bench.families import grasp_2d
 from quasistatic.tools.bench.simulation import planar_two_finger_push
 from quasistatic.tools.bench.sweep_bench import SWEEP_SCENE
 
@@ -195,3 +203,38 @@ def test_a_sweep_holds_at_most_the_window_of_undecided_messages(monkeypatch: pyt
     assert all(p.status == "solved" for p in result.points)  # a claim about the forces in every message
     decided = [SweepPoint.__dict__["message"].decided(p) for p in result.points]
     assert decided == [True, True, False, False, False]
+
+
+# --------------------------------------------------------------------------- unstable certificates
+
+
+def _pulled_box(pull: float) -> qs.Scene:
+    """A 2-D box on two table corners (mu 0.5), nothing pushing, pulled sideways by ``pull`` N/kg."""
+    box = qs.Body("box", mass=1.0, com=[0.0, 0.05])
+    contacts = [qs.Contact("box", "table", point=[x, 0.0], normal=[0.0, 1.0], mu=0.5) for x in (-0.05, 0.05)]
+    return qs.Scene(bodies=[box], movers=[qs.Mover("table")], contacts=contacts, dimension=2, gravity=[pull, -9.81])
+
+
+UNSTABLE = [grasp_2d(m, i) for m in (2, 3, 4) for i in range(6)] + [_pulled_box(6.0), _pulled_box(20.0)]
+
+
+@pytest.mark.parametrize("scene", UNSTABLE)
+def test_an_unstable_certificate_is_worked_out_when_read_and_equals_the_eager_one(scene: qs.Scene) -> None:
+    problem = qs.assemble(scene)
+    solution = qs.solve(problem)
+    if solution.status != "unstable":
+        return
+    certificate = solution.certificate
+    assert certificate is not None and certificate.kind is CertificateKind.INFEASIBLE_EQUILIBRIUM
+    fields = type(certificate).__dict__
+    assert not fields["text"].decided(certificate) and not fields["data"].decided(certificate)
+    eager = fall_certificate(problem, aligned_edges(problem, problem.friction.edges))
+    assert eager.data  # a fall direction: the LP found one
+    assert solution.to_dict()["certificate"] == eager.to_dict()
+    assert certificate == eager
+    again = qs.solve(problem).certificate
+    assert pickle.loads(pickle.dumps(again)) == eager  # pickling works it out first
+
+
+def test_unstable_scenes_are_among_the_checked_ones() -> None:
+    assert sum(qs.solve(scene).status == "unstable" for scene in UNSTABLE) >= 3
