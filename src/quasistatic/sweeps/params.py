@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import SceneError
 
-__all__ = ["Step", "SweepParam", "apply_values", "set_values", "parse_param_spec", "parse_path", "sweep_params"]
+__all__ = ["Step", "SweepParam", "apply_values", "resolved_path", "set_values", "parse_param_spec", "parse_path", "sweep_params"]
 
 Step = str | int
 """One step of a path: a mapping key or a list index."""
@@ -97,6 +97,23 @@ def sweep_params(data: Mapping[str, Any], params: Mapping[str, Any]) -> tuple[Sw
 def apply_values(data: Mapping[str, Any], params: Sequence[SweepParam], values: Sequence[float]) -> dict[str, Any]:
     """A deep copy of the scene file's data with each parameter's paths set to its value."""
     return set_values(copy.deepcopy(dict(data)), params, values)
+
+
+def resolved_path(data: Mapping[str, Any], path: tuple[Step, ...], name: str) -> tuple[Step, ...]:
+    """``path`` with a joint's name turned into its index: the keys and indices that reach the number in ``data``.
+
+    Raises
+    ------
+    SceneError
+        As :func:`sweep_params` does, when the path does not lead into ``data``.
+    """
+    node: Any = data
+    steps: list[Step] = []
+    for depth, step in enumerate(path):
+        steps.append(_resolved(node, step, path[:depth], data, name))
+        if depth < len(path) - 1:
+            node = node[steps[-1]]
+    return tuple(steps)
 
 
 def set_values(data: dict[str, Any], params: Sequence[SweepParam], values: Sequence[float]) -> dict[str, Any]:

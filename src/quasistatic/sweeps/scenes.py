@@ -30,7 +30,7 @@ from ..model.io import (
     read_scene_file,
     scene_from_file,
 )
-from .params import SweepParam, apply_values, set_values
+from .params import SweepParam, apply_values, resolved_path
 
 __all__ = ["PointScenes", "scene_at"]
 
@@ -61,6 +61,7 @@ class PointScenes:
     def __init__(self, data: Mapping[str, Any], folder: str | Path, params: Sequence[SweepParam]) -> None:
         self.data, self.folder, self.params = data, folder, tuple(params)
         self.parts = _swept_parts(self.params)
+        self.steps: list[tuple[tuple[str | int, ...], ...]] = []  # each parameter's paths as keys and indices
         self.base = self._base() if self.parts is not None else None
 
     def at(self, values: Sequence[float]) -> Scene:
@@ -82,12 +83,18 @@ class PointScenes:
         """The file's own scene; None for a scene of shapes, or a file each point must read to say why it fails."""
         try:
             parsed, _ = read_scene_file(self.data)
-            return None if parsed.is_geometric else scene_from_file(parsed)
+            if parsed.is_geometric:
+                return None
+            self.steps = [tuple(resolved_path(self.data, path, p.name) for path in p.paths) for p in self.params]
+            return scene_from_file(parsed)
         except SceneError:
             return None
 
     def _rebuilt(self, base: Scene, parts: tuple[Part, ...], values: Sequence[float]) -> Scene:
-        entries = set_values(_copied(self.data, parts), self.params, values)
+        entries = _copied(self.data, parts)
+        for paths, value in zip(self.steps, values, strict=True):
+            for path in paths:
+                _set(entries, path, float(value))
         contacts, bodies, movers = {}, {}, {}
         for key, name in parts:
             if key == "contacts":
@@ -100,6 +107,13 @@ class PointScenes:
                 movers[str(name)] = mover_from_file(str(name), None if entry is None else MoverFile.model_validate(entry))
         gravity = entries["gravity"] if ("gravity", "") in parts else None
         return base.replaced(bodies=bodies, movers=movers, contacts=contacts, gravity=gravity)
+
+
+def _set(data: dict[str, Any], path: tuple[str | int, ...], value: float) -> None:
+    node: Any = data
+    for step in path[:-1]:
+        node = node[step]
+    node[path[-1]] = value
 
 
 def _swept_parts(params: Sequence[SweepParam]) -> tuple[Part, ...] | None:
@@ -139,8 +153,13 @@ def _copied(data: Mapping[str, Any], parts: tuple[Part, ...]) -> dict[str, Any]:
 
 def _plain_copy(value: Any) -> Any:
     """A deep copy of a file's data (mappings, lists, numbers, text): ``copy.deepcopy`` costs 5x more per point."""
-    if isinstance(value, Mapping):
-        return {key: _plain_copy(item) for key, item in value.items()}
+    if type(value) in _LEAVES:  # most entries: numbers (the exact type: an ABC check costs more than the copy)
+        return value
     if isinstance(value, list):
         return [_plain_copy(item) for item in value]
-    return value  # a number, text, or a tuple (immutable: a path cannot set into it, as in a deep copy)
+    if isinstance(value, Mapping):
+        return {key: _plain_copy(item) for key, item in value.items()}
+    return value  # text, None, or a tuple (immutable: a path cannot set into it, as in a deep copy)
+
+
+_LEAVES = frozenset({float, int, str, bool, type(None)})
