@@ -15,6 +15,8 @@ import importlib
 import itertools
 import math
 import pickle
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -238,3 +240,42 @@ def test_an_unstable_certificate_is_worked_out_when_read_and_equals_the_eager_on
 
 def test_unstable_scenes_are_among_the_checked_ones() -> None:
     assert sum(qs.solve(scene).status == "unstable" for scene in UNSTABLE) >= 3
+
+
+# --------------------------------------------------------------------------- the console script
+
+ROOT = Path(__file__).resolve().parents[1]
+SCRIPT = Path(sys.executable).parent / "quasistatic"
+BOX = ROOT / "validation" / "scenes" / "box_push_high.yaml"
+
+
+def _cli(*args: str | Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([str(SCRIPT), *map(str, args)], capture_output=True, text=True, timeout=600, cwd=ROOT)
+
+
+def test_cli_a_value_rejected_with_another_gives_the_line_a_fresh_read_gives() -> None:
+    """Both normal entries swept: (0, 0) is no normal at all. The one line names the path as reading the file says."""
+    params = {"contacts[2].normal[0]": [1.0, 0.0], "contacts[2].normal[1]": [0.0, 1.0]}
+    data = qs.model.io.read_scene_data(BOX)
+    axes = sweep_params(data, params)
+    with pytest.raises(SceneError) as fresh:
+        scene_at(data, BOX.parent, axes, (0.0, 0.0))
+    inner = fresh.value
+    expected = SceneError("contacts[2].normal[0]", 0.0, f"the scene rejects this value ({inner.field}: {inner.reason})")
+    done = _cli("sweep", BOX, "--param", "contacts[2].normal[0]=1,0", "--param", "contacts[2].normal[1]=0,1")
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.splitlines() == [f"error: {' '.join(str(expected).split())}"]
+    assert "must be a unit vector" in done.stderr
+
+
+def test_cli_table_messages_equal_fresh_solves(tmp_path: Path) -> None:
+    import pyarrow.csv as pcsv
+
+    done = _cli("sweep", BOX, "--param", "contacts[2].point[1]=0.05,0.3", "--out", tmp_path / "r.csv")
+    assert done.returncode == 0, done.stderr
+    table = pcsv.read_csv(tmp_path / "r.csv")
+    data = qs.model.io.read_scene_data(BOX)
+    axes = sweep_params(data, {"contacts[2].point[1]": [0.05, 0.3]})
+    fresh = [qs.solve(scene_at(data, BOX.parent, axes, (h,))).message for h in (0.05, 0.3)]
+    assert table.column("message").to_pylist() == fresh
+    assert all("contact forces" in m for m in fresh)  # the claim the table waited for is in it
