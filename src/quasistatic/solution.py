@@ -115,6 +115,10 @@ class LaterField(Generic[T]):
     def __set__(self, obj: object, value: T | Later[T]) -> None:
         obj.__dict__[self.name] = value  # frozen dataclasses set their fields through object.__setattr__, here
 
+    def kept(self, obj: object) -> T | Later[T]:
+        """What ``obj`` holds: the value, or its :class:`Later` undecided (another value sharing it decides it once for both)."""
+        return obj.__dict__[self.name]  # type: ignore[no-any-return]
+
     def decided(self, obj: object) -> bool:
         """Whether ``obj``'s value is known without working anything out."""
         value = obj.__dict__[self.name]
@@ -166,8 +170,8 @@ class Certificate:
     """
 
     kind: CertificateKind
-    text: str
-    data: tuple[float, ...] = ()
+    text: LaterField[str] = LaterField(required=True)  # each may be a Later: a certificate the verdict does not rest on
+    data: LaterField[tuple[float, ...]] = LaterField(())  # (the direction of a fall, an LP) is worked out when read
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind.value, "text": self.text, "data": [float(x) for x in self.data]}
@@ -791,6 +795,11 @@ class Solution:
                 "source: this Solution was not made by solve(), so it has no scene to differentiate; use qs.sensitivity(scene, solution)"
             )
         return self.source.sensitivity(self, inputs, geometry)
+
+    def kept_message(self) -> str | Later[str]:
+        """The message, or its :class:`Later` undecided: a record sharing it (a simulation step) decides it once for both."""
+        field: LaterField[str] = type(self).__dict__["message"]
+        return field.kept(self)
 
     def __getstate__(self) -> dict[str, Any]:
         # Pickled without its scene: a batch's worker would ship back the scene its parent holds, doubling the cost

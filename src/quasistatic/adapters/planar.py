@@ -193,6 +193,7 @@ class PlanarLayout:
         self.outlines = [_Outline(s.vertices) if isinstance(s, Polygon) else None for s in shapes]
         self.radii = np.array([s.extent for s in shapes])
         self.sizes = np.array([s.extent if math.isfinite(s.extent) else 0.0 for s in shapes])
+        self.reach = np.where(np.isfinite(self.radii), self.radii, 0.0)  # a halfplane's bounding circle: none
         pairs = [
             (i, j)
             for i in range(len(shapes))
@@ -205,6 +206,10 @@ class PlanarLayout:
         self.second = np.array([j for _, j in pairs], dtype=int)
         self.kernels = [_kernel(shapes[i], shapes[j]) for i, j in pairs]
         self.planes = np.array([isinstance(shapes[i], HalfPlane) or isinstance(shapes[j], HalfPlane) for i, j in pairs], dtype=bool)
+        # each pair with a halfplane: its index, the halfplane's collider and the other's (the broad phase's scalar loop)
+        self.plane_pairs = [
+            (k, i, j) if isinstance(shapes[i], HalfPlane) else (k, j, i) for k, (i, j) in enumerate(pairs) if self.planes[k]
+        ]
         self.tolerances = [DUPLICATE_POINT * min(self.sizes[i] or math.inf, self.sizes[j] or math.inf) for i, j in pairs]
 
     def detect(self, poses: FloatArray, margin: float) -> list[ContactPoint]:
@@ -236,10 +241,9 @@ class PlanarLayout:
         """Broad phase: bounding circles within ``margin``; against a halfplane, the circle's signed distance."""
         i, j = self.first, self.second
         centres = poses[:, :2]
-        reach = np.where(np.isfinite(self.radii), self.radii, 0.0)
+        reach = self.reach
         near = np.hypot(*(centres[i] - centres[j]).T) <= reach[i] + reach[j] + margin
-        for k in np.flatnonzero(self.planes).tolist():
-            plane, other = (int(i[k]), int(j[k])) if isinstance(self.shapes[i[k]], HalfPlane) else (int(j[k]), int(i[k]))
+        for k, plane, other in self.plane_pairs:
             normal, offset = placed[plane].line()
             near[k] = float(normal @ centres[other]) - offset <= reach[other] + margin
         return near
@@ -254,12 +258,23 @@ class _Outline:
         self.squared = np.einsum("ij,ij->i", self.edges, self.edges)
         self.normals = np.column_stack([self.edges[:, 1], -self.edges[:, 0]]) / np.sqrt(self.squared)[:, None]  # outward
         self.offsets = np.einsum("ij,ij->i", self.normals, vertices)
+        self._faces = list(zip(vertices.tolist(), self.edges.tolist(), self.squared.tolist(), strict=True))
 
     def closest(self, point: FloatArray) -> FloatArray:
-        """The point of the boundary nearest ``point`` (both in this frame)."""
-        t = np.clip(((point - self.vertices) * self.edges).sum(axis=1) / self.squared, 0.0, 1.0)
-        candidates = self.vertices + t[:, None] * self.edges
-        return np.asarray(candidates[np.argmin(np.hypot(*(candidates - point).T))])
+        """The point of the boundary nearest ``point`` (both in this frame); the first face's of equally near ones.
+
+        Face by face in Python floats: a polygon's few faces cost less so than in numpy calls (each step
+        of a simulation asks this of every disk near a polygon).
+        """
+        px, py = float(point[0]), float(point[1])
+        best, nearest = math.inf, (0.0, 0.0)
+        for (vx, vy), (ex, ey), squared in self._faces:
+            t = min(max(((px - vx) * ex + (py - vy) * ey) / squared, 0.0), 1.0)
+            cx, cy = vx + t * ex, vy + t * ey
+            distance = math.hypot(cx - px, cy - py)
+            if distance < best:
+                best, nearest = distance, (cx, cy)
+        return np.array(nearest)
 
 
 class _Placed:
@@ -373,17 +388,19 @@ def _polygon_plane(a: _Placed, b: _Placed, margin: float, tolerance: float) -> W
     within = np.flatnonzero(gaps <= margin)
     if within.size == 0:
         return []
-    along = vertices @ np.array([-normal[1], normal[0]])
+    along = (vertices @ np.array([-normal[1], normal[0]])).tolist()
+    height = gaps.tolist()
+    inside = within.tolist()
 
-    def deepest(near: float) -> int:  # the deepest vertex within the margin at ``near`` along the line
-        there = within[np.abs(along[within] - near) <= tolerance]
-        return int(there[np.argmin(gaps[there])])
+    def deepest(near: float) -> int:  # the deepest vertex within the margin at ``near`` along the line (the first of equal ones)
+        return min((k for k in inside if abs(along[k] - near) <= tolerance), key=lambda k: height[k])
 
     kept: list[int] = []
-    for k in (int(within[np.argmin(gaps[within])]), deepest(along[within].min()), deepest(along[within].max())):
+    lowest = min(inside, key=lambda k: height[k])
+    for k in (lowest, deepest(min(along[k] for k in inside)), deepest(max(along[k] for k in inside))):
         if all(abs(along[k] - along[j]) > tolerance for j in kept):
             kept.append(k)
-    return [(vertices[k] - 0.5 * gaps[k] * normal, normal, float(gaps[k])) for k in sorted(kept, key=lambda k: along[k])]
+    return [(vertices[k] - 0.5 * gaps[k] * normal, normal, height[k]) for k in sorted(kept, key=lambda k: along[k])]
 
 
 def _separation(reference: _Placed, incident: FloatArray) -> tuple[float, int]:

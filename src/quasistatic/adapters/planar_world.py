@@ -44,9 +44,12 @@ class PlanarBody:
 
     def body(self) -> Body:
         """The solver's Body: the com in the world frame."""
+        return Body(self.name, self.mass, self.world_com(), self.wrench)
+
+    def world_com(self) -> FloatArray:
+        """The centre of mass in the world frame [x, y]."""
         local = np.asarray(self.com, dtype=float)
-        world = self.pose.rotation[:2, :2] @ local + self.pose.position[:2]
-        return Body(self.name, self.mass, world, self.wrench)
+        return np.asarray(self.pose.rotation[:2, :2] @ local + self.pose.position[:2], dtype=float)
 
 
 @dataclass(frozen=True)
@@ -60,6 +63,10 @@ class PlanarMover:
 
     def mover(self) -> Mover:
         return Mover(self.name, self.twist, origin=self.pose.position[:2])
+
+    def place(self) -> tuple[npt.ArrayLike | None, FloatArray]:
+        """The solver's Mover's numbers: its twist and origin."""
+        return self.twist, self.pose.position[:2]
 
 
 @dataclass(frozen=True)
@@ -138,19 +145,33 @@ class PlanarWorld:
         return Detection(contacts, tuple(p.gap for p in points), margin, isolated)
 
     def scene(self, detection: Detection | None = None) -> Scene:
-        """The 2-D point-contact Scene at this instant: detected contacts first, then the explicit ones."""
+        """The 2-D point-contact Scene at this instant: detected contacts first, then the explicit ones.
+
+        The last Scene made of this world (or of one :meth:`moved` gave) is restated with this instant's numbers when
+        its contacts touch the same pairs (:meth:`Scene.moved`: the new numbers checked, the rest kept); a
+        simulation makes most of its steps' scenes so.
+        """
         detection = detection or self.detect()
-        return Scene(
+        contacts = detection.contacts + self.contacts
+        kept: Scene | None = self._fixed.get("scene")
+        if kept is not None:
+            coms = [b.world_com() for b in self.bodies]
+            restated = kept.moved(coms, [m.place() for m in self.movers], contacts)
+            if restated is not None:
+                return restated
+        scene = Scene(
             bodies=[b.body() for b in self.bodies],
             movers=[m.mover() for m in self.movers],
             robots=self.explicit_robots,
-            contacts=detection.contacts + self.contacts,
+            contacts=contacts,
             dimension=2,
             gravity=self.gravity,
             friction=self.friction,
             stiffness=self.stiffness,
             closing_time=self.closing_time,
         )
+        self._fixed["scene"] = scene
+        return scene
 
     @property
     def contact_margin(self) -> float:

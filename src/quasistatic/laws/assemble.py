@@ -133,7 +133,8 @@ def assemble(scene: Scene) -> Problem:
     _add_blocks(J, rows, body, _twist_rows(frames, points - coms[body]), k)
     other = np.array([index.get(c.other, -1) for c in scene.contacts], dtype=int)
     pair = other >= 0  # a contact between two free bodies: the other body's motion counts against
-    _add_blocks(J, rows[pair], other[pair], -_twist_rows(frames[pair], points[pair] - coms[other[pair]]), k)
+    if n_bodies > 1 and pair.any():  # (one free body touches only movers: skip four empty numpy calls)
+        _add_blocks(J, rows[pair], other[pair], -_twist_rows(frames[pair], points[pair] - coms[other[pair]]), k)
     b = np.einsum("mst,mt->ms", frames, movers) / V
     g = np.concatenate([scene.load(body) / scales.wrench_units(dim) for body in scene.bodies])
     mu = np.array([c.mu for c in scene.contacts]) if scene.friction.kind != "none" else np.zeros(m)

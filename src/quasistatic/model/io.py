@@ -37,6 +37,9 @@ __all__ = [
     "scene_from_file",
     "scene_to_dict",
     "plain_robot",
+    "body_from_file",
+    "mover_from_file",
+    "contact_from_file",
     "stiffness_of",
     "SceneFile",
     "StiffnessFile",
@@ -264,13 +267,23 @@ def scene_from_file(parsed: SceneFile) -> Scene:
         dimension=parsed.dimension,
         gravity=parsed.gravity,
         friction=parsed.friction,
-        bodies=tuple(Body(name, b.mass, _com(name, b), b.wrench) for name, b in parsed.bodies.items()),
-        movers=tuple(Mover(name, m.twist, m.origin, m.robot) if m is not None else Mover(name) for name, m in parsed.movers.items()),
+        bodies=tuple(body_from_file(name, b) for name, b in parsed.bodies.items()),
+        movers=tuple(mover_from_file(name, m) for name, m in parsed.movers.items()),
         robots=tuple(plain_robot(name, r) for name, r in parsed.robots.items()),
-        contacts=tuple(_contact(c, index) for index, c in enumerate(parsed.contacts)),
+        contacts=tuple(contact_from_file(c, index) for index, c in enumerate(parsed.contacts)),
         stiffness=stiffness_of(parsed.stiffness, "stiffness"),
         closing_time=parsed.closing_time,
     )
+
+
+def body_from_file(name: str, body: BodyFile) -> Body:
+    """The Body of a file entry that lists its contacts (its com in the world frame)."""
+    return Body(name, body.mass, _com(name, body), body.wrench)
+
+
+def mover_from_file(name: str, mover: MoverFile | None) -> Mover:
+    """The Mover of a file entry (None: a fixed mover)."""
+    return Mover(name) if mover is None else Mover(name, mover.twist, mover.origin, mover.robot)
 
 
 def plain_robot(name: str, robot: RobotFile) -> Robot:
@@ -378,7 +391,7 @@ def _check_version(data: Mapping[str, Any]) -> None:
         raise SceneError("quasistatic", version, reason)
 
 
-def _contact(entry: ContactFile, index: int) -> Contact:
+def contact_from_file(entry: ContactFile, index: int) -> Contact:
     """A contact of the file; an error in it names the contact by its index."""
     stiffness = stiffness_of(entry.stiffness, f"contacts[{index}].stiffness")
     try:

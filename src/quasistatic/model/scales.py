@@ -65,13 +65,21 @@ def scene_scales(scene: Scene, mover_velocities: FloatArray | None = None) -> Sc
     origin = points.sum(axis=0) / len(points)  # a mean without np.mean's checks (small scenes solve in ~1 ms)
     length = _length(points, origin)
     dim = scene.dimension
-    loads = np.array([scene.load(body) for body in scene.bodies]).reshape(len(scene.bodies), -1)
+    loads = _loads(scene)
     linear, angular = np.sqrt(np.square(loads[:, :dim]).sum(axis=1)), np.sqrt(np.square(loads[:, dim:]).sum(axis=1))
     force = max(float(linear.max(initial=0.0)), float(angular.max(initial=0.0)) / length)
     velocities = mover_point_velocities(scene) if mover_velocities is None else mover_velocities
     velocity = math.sqrt(float(np.square(velocities).sum(axis=1).max(initial=0.0)))
     origin.setflags(write=False)
     return Scales(length=length, force=force or 1.0, velocity=velocity or 1.0, origin=origin)
+
+
+def _loads(scene: Scene) -> FloatArray:
+    """Each body's gravity plus applied wrench, (bodies, k): :meth:`Scene.load` for all at once (a Scene fills every wrench)."""
+    bodies = scene.bodies
+    loads = np.array([b.wrench for b in bodies], dtype=float).reshape(len(bodies), scene.twist_size)
+    loads[:, : scene.dimension] += np.array([b.mass for b in bodies])[:, None] * scene.gravity
+    return loads
 
 
 def _length(points: FloatArray, origin: FloatArray) -> float:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Callable, Collection, Iterable, Mapping
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar, cast
 
@@ -30,6 +30,7 @@ T = TypeVar("T")
 _TOO_LARGE = "larger numbers overflow the solvers' products; choose other units"
 _MU_TOO_LARGE = "beyond the solvers' precision; mu = 1000 already grips like infinite friction"
 _SHOWN_NAMES = 10  # known names listed when a name names nothing
+_SCALAR_CHECK = 32  # arrays of at most this many entries are range-checked in Python, larger ones by numpy
 _FRICTION_TEXT_LENGTH = 40  # longer text is no friction model ("pyramid:" and a thousand digits)
 
 
@@ -44,13 +45,20 @@ def checked_array(value: Any, path: str, ndim: int = 1) -> FloatArray:
         raise SceneError(path, value, f"expected {what}") from None
     if array.ndim != ndim:
         raise SceneError(path, value, f"expected {what}")
-    # One reduction for both checks (NaN and inf fail it too): detection builds a few arrays per contact.
-    if array.size and not float(np.abs(array).max()) <= MAX_MAGNITUDE:
+    if array.size and not _within_magnitude(array):
         if not np.all(np.isfinite(array)):
             raise SceneError(path, value, "every entry must be a finite number (no NaN or inf)")
         raise SceneError(path, value, f"every entry must be at most {MAX_MAGNITUDE:g} in magnitude ({_TOO_LARGE})")
     array.setflags(write=False)
     return array
+
+
+def _within_magnitude(array: FloatArray) -> bool:
+    """Every entry finite and within :data:`MAX_MAGNITUDE` (NaN and inf fail); a few entries (a point, a twist,
+    built several times a contact and a step) compared as Python floats, costing a third of two numpy calls."""
+    if array.size <= _SCALAR_CHECK:
+        return all(-MAX_MAGNITUDE <= x <= MAX_MAGNITUDE for x in array.ravel().tolist())
+    return float(np.abs(array).max()) <= MAX_MAGNITUDE  # one reduction for both checks
 
 
 def checked_number(value: Any, path: str, minimum: float | None = None, maximum: float = MAX_MAGNITUDE, why: str = "") -> float:
@@ -442,6 +450,65 @@ class Scene:
             values[key] = build(self)
         return cast(T, values[key])
 
+    def replaced(
+        self,
+        *,
+        bodies: Mapping[str, Body] | None = None,
+        movers: Mapping[str, Mover] | None = None,
+        contacts: Mapping[int, Contact] | None = None,
+        gravity: npt.ArrayLike | None = None,
+    ) -> Scene:
+        """This scene with some parts replaced by new ones of the same names (contacts by index), gravity too.
+
+        Only the new parts are checked, against this scene as the constructor checks them (the same errors);
+        the rest was checked when this scene was made. For a sweep that changes a few numbers at every point.
+
+        Raises
+        ------
+        SceneError
+            As :class:`Scene` would, for a new part or gravity; or naming a part this scene does not have.
+        """
+        parts = _Parts.of(self)
+        changes: dict[str, Any] = {"_derived": {}}
+        if bodies:
+            changes["bodies"] = _swapped(self.bodies, bodies, Body, "bodies", parts.body)
+        if movers:
+            changes["movers"] = _swapped(self.movers, movers, Mover, "movers", parts.mover)
+        if contacts:
+            unknown = sorted(set(contacts) - set(range(len(self.contacts))))
+            if unknown:
+                raise SceneError("contacts", unknown, f"the scene has {len(self.contacts)} contacts")
+            changes["contacts"] = tuple(
+                parts.contact(contacts[i], f"contacts[{i}]") if i in contacts else c for i, c in enumerate(self.contacts)
+            )
+        if gravity is not None:
+            changes["gravity"] = _sized(checked_array(gravity, "gravity"), self.dimension, "gravity")
+        return _checked_copy(self, **changes)
+
+    def moved(
+        self,
+        coms: Sequence[npt.ArrayLike],
+        mover_places: Sequence[tuple[npt.ArrayLike | None, npt.ArrayLike | None]],
+        contacts: Sequence[Contact],
+    ) -> Scene | None:
+        """This scene at another instant: new centres of mass (one per body), mover ``(twist, origin)`` pairs (one
+        per mover) and contacts, or None when the contacts' pairs differ from this scene's (then make a Scene).
+
+        Each new number is checked as the constructor checks it (the same errors); what an instant does not change
+        (names, masses, wrenches, gravity, friction, which pairs touch) was checked when this scene was made. For a
+        simulation step, whose bodies move but whose structure mostly stays; scenes with robots are not restated.
+        """
+        if self.robots or [(c.body, c.other) for c in contacts] != [(c.body, c.other) for c in self.contacts]:
+            return None
+        parts, d = _Parts.of(self), self.dimension
+        bodies = tuple(
+            _checked_copy(body, com=_sized(checked_array(com, f"bodies.{body.name}.com"), d, f"bodies.{body.name}.com"))
+            for body, com in zip(self.bodies, coms, strict=True)
+        )
+        movers = tuple(parts.mover_numbers(mover, twist, origin) for mover, (twist, origin) in zip(self.movers, mover_places, strict=True))
+        checked = tuple(parts.contact_numbers(_contact_of(contact), f"contacts[{i}]") for i, contact in enumerate(contacts))
+        return _checked_copy(self, bodies=bodies, movers=movers, contacts=checked, _derived={})
+
     def body_index(self, name: str) -> int:
         """Index of a free body by name."""
         return [b.name for b in self.bodies].index(name)
@@ -503,8 +570,36 @@ def _sized(vector: FloatArray, length: int, path: str) -> FloatArray:
     return vector
 
 
+def _contact_of(contact: Any) -> Contact:
+    if not isinstance(contact, Contact):
+        raise SceneError("contacts", type(contact).__name__, "expected a Contact")
+    return contact
+
+
+def _swapped(kept: tuple[T, ...], new: Mapping[str, Any], kind: type, path: str, check: Callable[[Any], T]) -> tuple[T, ...]:
+    """``kept`` with the parts named in ``new`` replaced, each checked; a new part keeps its name."""
+    names = [cast(Any, part).name for part in kept]
+    for name, part in new.items():
+        if name not in names:
+            raise SceneError(f"{path}.{name}", name, _unknown(kind.__name__.lower(), name, names))
+        if not isinstance(part, kind) or getattr(part, "name", None) != name:
+            raise SceneError(f"{path}.{name}", type(part).__name__, f"expected a {kind.__name__} named {name!r}")
+    return tuple(check(new[name]) if name in new else part for name, part in zip(names, kept, strict=True))
+
+
 class _Parts:
     """The scene's bodies, movers and robots checked together, with their defaults filled in (new objects)."""
+
+    @classmethod
+    def of(cls, scene: Scene) -> _Parts:
+        """The context of an already checked scene, to check new parts against it (nothing is checked again)."""
+        parts = cls.__new__(cls)
+        parts.dimension, parts.stiffness, parts.twist_size = scene.dimension, scene.stiffness, scene.twist_size
+        parts.robots, parts.bodies, parts.movers = scene.robots, scene.bodies, scene.movers
+        parts.robot_joints = {r.name: r.joint_velocities.size for r in scene.robots}
+        parts.body_names = {b.name for b in scene.bodies}
+        parts.mover_robot = {m.name: m.robot for m in scene.movers}
+        return parts
 
     def __init__(
         self, dimension: int, bodies: tuple[Body, ...], movers: tuple[Mover, ...], robots: tuple[Robot, ...], stiffness: Stiffness | None
@@ -520,12 +615,12 @@ class _Parts:
         _check_unique_names(bodies, movers, robots)
         self.robots = robots
         self.robot_joints = {r.name: r.joint_velocities.size for r in robots}
-        self.bodies = tuple(self._body(b) for b in bodies)
-        self.movers = tuple(self._mover(m) for m in movers)
+        self.bodies = tuple(self.body(b) for b in bodies)
+        self.movers = tuple(self.mover(m) for m in movers)
         self.body_names = {b.name for b in bodies}
         self.mover_robot = {m.name: m.robot for m in movers}
 
-    def _body(self, body: Body) -> Body:
+    def body(self, body: Body) -> Body:
         path = f"bodies.{body.name}"
         wrench = np.zeros(self.twist_size) if body.wrench is None else body.wrench
         return _checked_copy(
@@ -534,7 +629,7 @@ class _Parts:
             wrench=_sized(checked_array(wrench, path), self.twist_size, f"{path}.wrench"),
         )
 
-    def _mover(self, mover: Mover) -> Mover:
+    def mover(self, mover: Mover) -> Mover:
         path = f"movers.{mover.name}"
         if mover.robot is not None:
             if mover.twist is not None:
@@ -551,10 +646,23 @@ class _Parts:
             origin=_sized(checked_array(origin, path), self.dimension, f"{path}.origin"),
         )
 
+    def mover_numbers(self, mover: Mover, twist: npt.ArrayLike | None, origin: npt.ArrayLike | None) -> Mover:
+        """A checked rigid mover with a new twist and origin, each checked once as ``Mover`` and :meth:`mover` would."""
+        path = f"movers.{mover.name}"
+        twist = checked_array(np.zeros(self.twist_size) if twist is None else twist, f"{path}.twist")
+        origin = checked_array(np.zeros(self.dimension) if origin is None else origin, f"{path}.origin")
+        return _checked_copy(
+            mover, twist=_sized(twist, self.twist_size, f"{path}.twist"), origin=_sized(origin, self.dimension, f"{path}.origin")
+        )
+
     def contact(self, contact: Contact, path: str) -> Contact:
         if not isinstance(contact, Contact):
             raise SceneError(path, type(contact).__name__, "expected a Contact")
         self._check_pair(contact, path)
+        return self.contact_numbers(contact, path)
+
+    def contact_numbers(self, contact: Contact, path: str) -> Contact:
+        """A contact whose pair is known to be valid here: its point, unit normal, jacobian and stiffness checked."""
         point = _sized(contact.point, self.dimension, f"{path}.point")
         normal = _sized(contact.normal, self.dimension, f"{path}.normal")
         length = float(np.linalg.norm(normal))

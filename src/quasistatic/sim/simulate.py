@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +20,12 @@ from .state import InputSource, InputTable, State, inputs_at
 from .step import AmbiguityPolicy, Evaluation, Event, SimModel, StepOptions, StepResult, advance, evaluate, moving, safe_step
 from .trajectory import RunStatus, Trajectory
 
-__all__ = ["simulate", "Signature", "signature", "events_between"]
+__all__ = ["simulate", "Signature", "signature", "events_between", "UNDECIDED_MESSAGES"]
+
+UNDECIDED_MESSAGES = 1000
+"""Most recorded steps whose message (its claim about the forces) is left to be worked out when read: each keeps
+its solve's Problem until then (about 10 KiB on the planar push), so an older step's message is worked out as the
+run goes on, and a run of any length holds at most this many."""
 
 Signature = tuple[str, tuple[tuple[tuple[str, str], tuple[str, ...]], ...]]
 """What an event changes: the status, and per touching pair the set of its contacts' modes."""
@@ -79,13 +83,15 @@ def simulate(
         h = _step_length(current, dt, duration, inputs)
         taken, following, located = _located(model, inputs, current, h, tolerance)
         states.append(current.state)
-        steps.append(replace(StepResult.of(current, taken), events=pending))
+        steps.append(StepResult.of(current, taken, pending))
+        if len(steps) > UNDECIDED_MESSAGES:
+            _ = steps[-UNDECIDED_MESSAGES - 1].message  # worked out now, so its Problem is let go
         pending = located
         current = following
         if progress is not None:
             progress(current.state.time, duration)
     states.append(current.state)
-    steps.append(replace(StepResult.of(current, 0.0), events=pending))
+    steps.append(StepResult.of(current, 0.0, pending))
     status, message = _ending(current, duration, len(steps) > max_steps)
     scene_file = str(Path(scene).resolve()) if isinstance(scene, str | Path) else ""
     return Trajectory(tuple(states), tuple(steps), status, message, scene_file)

@@ -21,7 +21,7 @@ import numpy.typing as npt
 from ..adapters import AnyWorld, Detection
 from ..errors import SceneError, SolverError
 from ..model import Contact, Scene
-from ..solution import Mode, Motion, Solution, Status
+from ..solution import LaterField, Mode, Motion, Solution, Status
 from ..solve import solve
 from ..tolerances import SIM_APPROACH, SIM_LOOKAHEAD, SIM_PENETRATION, SIM_POWER_TIE
 from .rigid import advance_pose, point_velocity
@@ -159,21 +159,25 @@ class Evaluation:
 
 @dataclass(frozen=True)
 class StepResult:
-    """What happened at one state of a run, and the step taken from it (``dt`` is 0 for the last state)."""
+    """What happened at one state of a run, and the step taken from it (``dt`` is 0 for the last state).
+
+    ``message`` is the step's Solution's own message, worked out when first read (its claim about the forces
+    costs more than the rest of a small step's bookkeeping): saving, printing, comparing or pickling reads it.
+    """
 
     time: float
     dt: float
     status: Status
     certified: bool
-    message: str
-    twists: Mapping[str, FloatArray]
-    contacts: tuple[ContactRecord, ...]
+    message: LaterField[str] = LaterField(required=True)  # no default: reading it from the class raises AttributeError
+    twists: Mapping[str, FloatArray]  # type: ignore[misc]  # mypy takes any descriptor for a default; the message has none
+    contacts: tuple[ContactRecord, ...]  # type: ignore[misc]
     choice: str = ""
     penetration: float = 0.0
     events: tuple[Event, ...] = ()
 
     @classmethod
-    def of(cls, evaluation: Evaluation, dt: float) -> StepResult:
+    def of(cls, evaluation: Evaluation, dt: float, events: tuple[Event, ...] = ()) -> StepResult:
         twists = {b.name: evaluation.twist(b.name) for b in evaluation.world.bodies}
         solution = evaluation.solution
         return cls(
@@ -181,11 +185,12 @@ class StepResult:
             dt,
             solution.status,
             solution.certified,
-            solution.message,
+            solution.kept_message(),
             twists,
             evaluation.contact_records(),
             evaluation.choice,
             evaluation.penetration,
+            events,
         )
 
 
@@ -361,7 +366,7 @@ def _reclosed(evaluation: Evaluation, state: State) -> State:
 def _was_closed(before: list[tuple[Contact, Mode]], contact: Contact, band: float) -> bool:
     """The contact of the same pair nearest to ``contact`` before the step lies within ``band`` and was rolling or sliding."""
     pair = (contact.body, contact.other)
-    same_pair = [(float(np.linalg.norm(c.point - contact.point)), mode) for c, mode in before if (c.body, c.other) == pair]
+    same_pair = [(math.dist(c.point, contact.point), mode) for c, mode in before if (c.body, c.other) == pair]
     if not same_pair:
         return False
     distance, mode = min(same_pair, key=lambda entry: entry[0])

@@ -12,17 +12,14 @@ import time
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import ExitStack
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
-from ..adapters import world_from_file
 from ..errors import BackendUnavailableError, QuasistaticError
-from ..model import Scene
-from ..model.io import read_scene_file, scene_from_file
 from ..solution import Solution
 from ..solve import solve
-from .params import SweepParam, apply_values
+from .params import SweepParam
 from .result import SWEEPS_INSTALL_HINT, SweepPoint, point_from_solution
+from .scenes import PointScenes, scene_at
 
 __all__ = ["Chunk", "Executor", "executor_for", "scene_at", "solve_chunk"]
 
@@ -57,20 +54,15 @@ class Chunk:
     options: Mapping[str, Any]
 
 
-def scene_at(data: Mapping[str, Any], folder: str | Path, params: Sequence[SweepParam], values: Sequence[float]) -> Scene:
-    """The Scene with each parameter set to its value (contacts found when the file describes shapes)."""
-    parsed, _ = read_scene_file(apply_values(data, params, values))
-    return world_from_file(parsed, Path(folder)).scene() if parsed.is_geometric else scene_from_file(parsed)
-
-
 def solve_chunk(chunk: Chunk) -> tuple[str, list[SweepPoint]]:
     """Solve every point of a chunk (audited, as :func:`quasistatic.solve` does); a point whose scene or solve
     fails is recorded as ``failed`` with the reason, so one bad corner does not lose the sweep."""
     points = []
+    scenes = PointScenes(chunk.data, chunk.folder, chunk.params)  # the file validated once per chunk
     for index, values, refinement in chunk.points:
         start = time.perf_counter()
         try:
-            solution = solve(scene_at(chunk.data, chunk.folder, chunk.params, values), **chunk.options)
+            solution = solve(scenes.at(values), **chunk.options)
         except QuasistaticError as exc:  # SceneError and SolverError included
             method = str(chunk.options.get("method", "auto"))
             solution = Solution("failed", f"not solved at this point: {exc}", method, "", seconds=time.perf_counter() - start)

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import SceneError
 
-__all__ = ["Step", "SweepParam", "apply_values", "parse_param_spec", "parse_path", "sweep_params"]
+__all__ = ["Step", "SweepParam", "apply_values", "resolved_path", "set_values", "parse_param_spec", "parse_path", "sweep_params"]
 
 Step = str | int
 """One step of a path: a mapping key or a list index."""
@@ -96,12 +96,33 @@ def sweep_params(data: Mapping[str, Any], params: Mapping[str, Any]) -> tuple[Sw
 
 def apply_values(data: Mapping[str, Any], params: Sequence[SweepParam], values: Sequence[float]) -> dict[str, Any]:
     """A deep copy of the scene file's data with each parameter's paths set to its value."""
-    out = copy.deepcopy(dict(data))
+    return set_values(copy.deepcopy(dict(data)), params, values)
+
+
+def resolved_path(data: Mapping[str, Any], path: tuple[Step, ...], name: str) -> tuple[Step, ...]:
+    """``path`` with a joint's name turned into its index: the keys and indices that reach the number in ``data``.
+
+    Raises
+    ------
+    SceneError
+        As :func:`sweep_params` does, when the path does not lead into ``data``.
+    """
+    node: Any = data
+    steps: list[Step] = []
+    for depth, step in enumerate(path):
+        steps.append(_resolved(node, step, path[:depth], data, name))
+        if depth < len(path) - 1:
+            node = node[steps[-1]]
+    return tuple(steps)
+
+
+def set_values(data: dict[str, Any], params: Sequence[SweepParam], values: Sequence[float]) -> dict[str, Any]:
+    """``data`` itself with each parameter's paths set to its value (the caller copied what the paths reach)."""
     for param, value in zip(params, values, strict=True):
         for path in param.paths:
-            container, step = _parent(out, path, param.name)
+            container, step = _parent(data, path, param.name)
             container[step] = float(value)
-    return out
+    return data
 
 
 def parse_param_spec(text: str) -> tuple[str, np.ndarray]:
@@ -166,21 +187,26 @@ def _parent(data: Any, path: tuple[Step, ...], name: str) -> tuple[Any, Step]:
 
 def _resolved(node: Any, step: Step, before: tuple[Step, ...], data: Any, name: str) -> Step:
     """The step into ``node``; an error names the whole parameter (``name``) and the step that fails."""
-    where = _shown(before) or "the scene"
     if isinstance(node, Mapping):
         if isinstance(step, int):
-            raise SceneError(name, step, f"{where} is a mapping (keys: {', '.join(map(str, node))}), not a list")
+            raise SceneError(name, step, f"{_where(before)} is a mapping (keys: {', '.join(map(str, node))}), not a list")
         if step not in node and not _optional_leaf(before):
             known = ", ".join(map(str, node)) or "none"
-            raise SceneError(name, step, f"{where} has no key {step!r} (keys: {known})")
+            raise SceneError(name, step, f"{_where(before)} has no key {step!r} (keys: {known})")
         return step
     if isinstance(node, list):
         if isinstance(step, str):
             return _joint_index(node, step, before, data, name)
         if step >= len(node):
-            raise SceneError(name, step, f"{where} has {len(node)} entries; the index must be below {len(node)}")
+            raise SceneError(name, step, f"{_where(before)} has {len(node)} entries; the index must be below {len(node)}")
         return step
-    raise SceneError(name, node, f"{where} is empty in the scene: write its full value in the file first, then sweep an entry")
+    reason = "is empty in the scene: write its full value in the file first, then sweep an entry"
+    raise SceneError(name, node, f"{_where(before)} {reason}")
+
+
+def _where(before: tuple[Step, ...]) -> str:
+    """The path walked so far, for an error (made only then: every sweep point walks its paths)."""
+    return _shown(before) or "the scene"
 
 
 def _optional_leaf(before: tuple[Step, ...]) -> bool:

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from ..errors import BackendUnavailableError
-from ..solution import Solution, Status
+from ..solution import LaterField, Solution, Status
 from .params import SweepParam
 
 if TYPE_CHECKING:
@@ -41,7 +41,8 @@ class SweepPoint:
     certified : bool
         The verdict is proven (``Solution.certified``); false marks it unproven.
     message : str
-        The solution's message (or why the point could not be solved).
+        The solution's message (or why the point could not be solved); its claim about the forces is worked out
+        when first read (the table, pickling, ``==``), so a sweep that reads only statuses does not pay for it.
     motions : int
         Motions found: 1 for ``solved``, the listed ones for ``ambiguous``, 0 otherwise.
     twists : tuple of (str, tuple of float)
@@ -59,7 +60,7 @@ class SweepPoint:
     refinement: bool
     status: Status
     certified: bool
-    message: str
+    message: LaterField[str] = LaterField(required=True)  # no default: reading it from the class raises AttributeError
     motions: int = 0
     twists: tuple[tuple[str, tuple[float, ...]], ...] = ()
     forces: tuple[tuple[float, ...], ...] = ()
@@ -82,7 +83,7 @@ def point_from_solution(index: int, values: Sequence[float], refinement: bool, s
         refinement=refinement,
         status=solution.status,
         certified=solution.certified,
-        message=solution.message,
+        message=solution.kept_message(),  # its claim about the forces worked out when read (the table, a pickle, ==)
         motions=motions,
         twists=tuple((name, _floats(t)) for name, t in solution.twists.items()),
         forces=_point_forces(solution),

@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
+from collections import deque
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -14,16 +15,21 @@ from ..errors import SceneError
 from ..model import Scene
 from ..model.io import read_scene_data, read_scene_file, scene_to_dict
 from ..solvers import get_backend
-from .backends import Chunk, Executor, executor_for, scene_at
+from .backends import Chunk, Executor, executor_for
 from .params import SweepParam, sweep_params
 from .refine import boundary_intervals, narrowed
 from .result import PhaseKind, SweepPoint, SweepResult
+from .scenes import PointScenes
 from .store import ChunkStore, sweep_key
 
-__all__ = ["Progress", "sweep"]
+__all__ = ["Progress", "sweep", "UNDECIDED_MESSAGES"]
 
 Progress = Callable[[int, int], None]
 """Called after each finished chunk with (points done, points planned so far)."""
+
+UNDECIDED_MESSAGES = 4096
+"""Most points whose message (its claim about the forces) waits to be worked out when read: each keeps its solve's
+Problem until then (about 10 KiB on a small 2-D scene), so older points' messages are worked out as the sweep goes on."""
 
 
 def sweep(
@@ -136,6 +142,7 @@ class _Run:
         self.data, self.folder, self.axes, self.options = data, folder, axes, options
         self.store, self.progress = store, progress
         self.done = self.planned = self.reused = 0
+        self.undecided: deque[SweepPoint] = deque()
 
     def solve(self, executor: Executor, stage: str, tasks: Sequence[tuple[int, tuple[float, ...], bool]], size: int) -> list[SweepPoint]:
         """The points of ``tasks``, in order: stored chunks read back, the others solved and stored."""
@@ -162,8 +169,15 @@ class _Run:
         for name, points in executor.run(todo):
             if self.store is not None:
                 self.store.save(name, points)
+            self._hold(points)
             self._count(len(points))
             yield name, points
+
+    def _hold(self, points: list[SweepPoint]) -> None:
+        """Keep at most :data:`UNDECIDED_MESSAGES` points' messages waiting (a worker's points come decided)."""
+        self.undecided.extend(points)
+        while len(self.undecided) > UNDECIDED_MESSAGES:
+            _ = self.undecided.popleft().message  # worked out now, so its Problem is let go
 
     def _count(self, points: int) -> None:
         self.done += points
@@ -199,11 +213,12 @@ def _check_options(method: str, chunk_size: int | None, refine: int, phase: str,
 def _check_values(data: Mapping[str, Any], folder: str, axes: tuple[SweepParam, ...]) -> None:
     """Every value of every parameter, set alone on the scene, gives a valid scene; else the error names the path."""
     base = [float(p.values[0]) for p in axes]
+    scenes = PointScenes(data, folder, axes)
     for position, param in enumerate(axes):
         for value in dict.fromkeys(param.values.tolist()):
             values = [*base[:position], value, *base[position + 1 :]]
             try:
-                scene_at(data, folder, axes, values)
+                scenes.at(values)
             except SceneError as exc:
                 raise SceneError(param.name, value, f"the scene rejects this value ({exc.field}: {exc.reason})") from None
 

@@ -87,10 +87,12 @@ def _form_point(form: LCPForm, z: np.ndarray, frictional: np.ndarray) -> np.ndar
     lam = np.zeros(m)
     lam[frictional] = z[2 * n + m + f * K :]
     # A frictionless contact's slip speed is free of its force (beta = 0): the least one its edges accept.
-    slip_along = (form.W[m : m + m * K, :n] @ q - form.r[m : m + m * K]).reshape(m, K)
-    frictionless = np.setdiff1d(np.arange(m), frictional)
-    lam[frictionless] = np.maximum(0.0, np.max(-slip_along[frictionless], axis=1, initial=0.0))
-    return np.r_[q, z[2 * n : 2 * n + m], beta.ravel(), lam]
+    frictionless = np.ones(m, dtype=bool)
+    frictionless[frictional] = False
+    if frictionless.any():  # (a mask, not np.setdiff1d, and no np.r_: each costs more than the arithmetic here)
+        slip_along = (form.W[m : m + m * K, :n] @ q - form.r[m : m + m * K]).reshape(m, K)
+        lam[frictionless] = np.maximum(0.0, np.max(-slip_along[frictionless], axis=1, initial=0.0))
+    return np.concatenate([q, z[2 * n : 2 * n + m], beta.ravel(), lam])
 
 
 def satisfies_form(form: LCPForm, x: np.ndarray) -> bool:
@@ -112,9 +114,10 @@ def kinematically_unique(problem: Problem, q: np.ndarray) -> bool:
     gap = problem.Jn @ q - problem.bn
     closed = np.abs(gap) <= MODE_SPEED
     A, t = problem.Jn[closed], -gap[closed]
-    exact = kinematic_radius(A, t)
-    loose = kinematic_radius(A, np.abs(t) + LP_FEASIBILITY)
-    return exact <= 0.5 * SAME_TWIST and loose <= DISTINCT_TWIST
+    bound = _GordanBound.of(A)  # one SVD serves both radii
+    if bound is None:
+        return False
+    return bound.radius(t) <= 0.5 * SAME_TWIST and bound.radius(np.abs(t) + LP_FEASIBILITY) <= DISTINCT_TWIST
 
 
 def kinematic_radius(A: np.ndarray, t: np.ndarray) -> float:
@@ -122,22 +125,40 @@ def kinematic_radius(A: np.ndarray, t: np.ndarray) -> float:
 
     ``A`` (k, n): rows of the normal Jacobian; ``t`` (k,): small right-hand sides.
     """
-    k, n = A.shape
-    if k <= n:  # a pointed cone needs more rows than unknowns
-        return np.inf
-    u, sigma, _ = np.linalg.svd(A, full_matrices=True)
-    s = float(sigma[-1])
-    if s <= MOTION_RANK:
-        return np.inf
-    null = u[:, n:]  # left null space of A: every y with A^T y = 0
-    y = null @ (null.T @ np.ones(k))  # the all-ones vector's part in it; Gordan multipliers when positive
-    top = float(np.max(y, initial=0.0))
-    if top <= 0.0 or float(np.min(y)) <= MOTION_RANK * top:
-        return np.inf
-    y = y / top
-    inverse = float(np.linalg.norm(1.0 / y))
-    e = float(np.linalg.norm(A.T @ y))
-    bracket = 1.0 - e * inverse / s
-    if bracket < 0.5:  # the multipliers are too far from A^T y = 0 to bound anything
-        return np.inf
-    return float((abs(float(y @ t)) * inverse + float(np.linalg.norm(t))) / (s * bracket))
+    bound = _GordanBound.of(A)
+    return np.inf if bound is None else bound.radius(t)
+
+
+class _GordanBound:
+    """What the bound reads of ``A`` alone: its smallest singular value ``s``, the multipliers ``y`` (largest 1),
+    ``|1/y|`` and the bracket ``1 - |A^T y| |1/y| / s``; :meth:`radius` adds the right-hand sides."""
+
+    def __init__(self, s: float, y: np.ndarray, inverse: float, bracket: float) -> None:
+        self.s, self.y, self.inverse, self.bracket = s, y, inverse, bracket
+
+    @classmethod
+    def of(cls, A: np.ndarray) -> _GordanBound | None:
+        """None when ``A`` bounds nothing (too few rows, rank deficient, no positive multipliers, too far from ``A^T y = 0``)."""
+        k, n = A.shape
+        if k <= n:  # a pointed cone needs more rows than unknowns
+            return None
+        u, sigma, _ = np.linalg.svd(A, full_matrices=True)
+        s = float(sigma[-1])
+        if s <= MOTION_RANK:
+            return None
+        null = u[:, n:]  # left null space of A: every y with A^T y = 0
+        y = null @ (null.T @ np.ones(k))  # the all-ones vector's part in it; Gordan multipliers when positive
+        top = float(np.max(y, initial=0.0))
+        if top <= 0.0 or float(np.min(y)) <= MOTION_RANK * top:
+            return None
+        y = y / top
+        inverse = float(np.linalg.norm(1.0 / y))
+        e = float(np.linalg.norm(A.T @ y))
+        bracket = 1.0 - e * inverse / s
+        if bracket < 0.5:  # the multipliers are too far from A^T y = 0 to bound anything
+            return None
+        return cls(s, y, inverse, bracket)
+
+    def radius(self, t: np.ndarray) -> float:
+        """The bound on ``|d|`` for right-hand sides ``t``."""
+        return float((abs(float(self.y @ t)) * self.inverse + float(np.linalg.norm(t))) / (self.s * self.bracket))
