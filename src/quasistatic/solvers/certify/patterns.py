@@ -132,6 +132,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import Any
 
 import numpy as np
 from scipy.optimize import nnls
@@ -256,6 +257,26 @@ class _Rows:
     survivor: _Node | None = None  # the sector relaxation's leaf whose twists and forces were not excluded
     survivor_twist: np.ndarray | None = None  # a twist of it (None: its LP did not answer)
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
+
+    @classmethod
+    def of(cls, layout: _Layout, g: np.ndarray, width: int, budget: int, **search: Any) -> _Rows:
+        """The rows of ``layout`` under the load ``g``, ``width`` load columns per contact, with what follows from
+        them (row norms, an empty Farkas store, each contact's outside columns); ``search``: the other fields."""
+        n_loads = layout.loads.shape[1]
+        every, block = (1 << n_loads) - 1, (1 << width) - 1
+        return cls(
+            layout.bank,
+            layout.rhs,
+            np.linalg.norm(layout.bank, axis=1),
+            layout.loads,
+            g,
+            levels=layout.levels,
+            budget=budget,
+            farkas=_FarkasVectors(layout.loads, g, math.sqrt(g.size) * LP_FEASIBILITY),
+            outside=[every & ~(block << (width * i)) for i in range(len(layout.roots))],
+            width=width,
+            **search,
+        )
 
     @property
     def lcp(self) -> LCPForm:
@@ -456,23 +477,9 @@ def relaxation_excluded(problem: Problem, sectors: list[np.ndarray], remaining: 
     """
     layout, sector_of = _sector_layout(problem, sectors)
     width = layout.loads.shape[1] // problem.n_contacts
-    rows = _Rows(
-        layout.bank,
-        layout.rhs,
-        np.linalg.norm(layout.bank, axis=1),
-        layout.loads,
-        problem.g,
-        None,
-        None,
-        layout.levels,
-        PYRAMID_PATTERN_NODES,
-        _FarkasVectors(layout.loads, problem.g, math.sqrt(problem.g.size) * LP_FEASIBILITY),
-        remaining=remaining,
-        width=width,
-    )
+    rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=None, form=None, remaining=remaining)
     m = problem.n_contacts
-    every, block = (1 << layout.loads.shape[1]) - 1, (1 << width) - 1
-    rows.outside = [every & ~(block << (width * i)) for i in range(m)]
+    every = (1 << layout.loads.shape[1]) - 1
     root_columns = functools.reduce(lambda bits, mode: bits & ~mode.removes, layout.roots, every)  # no padding
     root = _Node(0, (1 << m) - 1, root_columns, layout.roots, 0)
     fit = _fitted_forces(rows, root.columns)
@@ -599,26 +606,11 @@ def prove_by_patterns(
     layout = _planar_layout(problem, order) if planar else _pyramid_layout(form, [order])
     roots = layout.roots if planar or seed_x is None else _seed_modes_first(layout, form, seed_x)
     seed = None if seed_x is None else seed_x[:n_q]
-    rows = _Rows(
-        layout.bank,
-        layout.rhs,
-        np.linalg.norm(layout.bank, axis=1),
-        layout.loads,
-        problem.g,
-        seed,
-        form,
-        layout.levels,
-        PATTERN_NODES if planar else PYRAMID_PATTERN_NODES,
-        _FarkasVectors(layout.loads, problem.g, math.sqrt(problem.g.size) * LP_FEASIBILITY),
-        max_motions=max_motions,
-        remaining=remaining,
-        reuse=reuse,
-        width=2 if planar else form.n_edges,
-    )
+    budget = PATTERN_NODES if planar else PYRAMID_PATTERN_NODES
+    width = 2 if planar else form.n_edges
+    rows = _Rows.of(layout, problem.g, width, budget, seed=seed, form=form, max_motions=max_motions, remaining=remaining, reuse=reuse)
     rows.proof.seed = seed_x
     m = problem.n_contacts
-    every, block = (1 << layout.loads.shape[1]) - 1, (1 << rows.width) - 1
-    rows.outside = [every & ~(block << (rows.width * i)) for i in range(m)]
     root = _Node(0, (1 << m) - 1, (1 << layout.loads.shape[1]) - 1, roots, 0)
     fit = _fitted_forces(rows, root.columns)
     rows.proof.equilibrium = False if fit is None else _balances(rows, fit.forces)
