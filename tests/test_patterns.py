@@ -20,7 +20,7 @@ import pytest
 
 import quasistatic as qs
 import quasistatic.solvers.certified as certified_door
-from hulls import near_hull
+from hulls import covered
 from quasistatic.laws import RawMotion
 from quasistatic.laws.polyhedral import aligned_edges, polyhedral_form
 from quasistatic.solvers.certify.arrangement import VertexProof, VertexVerdict
@@ -118,7 +118,7 @@ class _Listed:
 
     q: np.ndarray
     extremes: tuple[np.ndarray, ...]
-    free: bool
+    unbounded: bool
 
     @classmethod
     def of_raw(cls, raw: RawMotion) -> _Listed:
@@ -132,31 +132,15 @@ class _Listed:
 
     @property
     def continuum(self) -> bool:
-        return bool(self.extremes) or self.free
-
-
-def _covered(motion: _Listed, others: list[_Listed], tol: float) -> bool:
-    """A twist: one of ``others`` has it, or a continuum holds it; a continuum: one of ``others`` with its extremes."""
-    if not motion.continuum:
-        return any(
-            np.max(np.abs(o.q - motion.q)) <= tol if not o.continuum else bool(o.extremes) and near_hull(motion.q, o.extremes, tol)
-            for o in others
-        )
-    return any(
-        o.continuum
-        and o.free == motion.free
-        and len(o.extremes) == len(motion.extremes)
-        and all(any(np.max(np.abs(e - f)) <= tol for f in o.extremes) for e in motion.extremes)
-        for o in others
-    )
+        return bool(self.extremes) or self.unbounded
 
 
 def _same_motion_sets(problem: qs.Problem, mine: list[_Listed], scip: list[_Listed]) -> None:
     """The branch and bound's list equals SCIP's as sets: each motion of one is in the other, within DISTINCT_TWIST."""
     scale = max([1.0] + [float(np.max(np.abs(m.q))) for m in mine + scip])
     tol = DISTINCT_TWIST * scale
-    assert all(_covered(m, scip, tol) for m in mine), "patterns lists a motion scip does not"
-    assert all(_covered(m, mine, tol) for m in scip), "scip lists a motion patterns does not"
+    assert all(covered(m, scip, tol) for m in mine), "patterns lists a motion scip does not"
+    assert all(covered(m, mine, tol) for m in scip), "scip lists a motion patterns does not"
 
 
 @pytest.mark.parametrize("chunk", range(8))
