@@ -44,7 +44,7 @@ from ...adapters import (
 )
 from ...errors import SceneError
 from ...laws import assemble
-from ...sim import Inputs, SimModel, State, StepOptions, advance, evaluate
+from ...sim import Evaluation, Inputs, SimModel, State, StepOptions, advance, evaluate
 from ...solve import Reuse, solve
 from .pipeline import PipelineRow, allegro_grasp
 
@@ -118,7 +118,7 @@ def _row(case: str, world: AnyWorld, steps: int, policy: str) -> PipelineRow:
         state = advance(evaluation, PUSH_STEP)
         times.append(time.perf_counter() - start)
         cpu.append(time.process_time() - start_cpu)
-        parts.append(_split(evaluation.world, memory))
+        parts.append(_split(evaluation, memory))
     reused = model.reuse.hits - reused if model.reuse is not None else 0
     if not times:
         return PipelineRow(case, skipped=f"no step taken: {evaluation.solution.status}")
@@ -138,16 +138,19 @@ def _row(case: str, world: AnyWorld, steps: int, policy: str) -> PipelineRow:
     )  # fmt: skip
 
 
-def _split(world: AnyWorld, memory: Reuse | None) -> tuple[float, float, float]:
-    """One step's detection, assembly (the Scene and its Problem) and solve, timed apart on the same state.
+def _split(evaluation: Evaluation, memory: Reuse | None) -> tuple[float, float, float]:
+    """One step's detection, assembly (the Scene and its Problem) and solve, timed apart on the step's own state.
 
-    The solve is given the assembled Problem, so its time does not count the assembly a second time, and the
-    run's memory of its last certified answer as the step found it (``memory``, a copy), so it reuses when the step did.
+    Detection is timed on the step's World (the look-ahead band); the Scene is the step's own (the contacts it
+    touched), as is the solve, given the assembled Problem (so its time does not count the assembly a second time)
+    and the run's memory of its last certified answer as the step found it (``memory``, a copy), so it reuses
+    exactly when the step did.
     """
+    world = evaluation.world
     start = time.perf_counter()
-    detection = world.detect()
+    world.detect()
     detected = time.perf_counter()
-    problem = assemble(world.scene(detection))
+    problem = assemble(world.scene(evaluation.detection))
     assembled = time.perf_counter()
     solve(problem, reuse=memory)
     return detected - start, assembled - detected, time.perf_counter() - assembled
