@@ -25,14 +25,21 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "sim"
 
 @pytest.mark.parametrize(
     ("scene", "duration", "dt"),
-    [(EXAMPLES / "push_planar.yaml", 5.0, 0.05), (EXAMPLES / "tip_box_planar.yaml", 10.0, 0.25)],
+    [
+        (EXAMPLES / "push_planar.yaml", 5.0, 0.05),
+        (EXAMPLES / "tip_box_planar.yaml", 10.0, 0.25),
+        pytest.param(EXAMPLES / "push_box.yaml", 0.5, 0.5, marks=pytest.mark.slow),
+    ],
 )
 def test_a_run_with_reuse_is_the_run_without_it_saved_byte_for_byte(scene: Path, duration: float, dt: float, tmp_path: Path) -> None:
-    """The push translates (most steps reuse); the tipping box turns, so its laws change every step (none do)."""
-    runs = [qs.simulate(scene, duration=duration, dt=dt, reuse=reuse) for reuse in (False, True)]
+    """The planar push translates (most steps reuse); the tipping box turns, so its laws change every step (none do);
+    the 3-D push is ambiguous at every step, so the least-power motion is taken from a reused list of motions."""
+    if scene.name == "push_box.yaml":
+        pytest.importorskip("coal")
+    runs = [qs.simulate(scene, duration=duration, dt=dt, ambiguous="min_power", reuse=reuse) for reuse in (False, True)]
     files = [run.save(tmp_path / f"run_{i}.jsonl").read_text(encoding="utf-8") for i, run in enumerate(runs)]
     assert files[0] == files[1]
-    assert runs[1].status == runs[0].status and runs[1].certified and len(runs[1].steps) > 3
+    assert runs[1].status == runs[0].status and runs[1].certified and len(runs[1].steps) >= 2
 
 
 def test_the_planar_push_reuses_most_steps_and_each_is_the_fresh_answer() -> None:
