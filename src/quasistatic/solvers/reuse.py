@@ -1,10 +1,10 @@
 """The last certified answer, taken again for laws equal to its own bit for bit (a simulation's next step).
 
 A backend's answer is a function of the scene-relative laws alone (``J``, ``b``, ``g``, ``mu``, the friction
-model, the contact frames, which bodies and contacts they belong to) and of the options that shape a search. When a step's laws
-are the previous step's to the last bit, as they are while a pushed body translates (the scene-relative
-origin moves with the contacts), the proof that certified the previous answer proves this one: :class:`Reuse`
-hands that answer back instead of proving it again. Only certified answers whose list of motions is complete
+model, the contact frames, the scales, which bodies and contacts they belong to) and of the options that shape a
+search. When a step's laws are the previous step's to the last bit, as they are while a pushed body translates
+(the scene-relative origin moves with the contacts), the proof that certified the previous answer proves this
+one: :class:`Reuse` hands that answer back instead of proving it again. Only certified answers whose list of motions is complete
 are kept (``solved``, and ``ambiguous`` listed in full). The caller still converts and audits every motion on
 its own scene, so the reused answer is judged anew.
 """
@@ -50,13 +50,15 @@ class Reuse:
 
 def _key(method: str, problem: Problem, options: Options) -> tuple[Any, ...]:
     """Everything a backend's answer depends on: the method, the options that shape a search, the friction model,
-    the names the rows belong to, and the laws' arrays to the last bit (their shapes included)."""
-    scene = problem.scene
+    the scales (a certificate's physical units; not the origin, which assembly takes out), the names the rows
+    belong to, and the laws' arrays to the last bit (their shapes included)."""
+    scene, scales = problem.scene, problem.scales
     return (
         method,
         options.max_solutions,
         options.modes,
         str(problem.friction),
+        (scales.length, scales.force, scales.velocity),
         tuple(body.name for body in scene.bodies),
         tuple((contact.body, contact.other) for contact in scene.contacts),
         problem.J.shape,
