@@ -24,10 +24,11 @@ from .laws import DeferredForces, Problem, RawMotion, WorldForceSet, assemble, f
 from .model import FloatArray, Scene
 from .solution import Attempt, CompliantStep, Later, Mode, Motion, Solution, UnprovenExtreme
 from .solvers import BACKENDS, Backend, BackendResult, Options, SearchProgress, compliant_forces, compliant_step, get_backend, too_large
+from .solvers.reuse import Reuse
 
 Range = tuple[float, float | None]
 
-__all__ = ["solve", "METHODS", "audited_raw_motion", "with_detection"]
+__all__ = ["solve", "METHODS", "Reuse", "audited_raw_motion", "with_detection"]
 
 METHODS = ("auto", *BACKENDS)
 _MODE_NAMES = ("rolling", "sliding", "separating")
@@ -44,6 +45,7 @@ def solve(
     tolerance: float = DEFAULT_TOLERANCE,
     time_limit: float = 60.0,
     progress: Callable[[SearchProgress], None] | None = None,
+    reuse: Reuse | None = None,
 ) -> Solution:
     """Predict the quasi-static motion of the free bodies of a scene.
 
@@ -79,6 +81,10 @@ def solve(
     progress : callable, optional
         Called with a :class:`~quasistatic.solvers.SearchProgress` (motions found, nodes,
         seconds) after each step of the certified search, e.g. to show a status line.
+    reuse : Reuse, optional
+        A memory of the last certified answer (a simulation keeps one per run): laws equal to its own
+        bit for bit take that answer again instead of proving it anew; every motion is still audited
+        on this scene.
 
     Returns
     -------
@@ -97,6 +103,7 @@ def solve(
             tolerance=tolerance,
             time_limit=time_limit,
             progress=progress,
+            reuse=reuse,
         )
         solution = dataclasses.replace(solution, source=SolvedScene(solution.scene, scene.robots))  # joint positions too
         return with_detection(solution, detection)
@@ -113,7 +120,7 @@ def solve(
                 f"method {name!r} is frictionless but contacts {_frictional(problem)} have mu > 0; "
                 "use method 'auto', or set 'friction: none' to drop friction on purpose"
             )
-        result = _run(backend, problem, options)
+        result = _run(backend, problem, options) if reuse is None else _recalled_or_run(reuse, backend, problem, options)
         solution = _audited(problem, result, name, tolerance, options, tuple(tried), started)
         solution = _compliant(problem, solution, result, tolerance, options.time_limit)
         # A certifying method's verdict stands unless the audit turned its motion down; the fast path's only when solved.
@@ -140,6 +147,16 @@ def _run(backend: Backend, problem: Problem, options: Options) -> BackendResult:
         raise
     except Exception as exc:
         raise SolverError(backend.name, f"{type(exc).__name__}: {exc}") from exc
+
+
+def _recalled_or_run(reuse: Reuse, backend: Backend, problem: Problem, options: Options) -> BackendResult:
+    """The answer ``reuse`` kept for these very laws, else the backend's (kept in turn when certified and complete)."""
+    kept = reuse.recalled(backend.name, problem, options)
+    if kept is not None:
+        return kept
+    result = _run(backend, problem, options)
+    reuse.keep(backend.name, problem, options, result)
+    return result
 
 
 def _choose(method: str, problem: Problem, modes_given: bool, certify: bool, insist: bool) -> tuple[str, ...]:

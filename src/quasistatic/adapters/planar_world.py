@@ -182,8 +182,8 @@ class PlanarWorld:
 
     @property
     def size(self) -> float:
-        """The largest free body's bounding radius [length] (1 when no body has a shape)."""
-        return max((b.shape.extent for b in self.bodies if b.shape is not None), default=1.0)
+        """The largest free body's bounding radius [length] (1 when no body has a shape); kept, as :meth:`moved` keeps the shapes."""
+        return self._kept("size", lambda: max((b.shape.extent for b in self.bodies if b.shape is not None), default=1.0))
 
     # ----------------------------------------------------------------- parts
 

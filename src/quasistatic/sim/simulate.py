@@ -43,6 +43,7 @@ def simulate(
     event_tolerance: float | None = None,
     max_steps: int = 100_000,
     progress: Callable[[float, float], None] | None = None,
+    reuse: bool = True,
 ) -> Trajectory:
     """Follow the quasi-static motion of a scene of shapes for ``duration`` seconds.
 
@@ -63,6 +64,10 @@ def simulate(
         Width of the time window that locates an event [s]; ``dt`` times :data:`SIM_EVENT_TIME` by default.
     progress : function (time, duration), optional
         Called after every step.
+    reuse : bool
+        True (default): a step whose scene-relative laws equal the previous solve's bit for bit takes its
+        certified answer again, audited anew (:class:`~quasistatic.sim.StepOptions`); False proves every step
+        anew. The run is the same either way.
 
     Returns
     -------
@@ -72,7 +77,7 @@ def simulate(
     """
     world = _world(scene)
     _check_run(duration, event_tolerance, max_steps)
-    model = SimModel(world, StepOptions(dt, ambiguous, method, certify))
+    model = SimModel(world, StepOptions(dt, ambiguous, method, certify, reuse=reuse))
     tolerance = dt * SIM_EVENT_TIME if event_tolerance is None else event_tolerance
     state = State.of(world)
     current = evaluate(model, state, inputs_at(inputs, state))

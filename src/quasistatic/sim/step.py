@@ -22,7 +22,7 @@ from ..adapters import AnyWorld, Detection
 from ..errors import SceneError, SolverError
 from ..model import Contact, Scene
 from ..solution import LaterField, Mode, Motion, Solution, Status
-from ..solve import solve
+from ..solve import Reuse, solve
 from ..tolerances import SIM_APPROACH, SIM_LOOKAHEAD, SIM_PENETRATION, SIM_POWER_TIE
 from .rigid import advance_pose, point_velocity
 from .state import Inputs, State
@@ -41,6 +41,9 @@ class StepOptions:
     ``ambiguous``: ``stop`` ends the run at an ambiguous answer; ``min_power`` goes on with the motion of
     least input power among those listed (the paper's choice), and records that a choice was made.
     ``method``, ``certify``, ``time_limit``: passed to :func:`quasistatic.solve`.
+    ``reuse``: a step whose scene-relative laws equal the previous solve's bit for bit (a body that only
+    translates) takes that certified answer again (:class:`quasistatic.solve.Reuse`), audited anew;
+    the run is the same step for step with it off.
     """
 
     dt: float = 0.01
@@ -48,6 +51,7 @@ class StepOptions:
     method: str = "auto"
     certify: bool = True
     time_limit: float = 60.0
+    reuse: bool = True
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.dt) and self.dt > 0):
@@ -73,6 +77,11 @@ class SimModel:
         """The World searching the look-ahead band too: built once, so every step reuses its detection layout."""
         band = self.margin + SIM_LOOKAHEAD * self.world.size
         return replace(self.world, detection=replace(self.world.detection, margin=band))
+
+    @cached_property
+    def reuse(self) -> Reuse | None:
+        """The run's memory of its last certified answer (None when ``options.reuse`` is off)."""
+        return Reuse() if self.options.reuse else None
 
     def found_at(self, state: State, world: AnyWorld) -> Detection:
         """``world.detect()``, ``world`` being the look-ahead World placed at ``state``; the contacts found at the
@@ -225,15 +234,16 @@ def evaluate(model: SimModel, state: State, inputs: Inputs) -> Evaluation:
     detection = Detection(
         tuple(found.contacts[i] for i in touching), tuple(found.gaps[i] for i in touching), margin, _isolated(world, found, touching)
     )
-    solution = _solved(model.options, world.scene(detection))
+    solution = _solved(model, world.scene(detection))
     motion, choice = _chosen(solution, model.options.ambiguous)
     return Evaluation(state, inputs, world, margin, detection, near, solution, motion, choice, penetration, model)
 
 
-def _solved(options: StepOptions, scene: Scene) -> Solution:
+def _solved(model: SimModel, scene: Scene) -> Solution:
     """The certified answer; a solver that crashes underneath (HiGHS, SCIP) ends the run ``failed``, its steps kept."""
+    options = model.options
     try:
-        return solve(scene, options.method, certify=options.certify, time_limit=options.time_limit)
+        return solve(scene, options.method, certify=options.certify, time_limit=options.time_limit, reuse=model.reuse)
     except SolverError as error:
         return Solution("failed", f"the solver failed: {error}", options.method, str(scene.friction))
 
