@@ -18,7 +18,7 @@ import quasistatic as qs
 from quasistatic.laws import Problem, assemble
 from quasistatic.sim import Inputs, SimModel, State, StepOptions, advance, evaluate
 from quasistatic.solve import Reuse
-from quasistatic.tools.bench.simulation import planar_two_finger_push
+from quasistatic.tools.bench.simulation import planar_tipping_box, planar_two_finger_push
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "sim"
 
@@ -101,3 +101,22 @@ def test_a_kept_answer_that_fails_the_audit_on_the_new_scene_is_not_reported() -
     assert memory.hits == 1  # taken again, and judged by the audit
     assert answer.status == "solved" and answer.method == "scip" and answer.fallback[0].method == "certified"
     assert np.allclose(answer.motion.twists["box"], truth.motion.twists["box"])  # type: ignore[union-attr]
+
+
+@pytest.mark.parametrize(
+    ("build", "example", "reuses"),
+    [(planar_two_finger_push, "push_planar.yaml", True), (planar_tipping_box, "tip_box_planar.yaml", False)],
+)
+def test_the_bench_rows_run_their_examples_and_only_the_translating_push_reuses(build, example: str, reuses: bool, tmp_path: Path) -> None:
+    """The bench's two planar rows are the examples they name (the same run, saved byte for byte), and the turning
+    box is the row that cannot reuse: a bench figure for it measures proofs, not the memory."""
+    built, loaded = qs.simulate(build(), duration=2.0, dt=0.05), qs.simulate(EXAMPLES / example, duration=2.0, dt=0.05)
+    files = [run.save(tmp_path / f"run_{i}.jsonl").read_text(encoding="utf-8") for i, run in enumerate((built, loaded))]
+    _headers, steps = zip(*(text.split("\n", 1) for text in files), strict=True)
+    assert steps[0] == steps[1] and len(built.steps) >= 20  # the header names the source file, which differs
+    world = build()
+    model, state = SimModel(world, StepOptions(0.05)), State.of(world)
+    for _ in range(20):
+        evaluation = evaluate(model, state, Inputs())
+        state = advance(evaluation, 0.05)
+    assert model.reuse is not None and (model.reuse.hits >= 15 if reuses else model.reuse.hits <= 2)

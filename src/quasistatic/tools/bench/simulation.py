@@ -1,10 +1,14 @@
 """Motion over time in the benchmark: steps per second, and where a step's time goes.
 
-Three runs of :func:`quasistatic.sim.step` (each step: contacts found again, a certified solve, the move):
+Four runs of :func:`quasistatic.sim.step` (each step: contacts found again, a certified solve, the move):
 
 - ``simulate push (planar)``: issue 13's planar two-finger push, ``examples/sim/push_planar.yaml`` built in
   Python: a box on a table pushed by two fingertips (disks) one above the other (4 contacts, detection in
-  NumPy, solved and certified at every step; runs without the robots extra);
+  NumPy, solved and certified at every step; runs without the robots extra). The box only translates, so
+  most steps' laws repeat bit for bit and take the previous certified answer again;
+- ``simulate tip (planar, turning)``: ``examples/sim/tip_box_planar.yaml`` built in Python: a tall box tipped
+  about its front corner by a fingertip pushing high. It turns, so every step's laws are new and proven anew:
+  the cost of a step that cannot reuse;
 - ``simulate push``: a box on a table pushed by two fingertips side by side (6 contacts; the answer is
   ambiguous, so the least-power motion is followed, as ``--ambiguous min-power`` does);
 - ``simulate allegro``: the Allegro hand holding a cube on a table (the pipeline rows' grasp), the hand
@@ -48,7 +52,7 @@ from ...sim import Evaluation, Inputs, SimModel, State, StepOptions, advance, ev
 from ...solve import Reuse, solve
 from .pipeline import PipelineRow, allegro_grasp
 
-__all__ = ["run_simulation_rows", "two_finger_push", "planar_two_finger_push"]
+__all__ = ["run_simulation_rows", "two_finger_push", "planar_two_finger_push", "planar_tipping_box"]
 
 PUSH_STEP = 0.05  # [s]: the fingertips move 0.5 mm per step
 
@@ -83,10 +87,25 @@ def planar_two_finger_push() -> PlanarWorld:
     )
 
 
+def planar_tipping_box() -> PlanarWorld:
+    """``examples/sim/tip_box_planar.yaml``: a 0.1 x 0.2 m, 1 kg box on a table (friction 0.8) tipped over by a
+    frictionless fingertip (a disk, radius 5 mm) pushing its back face at height 0.15 m in +x at 1 cm/s."""
+    finger = PlanarMover("finger", Disk(0.005), planar_pose([-0.055, 0.15]), twist=[0.01, 0.0, 0.0])
+    return PlanarWorld(
+        bodies=(PlanarBody("box", 1.0, Rectangle([0.1, 0.2]), planar_pose([0.0, 0.1])),),
+        movers=(PlanarMover("table", HalfPlane([0.0, 1.0], 0.0)), finger),
+        detection=ContactDetection(mu=0.8, pairs=(FrictionPair(("box", "finger"), 0.0),)),
+    )
+
+
 def run_simulation_rows(full: bool, say: Callable[[str], None]) -> list[PipelineRow]:
     """The simulation rows: the planar push always; the 3-D ones need the robots extra (the Allegro row also example-robot-data)."""
     steps = 20 if full else 6
-    rows = [_row("simulate push (planar)", planar_two_finger_push(), 200 if full else 60, "stop")]
+    planar_steps = 200 if full else 60
+    rows = [
+        _row("simulate push (planar)", planar_two_finger_push(), planar_steps, "stop"),
+        _row("simulate tip (planar, turning)", planar_tipping_box(), planar_steps, "stop"),
+    ]
     if find_spec("coal") is None or find_spec("pinocchio") is None:
         rows.append(PipelineRow("simulate", skipped="coal/pinocchio not installed (pip install 'quasistatic[robots]')"))
         for row in rows:
