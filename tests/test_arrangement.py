@@ -277,4 +277,58 @@ def test_a_vertex_that_keeps_every_contact_open_skips_only_an_lp_that_finds_noth
         assert (fast.status, fast.diagnosis) == (full.status, full.diagnosis)
         assert fast.certificate is not None and full.certificate is not None and fast.certificate.kind == full.certificate.kind
         skipped += proof.admissible
-    assert skipped >= 15  # measured: 25 of the 90 "no motion" verdicts
+    assert skipped >= 75  # measured: 81 of the 90 "no motion" verdicts (the other 9 are kinematic jams)
+
+
+@pytest.mark.parametrize(("contacts", "instance"), [(4, 1), (6, 1), (6, 3)])
+def test_a_wedged_grasp_whose_gap_planes_meet_to_round_off_needs_no_kinematic_lp(
+    contacts: int, instance: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Four or five gap planes through one point (every finger follows one twist), the only admissible twist: its
+    gap rates are round-off (exact multipliers of 1e16 exist on the stored numbers), so the LP's verdict, wedged,
+    is given without the LP, with the same certificate."""
+    from quasistatic.solvers.certify import diagnose as diagnose_module
+
+    problem = qs.assemble(grasp_2d(contacts, instance))
+    assert _proof(problem).admissible
+    full = qs.solve(problem)
+    assert full.status == "jammed" and full.diagnosis is qs.Diagnosis.WEDGED
+
+    def not_run(problem: qs.Problem) -> None:
+        raise AssertionError("the kinematic LP ran")
+
+    monkeypatch.setattr(diagnose_module, "kinematic_certificate", not_run)
+    fast = qs.solve(problem)
+    assert (fast.status, fast.diagnosis, fast.message) == (full.status, full.diagnosis, full.message)
+    assert fast.certificate is not None and full.certificate is not None
+    assert (fast.certificate.kind, fast.certificate.text) == (full.certificate.kind, full.certificate.text)
+    assert dict(fast.notes)["certificate"] == NO_VERTEX_PROOF
+
+
+def test_kinematic_multipliers_past_the_bound_are_not_a_certificate() -> None:
+    """Two opposed gap rows closing at ``2 b`` (``bn = (b, b)``): multipliers ``(1/2b, 1/2b)``. HiGHS finds them at every
+    ``b`` here; those past ``KINEMATIC_MULTIPLIERS`` (a closing speed of round-off) are refused."""
+    from types import SimpleNamespace
+
+    from quasistatic.solvers.certify.diagnose import kinematic_certificate
+    from quasistatic.tolerances import KINEMATIC_MULTIPLIERS
+
+    for b in (0.5, 5e-5, 5e-10):
+        y = kinematic_certificate(SimpleNamespace(Jn=np.array([[1.0], [-1.0]]), bn=np.array([b, b])))  # type: ignore[arg-type]
+        assert y is not None and np.allclose(y, 0.5 / b)
+    assert KINEMATIC_MULTIPLIERS < 1.0 / 5e-12
+    assert kinematic_certificate(SimpleNamespace(Jn=np.array([[1.0], [-1.0]]), bn=np.array([5e-12, 5e-12]))) is None  # type: ignore[arg-type]
+
+
+def test_a_twist_below_a_gap_row_by_more_than_round_off_admits_multipliers() -> None:
+    """The bound of ``admits_no_multipliers`` is not met by every twist: a gap rate below 0 by more than
+    ``1 / KINEMATIC_MULTIPLIERS`` leaves room for a certificate, as does an error bar that large."""
+    from quasistatic.solvers.certify.diagnose import admits_no_multipliers
+    from quasistatic.tolerances import KINEMATIC_MULTIPLIERS
+
+    q = np.array([0.3, -0.2, 0.5])
+    assert admits_no_multipliers(np.array([0.0, 0.2, 1e-3]), q)
+    assert admits_no_multipliers(np.array([-1e-16, 0.2, 0.0]), q, 1e-15)
+    assert not admits_no_multipliers(np.array([-1.0 / KINEMATIC_MULTIPLIERS, 0.2, 0.0]), q)
+    assert not admits_no_multipliers(np.array([0.0, 0.2, 0.0]), q, 1.0 / KINEMATIC_MULTIPLIERS)
+    assert not admits_no_multipliers(np.array([0.0, 0.2, 0.0]), 1e7 * q)  # LP_FEASIBILITY |q|_1 past 1/2

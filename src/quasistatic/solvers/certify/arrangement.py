@@ -94,9 +94,10 @@ the least-squares residual of ``-g`` from any cone of loads can take), the set
 of loads each excludes, as a bit mask; a set of loads is excluded when one
 direction's mask holds it (one bitwise test per pair). When no forces at all
 balance the load (every load excluded) no twist is needed to say so; for either
-"no motion", an exact vertex that keeps every contact closed or opening tells
-:func:`~.diagnose.diagnose` that no kinematic certificate exists, so it skips
-that LP (:func:`~.diagnose.admits_no_multipliers`). Without
+"no motion", a vertex (or the least-squares twist of the gap rows) that keeps
+every contact closed or opening to within round-off tells :func:`~.diagnose.diagnose` that no kinematic certificate exists
+(none with multipliers below :data:`~quasistatic.tolerances.KINEMATIC_MULTIPLIERS`, all its LP
+accepts), so it skips that LP (:func:`~.diagnose.admits_no_multipliers`). Without
 Lemke's point, the held vertex best computed becomes the seed when its twist
 with non-negative least-squares forces on its loads satisfies every law of the
 form (:func:`~.cheap.satisfies_form`, as Lemke's point is checked). Anything
@@ -146,7 +147,7 @@ class VertexProof:
     equilibrium: bool | None = None
     triples: int = 0
     seed: np.ndarray | None = None  # for ``UNIQUE``: the motion, a point ``[q, cn, beta, lam]`` of the form (checked)
-    admissible: bool = False  # for ``NONE``: a vertex keeps every contact closed or opening (no kinematic certificate)
+    admissible: bool = False  # for ``NONE``: a vertex keeps every contact closed or opening, to round-off (no kinematic certificate)
 
 
 _UNDECIDED = VertexProof(VertexVerdict.UNDECIDED)
@@ -191,8 +192,7 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None) -> VertexProof:
     excluded = _Exclusions.of(planes.loads, problem.g)
     vertices = _vertices(planes)
     if excluded.every_load():  # no forces balance the load at all, whatever the twist
-        admissible = vertices is not None and _admissible(planes, vertices)
-        return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False, admissible=admissible)
+        return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False, admissible=_admissible(planes, vertices))
     if vertices is None:
         return _UNDECIDED  # the normals do not span R^3: every motion lies on a line of motions
     held = np.flatnonzero(~excluded.excludes(_load_masks(planes, vertices.signs)))
@@ -261,7 +261,6 @@ class _Vertices:
     spread: np.ndarray
     slack: np.ndarray
     count: int
-    triples: np.ndarray  # (V, 3): each vertex's planes
 
 
 @functools.cache
@@ -301,7 +300,7 @@ def _vertices(planes: _Planes) -> _Vertices | None:
     signs = (rows > near).view(np.int8) - (rows < -near).view(np.int8)
     kept = (signs[:m] >= 0).all(axis=0)  # loose Q0
     spread = np.abs(planes.flat_crosses[columns[:, kept]]).sum(axis=0) / np.abs(det[kept, None])  # sum_k |N_T^-1[j, k]|
-    return _Vertices(w[kept], signs[:, kept].T, spread, slack[kept], int(det.size), triples[kept])
+    return _Vertices(w[kept], signs[:, kept].T, spread, slack[kept], int(det.size))
 
 
 def _load_masks(planes: _Planes, signs: np.ndarray) -> np.ndarray:
@@ -401,21 +400,20 @@ def _vertex_point(form: LCPForm, planes: _Planes, vertices: _Vertices, held: np.
     return x if satisfies_form(form, x) else None
 
 
-def _admissible(planes: _Planes, vertices: _Vertices) -> bool:
-    """Whether an exact vertex keeps every contact closed or opening, near enough for
-    :func:`~.diagnose.admits_no_multipliers`. Its own triple's rows are 0 there; another gap row, computed at the
-    computed vertex ``w``, is off by its evaluation's round-off plus ``|n_p N_T^-1|_1`` times the triple's residual
-    (round-off of ``|n| |w|_1`` and the triple's offsets: 0 where both are, as at rest with still movers)."""
-    m, w = planes.m, vertices.w
-    gaps = planes.normals[:m] @ w.T - planes.rhs[:m, None]  # (m, V)
-    own = (vertices.triples[None, :, :] == np.arange(m)[:, None, None]).any(axis=2)  # (m, V): the triple's gap rows
-    size = np.abs(w).sum(axis=1)
-    residual = ARRANGEMENT_ROUNDOFF * (planes.longest * size + np.abs(planes.rhs[vertices.triples]).max(axis=1))
-    drift = math.sqrt(3.0) * planes.longest * vertices.spread.max(axis=1) * residual  # |n_p (w_T - w)|
-    evaluation = ARRANGEMENT_ROUNDOFF * (planes.longest * size + np.abs(planes.rhs[:m, None]))
-    opening = (own | (gaps >= drift + evaluation)).all(axis=0)
-    exact = np.where(own, 0.0, gaps + drift + evaluation)  # at most this at the exact vertex
-    return any(admits_no_multipliers(exact[:, v], w[v]) for v in np.flatnonzero(opening))
+def _admissible(planes: _Planes, vertices: _Vertices | None) -> bool:
+    """Whether a computed vertex ``w``, or the least-squares twist of the gap rows (where the normals do not span
+    R^3 there are no vertices), meets every gap row near enough to rule out every kinematic certificate
+    (:func:`~.diagnose.admits_no_multipliers`): each twist is a point of its own, whose gap rates are known to their
+    evaluation's round-off ``ARRANGEMENT_ROUNDOFF (|n| |w|_1 + |r|)``, and may fall below 0 by round-off only. The
+    twist least below is tried."""
+    m = planes.m
+    normals, rhs = planes.normals[:m], planes.rhs[:m]
+    fit = np.linalg.lstsq(normals, rhs)[0]
+    twists = fit[None, :] if vertices is None else np.vstack((vertices.w, fit))
+    gaps = normals @ twists.T - rhs[:, None]  # (m, V)
+    error = ARRANGEMENT_ROUNDOFF * (planes.longest * np.abs(twists).sum(axis=1) + np.abs(rhs[:, None]))
+    best = int(np.argmin((error - gaps).max(axis=0)))
+    return admits_no_multipliers(gaps[:, best], twists[best], error[:, best])
 
 
 def _near_seed(vertices: _Vertices, held: np.ndarray, q: np.ndarray) -> bool:
