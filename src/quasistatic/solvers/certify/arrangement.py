@@ -233,14 +233,14 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None, max_solutions: i
         if seed_x is not None:
             return _UNDECIDED  # a checked motion, yet every vertex excluded: too close to call
         return VertexProof(VertexVerdict.NONE, excluded.equilibrium(), vertices.count, admissible=_admissible(planes, vertices))
-    clusters = _clusters(vertices, held)
-    if len(clusters) == 1:
-        seed_x = seed_x if seed_x is not None else _vertex_point(form, planes, vertices, held)
-        if seed_x is None or not _near_seed(vertices, held, seed_x[:3]):
-            return _UNDECIDED
+    seed_x = seed_x if seed_x is not None else _vertex_point(form, planes, vertices, held)
+    if seed_x is not None and _near_seed(vertices, held, seed_x[:3]):  # one motion, if no edge leaves it
         if not _edges_excluded(planes, vertices, held, excluded):
             return _UNDECIDED
         return VertexProof(VertexVerdict.UNIQUE, None, vertices.count, seed_x)
+    clusters = _clusters(vertices, held)
+    if len(clusters) == 1:
+        return _UNDECIDED  # one group, not near its motion: too close to call
     if max_solutions is not None and len(clusters) > max_solutions:
         return _UNDECIDED  # more motions than asked for: the branch and bound (and SCIP) say so
     motions = _listed(form, planes, vertices, clusters, seed_x)
@@ -484,14 +484,14 @@ def _edges_excluded(planes: _Planes, vertices: _Vertices, held: np.ndarray, excl
         i, j = _pairs(near.size)
         pair = near[i] * P + near[j]
         lines = planes.flat_crosses[pair]
-        lengths = np.sqrt(np.einsum("lj,lj->l", lines, lines))
-        kept = lengths > planes.dependent / planes.longest  # not parallel
-        pair, lengths = pair[kept], lengths[kept]
+        squares = np.einsum("lj,lj->l", lines, lines)
+        kept = squares > planes.dependent**2 / planes.longest**2  # not parallel
+        pair = pair[kept]
         along = planes.triple[near[:, None], pair].T  # (L, k): n_p . (n_a x n_b), p near
-        zero = np.full(along.shape, planes.dependent)
+        zero: np.ndarray | float = planes.dependent
         if apart is not None:
             rate = 2.0 * vertices.margin[held[key]][:, near].max(axis=0) / apart  # (k,): per unit length
-            zero = np.maximum(zero, lengths[:, None] * rate[None, :])
+            zero = np.maximum(planes.dependent, np.sqrt(squares[kept])[:, None] * rate[None, :])
         along[np.abs(along) <= zero] = 0.0
         rays = np.concatenate((along, -along))
         rays = rays[(rays[:, near < m] >= 0.0).all(axis=1)]  # no near gap row falls along it
