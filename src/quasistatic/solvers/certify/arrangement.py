@@ -443,15 +443,21 @@ def _vertex_point(form: LCPForm, planes: _Planes, vertices: _Vertices, held: np.
 
 
 def _admissible(planes: _Planes, vertices: _Vertices | None) -> bool:
-    """Whether a computed vertex ``w``, or the least-squares twist of the gap rows (where the normals do not span
+    """Whether a computed vertex ``w``, or else the least-squares twist of the gap rows (where the normals do not span
     R^3 there are no vertices), meets every gap row near enough to rule out every kinematic certificate
-    (:func:`~.diagnose.admits_no_multipliers`): each twist is a point of its own, whose gap rates are known to their
-    evaluation's round-off ``ARRANGEMENT_ROUNDOFF (|n| |w|_1 + |r|)``, and may fall below 0 by round-off only. The
-    twist least below is tried."""
+    (:func:`~.diagnose.admits_no_multipliers`)."""
+    if vertices is not None and vertices.w.shape[0] and _admits(planes, vertices.w):
+        return True
+    m = planes.m
+    return _admits(planes, np.linalg.lstsq(planes.normals[:m], planes.rhs[:m])[0][None, :])
+
+
+def _admits(planes: _Planes, twists: np.ndarray) -> bool:
+    """:func:`~.diagnose.admits_no_multipliers` for the one of ``twists`` (V, 3) least below a gap row: each twist is
+    a point of its own, whose gap rates are known to their evaluation's round-off ``ARRANGEMENT_ROUNDOFF (|n| |w|_1 +
+    |r|)``, and may fall below 0 by round-off only."""
     m = planes.m
     normals, rhs = planes.normals[:m], planes.rhs[:m]
-    fit = np.linalg.lstsq(normals, rhs)[0]
-    twists = fit[None, :] if vertices is None else np.vstack((vertices.w, fit))
     gaps = normals @ twists.T - rhs[:, None]  # (m, V)
     error = ARRANGEMENT_ROUNDOFF * (planes.longest * np.abs(twists).sum(axis=1) + np.abs(rhs[:, None]))
     best = int(np.argmin((error - gaps).max(axis=0)))
