@@ -120,9 +120,10 @@ of loads each excludes, as a bit mask; a set of loads is excluded when one
 direction's mask holds it (one bitwise test per pair). When no forces at all
 balance the load (every load excluded) no twist is needed to say so; for either
 "no motion", a vertex (or the least-squares twist of the gap rows) that keeps
-every contact closed or opening to within round-off tells :func:`~.diagnose.diagnose` that no kinematic certificate exists
-(none with multipliers below :data:`~quasistatic.tolerances.KINEMATIC_MULTIPLIERS`, all its LP
-accepts), so it skips that LP (:func:`~.diagnose.admits_no_multipliers`). Without
+every contact closed or opening to within round-off tells
+:func:`~.diagnose.diagnose` that no kinematic certificate exists (none with
+multipliers below :data:`~quasistatic.tolerances.KINEMATIC_MULTIPLIERS`, all
+its LP accepts), so it skips that LP (:func:`~.diagnose.admits_no_multipliers`). Without
 Lemke's point, the held vertex best computed becomes the seed when its twist
 with non-negative least-squares forces on its loads satisfies every law of the
 form (:func:`~.cheap.satisfies_form`, as Lemke's point is checked). Anything
