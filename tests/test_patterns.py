@@ -185,7 +185,9 @@ def test_certified_grasps_are_proven_by_the_mode_branch_and_bound_without_scip(
         raise AssertionError("the SCIP search ran")
 
     monkeypatch.setattr(certified_door, "certified_polyhedral", no_scip)
-    monkeypatch.setattr(certified_door, "prove_by_vertices", lambda form, seed: VertexProof(VertexVerdict.UNDECIDED))  # decides these first
+    monkeypatch.setattr(
+        certified_door, "prove_by_vertices", lambda form, seed, limit=None: VertexProof(VertexVerdict.UNDECIDED)
+    )  # decides first
     solution = qs.solve(grasp_2d(contacts, instance))
     assert solution.status == PATTERN_DECIDED[(contacts, instance)]
     assert solution.certified
@@ -208,6 +210,9 @@ def test_ambiguous_grasps_are_listed_by_the_mode_branch_and_bound_without_scip(
         raise AssertionError("the SCIP search ran")
 
     monkeypatch.setattr(certified_door, "certified_polyhedral", no_scip)
+    monkeypatch.setattr(
+        certified_door, "prove_by_vertices", lambda form, seed, limit=None: VertexProof(VertexVerdict.UNDECIDED)
+    )  # lists first
     solution = qs.solve(scene)
     assert solution.status == "ambiguous" and solution.certified and solution.search_complete
     assert len(solution.solutions) == 2 and all(motion.audit.passed for motion in solution.solutions)

@@ -131,6 +131,18 @@ MOTION_RANK = 1e-9
 LP_FEASIBILITY = 1e-7
 """What HiGHS and SCIP meet constraints to; a certificate or range checked with their output uses the same [-]."""
 
+KINEMATIC_MULTIPLIERS = 1e10
+"""Largest ``|y|_1`` of Farkas multipliers (``y >= 0``, ``Jn^T y = 0``, ``bn.y = 1``) accepted as proof that no twist keeps
+every contact closed or opening [-]. Multipliers this large say only that every twist misses some gap row by less than
+``1 / |y|_1`` (1e-10) of the scene's velocity, far inside the ``LP_FEASIBILITY`` every certified claim is made to (two
+opposed fingers closing at 1e-8 of it already have motions that meet the rows to it: ``ambiguous``, with or without
+the bound). Measured: HiGHS returns multipliers of 2e9 for fingers closing at 1e-9 (accepted), 2e11 at 1e-11
+(refused), none at 1e-13; the largest on 1,320 random scenes and grasps was 433. The 6-contact bench grasps whose
+fingers all follow one twist have five gap planes through one point, missed by 1e-17 in exact arithmetic on the
+stored numbers (exact multipliers of 1e16 exist; HiGHS calls the LP infeasible). With the bound, a twist meeting every gap row to within
+round-off rules out every accepted certificate without the LP
+(:func:`quasistatic.solvers.certify.diagnose.admits_no_multipliers`)."""
+
 FORCE_CEILING = 1e6
 """Largest total scene-relative force a Farkas vector of the mode branch and bound must exclude [-]: its check
 ``G^T y <= 0`` is met to round-off (1e-16 of the load) only, which rules out every equilibrium with forces below

@@ -11,7 +11,8 @@
    (:mod:`.certify.arrangement`, whole-array 3x3 solves and checked Farkas directions)
    prove Lemke's (or a vertex's) twist the only motion, or that none exists (then
    ``jammed``/``unstable`` by :func:`~.certify.diagnose.diagnose`, told when a vertex
-   keeps every contact open), for most problems; where it proves nothing, step 4.
+   keeps every contact open), or list every motion when they are isolated twists
+   (``ambiguous``), for most problems; where it proves nothing, step 4.
 4. Planar and 3-D pyramid problems: a branch and bound over each contact's mode
    (separating, rolling, sliding either way in 2-D; on a pyramid's vertex or
    face in 3-D), whose nodes are pruned by checked Farkas
@@ -39,7 +40,7 @@ from __future__ import annotations
 
 from ..laws import Problem, RawMotion
 from ..laws.polyhedral import aligned_edges, polyhedral_form
-from .certify.arrangement import NO_VERTEX_PROOF, VERTEX_PROOF, VertexVerdict, prove_by_vertices
+from .certify.arrangement import NO_VERTEX_PROOF, VERTEX_LISTING_PROOF, VERTEX_PROOF, VertexVerdict, prove_by_vertices
 from .certify.cheap import exact_motion, kinematically_unique, seed_point
 from .certify.diagnose import diagnose
 from .certify.exact_cone import solve_exact_3d, unique_exact_motion
@@ -66,10 +67,14 @@ def solve_cheap_certified(problem: Problem, options: Options) -> BackendResult:
     if seed is not None and kinematically_unique(problem, seed[: form.n_q]):
         motion = RawMotion(seed[: form.n_q], form.forces(seed))
         return summarise(form, [motion], True, options).with_notes(certificate=_KINEMATIC)
-    vertices = prove_by_vertices(form, seed)
+    vertices = prove_by_vertices(form, seed, options.max_solutions)
     if vertices.verdict is VertexVerdict.UNIQUE and vertices.seed is not None:
         motion = RawMotion(vertices.seed[: form.n_q], form.forces(vertices.seed))
         return summarise(form, [motion], True, options).with_notes(certificate=VERTEX_PROOF)
+    if vertices.verdict is VertexVerdict.ENUMERATED:
+        options.report(len(vertices.motions), 0)  # as the SCIP search reports its steps
+        motions = [RawMotion(x[: form.n_q], form.forces(x)) for x in vertices.motions]
+        return summarise(form, motions, True, options).with_notes(certificate=VERTEX_LISTING_PROOF)
     if vertices.verdict is VertexVerdict.NONE:
         return diagnose(problem, edges, equilibrium=vertices.equilibrium, admissible=vertices.admissible).with_notes(
             certificate=NO_VERTEX_PROOF

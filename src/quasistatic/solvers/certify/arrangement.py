@@ -31,8 +31,10 @@ planes through it meet). Hence:
 2. one motion vertex ``v``, and no motion edge leaving it, means ``v`` is the
    only motion (a motion face of dimension >= 1 with ``v`` its only vertex is
    ``v`` plus a pointed cone, whose extreme rays are motion edges at ``v``);
-3. two motion vertices, or a motion edge, mean more than one motion: the
-   listing is the branch and bound's, which runs unchanged.
+3. several motion vertices and no motion edge leaving any of them mean that
+   these vertices are the motions (a motion face of dimension >= 1 has a motion
+   edge); a motion edge means a continuum: the listing is the branch and bound's,
+   which runs unchanged.
 
 **With the tolerances of the rest of certify/.** The claims are made for the
 twists that meet every row to ``tau`` (``LP_FEASIBILITY``, what HiGHS and SCIP
@@ -76,6 +78,29 @@ the loads):
   lies in a bounded cell whose vertices are near ``q*``: the **only motion** is
   ``q*`` (claim 2).
 
+- **several isolated motions** (claim 3 with the margins): group the held triples
+  by twist (within ``DISTINCT_TWIST`` of a group's best computed one), give each
+  group a checked motion ``q_k`` (the seed for its group, else the group's best
+  computed vertex with least-squares forces, checked as Lemke's point is) with
+  every triple of the group near ``q_k`` as above. A loose motion lies in a cell
+  whose vertices are each near a held triple. An unbounded cell is held by a ray
+  as above. A bounded cell whose vertices all lie near one group lies in that
+  group's box. Otherwise the cell has an edge from a vertex ``x`` near a triple
+  ``T`` of one group to a vertex ``x'`` near another group, at least ``L`` away
+  (the least distance between two groups' triples less their loose boxes). The
+  edge lies where two of the cell's bounding planes meet, both near ``w_T`` (``x``
+  is on them), so along ``e = +-n_a x n_b``. A near plane ``p`` with cell sign 0
+  keeps ``|row_p| <= tau`` over the edge, so ``|n_p . e| <= 2 tau / L`` per unit
+  length; one with cell sign ``+`` keeps ``row_p >= tau`` from ``|row_p(x)| <=
+  2 margin_p`` on, so ``n_p . e >= -2 margin_p / L``. Taking every rate within
+  ``2 margin_p / L`` as 0 (it only adds loads), the ray's sign vector has at least
+  the cell's zeros and no sign against the cell's, so ``G(e)`` holds the cell's
+  loads. So when every such ray's loads are excluded, every loose motion lies in
+  one group's box: the motions are the ``q_k``, **each listed** (as the branch and
+  bound lists isolated motions: one twist per ``DISTINCT_TWIST`` box, the seed's
+  first). A motion edge (a continuum) leaves a ray not excluded, and the branch
+  and bound lists it as before; more groups than ``max_solutions`` too.
+
 A sign of ``n_p . e`` within round-off is taken as 0, which only adds loads
 (it can keep a ray from being excluded, never exclude one). Three normals whose
 determinant is within round-off of 0 are taken as dependent, and two within
@@ -94,15 +119,17 @@ the least-squares residual of ``-g`` from any cone of loads can take), the set
 of loads each excludes, as a bit mask; a set of loads is excluded when one
 direction's mask holds it (one bitwise test per pair). When no forces at all
 balance the load (every load excluded) no twist is needed to say so; for either
-"no motion", an exact vertex that keeps every contact closed or opening tells
-:func:`~.diagnose.diagnose` that no kinematic certificate exists, so it skips
-that LP (:func:`~.diagnose.admits_no_multipliers`). Without
+"no motion", a vertex (or the least-squares twist of the gap rows) that keeps
+every contact closed or opening to within round-off tells
+:func:`~.diagnose.diagnose` that no kinematic certificate exists (none with
+multipliers below :data:`~quasistatic.tolerances.KINEMATIC_MULTIPLIERS`, all
+its LP accepts), so it skips that LP (:func:`~.diagnose.admits_no_multipliers`). Without
 Lemke's point, the held vertex best computed becomes the seed when its twist
 with non-negative least-squares forces on its loads satisfies every law of the
 form (:func:`~.cheap.satisfies_form`, as Lemke's point is checked). Anything
-else (a held triple far from the seed, a ray not excluded, normals that do not
-span R^3, more than :data:`ARRANGEMENT_CONTACTS` contacts) proves nothing
-here, and the branch and bound runs as before.
+else (a held triple far from its group's motion, groups too close, a ray not
+excluded, normals that do not span R^3, more than :data:`ARRANGEMENT_CONTACTS`
+contacts) proves nothing here, and the branch and bound runs as before.
 """
 
 from __future__ import annotations
@@ -121,10 +148,14 @@ from ...tolerances import ARRANGEMENT_CONTACTS, ARRANGEMENT_ROUNDOFF, DISTINCT_T
 from .cheap import satisfies_form
 from .diagnose import admits_no_multipliers
 
-__all__ = ["VertexVerdict", "VertexProof", "prove_by_vertices", "VERTEX_PROOF", "NO_VERTEX_PROOF"]
+__all__ = ["VertexVerdict", "VertexProof", "prove_by_vertices", "VERTEX_PROOF", "NO_VERTEX_PROOF", "VERTEX_LISTING_PROOF"]
 
 VERTEX_PROOF = (
     "the found twist is the only motion vertex of the contacts' twist planes and no motion edge leaves it "
+    "(vertex certificate: 3x3 solves and checked Farkas vectors)"
+)
+VERTEX_LISTING_PROOF = (
+    "every motion vertex of the contacts' twist planes listed, no motion edge leaving any of them "
     "(vertex certificate: 3x3 solves and checked Farkas vectors)"
 )
 NO_VERTEX_PROOF = "no vertex of the contacts' twist planes holds a motion (vertex certificate: 3x3 solves and checked Farkas vectors)"
@@ -133,20 +164,23 @@ NO_VERTEX_PROOF = "no vertex of the contacts' twist planes holds a motion (verte
 class VertexVerdict(Enum):
     UNIQUE = "unique"  # every motion is the seed's twist
     NONE = "none"  # no motion at all
-    UNDECIDED = "undecided"  # not applicable, several motions, or too close to call: the branch and bound decides
+    ENUMERATED = "enumerated"  # several isolated motions, every one of them listed in ``motions``
+    UNDECIDED = "undecided"  # not applicable, a continuum, or too close to call: the branch and bound decides
 
 
 @dataclass(frozen=True)
 class VertexProof:
     """The verdict; for ``NONE``, whether equilibrium exists with every load (True: a balancing fit, False: a
     checked Farkas vector, None: neither), as :class:`~.patterns.PatternProof` says it; the triples solved; for
-    ``UNIQUE``, the only motion (the caller's seed, or without one the vertex's, checked on every law of the form)."""
+    ``UNIQUE``, the only motion (the caller's seed, or without one the vertex's, checked on every law of the form);
+    for ``ENUMERATED``, every motion, each checked the same way (the seed's first)."""
 
     verdict: VertexVerdict
     equilibrium: bool | None = None
     triples: int = 0
     seed: np.ndarray | None = None  # for ``UNIQUE``: the motion, a point ``[q, cn, beta, lam]`` of the form (checked)
-    admissible: bool = False  # for ``NONE``: a vertex keeps every contact closed or opening (no kinematic certificate)
+    motions: tuple[np.ndarray, ...] = ()  # for ``ENUMERATED``: each motion as a point of the form (checked)
+    admissible: bool = False  # for ``NONE``: a vertex keeps every contact closed or opening, to round-off (no kinematic certificate)
 
 
 _UNDECIDED = VertexProof(VertexVerdict.UNDECIDED)
@@ -180,9 +214,10 @@ class _Planes:
         return int(self.frictional.size)
 
 
-def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None) -> VertexProof:
+def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None, max_solutions: int | None = None) -> VertexProof:
     """Whether the only motion of the planar laws ``form`` is the twist of ``seed_x`` (a point ``[q, cn, beta, lam]``
-    every law of the form holds at, checked by the caller), or no motion exists; see the module docstring."""
+    every law of the form holds at, checked by the caller), or no motion exists, or the motions are isolated twists
+    (at most ``max_solutions`` of them), each listed; see the module docstring."""
     problem = form.problem
     m = problem.n_contacts
     if problem.dimension != 2 or form.n_q != 3 or form.n_edges != 2 or not 0 < m <= ARRANGEMENT_CONTACTS:
@@ -191,8 +226,7 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None) -> VertexProof:
     excluded = _Exclusions.of(planes.loads, problem.g)
     vertices = _vertices(planes)
     if excluded.every_load():  # no forces balance the load at all, whatever the twist
-        admissible = vertices is not None and _admissible(planes, vertices)
-        return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False, admissible=admissible)
+        return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False, admissible=_admissible(planes, vertices))
     if vertices is None:
         return _UNDECIDED  # the normals do not span R^3: every motion lies on a line of motions
     held = np.flatnonzero(~excluded.excludes(_load_masks(planes, vertices.signs)))
@@ -201,11 +235,19 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None) -> VertexProof:
             return _UNDECIDED  # a checked motion, yet every vertex excluded: too close to call
         return VertexProof(VertexVerdict.NONE, excluded.equilibrium(), vertices.count, admissible=_admissible(planes, vertices))
     seed_x = seed_x if seed_x is not None else _vertex_point(form, planes, vertices, held)
-    if seed_x is None or not _near_seed(vertices, held, seed_x[:3]):
+    if seed_x is not None and _near_seed(vertices, held, seed_x[:3]):  # one motion, if no edge leaves it
+        if not _edges_excluded(planes, vertices, held, excluded):
+            return _UNDECIDED
+        return VertexProof(VertexVerdict.UNIQUE, None, vertices.count, seed_x)
+    clusters = _clusters(vertices, held)
+    if len(clusters) == 1:
+        return _UNDECIDED  # one group, not near its motion: too close to call
+    if max_solutions is not None and len(clusters) > max_solutions:
+        return _UNDECIDED  # more motions than asked for: the branch and bound (and SCIP) say so
+    motions = _listed(form, planes, vertices, clusters, seed_x)
+    if motions is None or not _edges_excluded(planes, vertices, held, excluded, _apart(vertices, clusters)):
         return _UNDECIDED
-    if not _edges_excluded(planes, vertices.signs[held], excluded):
-        return _UNDECIDED
-    return VertexProof(VertexVerdict.UNIQUE, None, vertices.count, seed_x)
+    return VertexProof(VertexVerdict.ENUMERATED, None, vertices.count, motions[0], motions)
 
 
 def _planes(J: np.ndarray, b: np.ndarray, mu: np.ndarray) -> _Planes:
@@ -253,15 +295,15 @@ _EPSILON = _levi_civita()
 class _Vertices:
     """The vertices ``w`` (V, 3) of the independent triples whose gap rows are not below their margin; ``signs``
     (V, P): each plane's sign there, 0 where it is near (see the module docstring) at ``tau = LP_FEASIBILITY``;
-    ``spread`` (V, 3): ``|N_T^-1|_1`` per twist entry, and ``slack`` (V,) the triple's own round-off (of its rows
-    at ``w``, and of the exact vertex's rows)."""
+    ``margin`` (V, P): how near a plane's row must be to 0 for that; ``spread`` (V, 3): ``|N_T^-1|_1`` per twist entry,
+    and ``slack`` (V,) the triple's own round-off (of its rows at ``w``, and of the exact vertex's rows)."""
 
     w: np.ndarray
     signs: np.ndarray
+    margin: np.ndarray
     spread: np.ndarray
     slack: np.ndarray
     count: int
-    triples: np.ndarray  # (V, 3): each vertex's planes
 
 
 @functools.cache
@@ -301,7 +343,7 @@ def _vertices(planes: _Planes) -> _Vertices | None:
     signs = (rows > near).view(np.int8) - (rows < -near).view(np.int8)
     kept = (signs[:m] >= 0).all(axis=0)  # loose Q0
     spread = np.abs(planes.flat_crosses[columns[:, kept]]).sum(axis=0) / np.abs(det[kept, None])  # sum_k |N_T^-1[j, k]|
-    return _Vertices(w[kept], signs[:, kept].T, spread, slack[kept], int(det.size), triples[kept])
+    return _Vertices(w[kept], signs[:, kept].T, near[:, kept].T, spread, slack[kept], int(det.size))
 
 
 def _load_masks(planes: _Planes, signs: np.ndarray) -> np.ndarray:
@@ -401,21 +443,26 @@ def _vertex_point(form: LCPForm, planes: _Planes, vertices: _Vertices, held: np.
     return x if satisfies_form(form, x) else None
 
 
-def _admissible(planes: _Planes, vertices: _Vertices) -> bool:
-    """Whether an exact vertex keeps every contact closed or opening, near enough for
-    :func:`~.diagnose.admits_no_multipliers`. Its own triple's rows are 0 there; another gap row, computed at the
-    computed vertex ``w``, is off by its evaluation's round-off plus ``|n_p N_T^-1|_1`` times the triple's residual
-    (round-off of ``|n| |w|_1`` and the triple's offsets: 0 where both are, as at rest with still movers)."""
-    m, w = planes.m, vertices.w
-    gaps = planes.normals[:m] @ w.T - planes.rhs[:m, None]  # (m, V)
-    own = (vertices.triples[None, :, :] == np.arange(m)[:, None, None]).any(axis=2)  # (m, V): the triple's gap rows
-    size = np.abs(w).sum(axis=1)
-    residual = ARRANGEMENT_ROUNDOFF * (planes.longest * size + np.abs(planes.rhs[vertices.triples]).max(axis=1))
-    drift = math.sqrt(3.0) * planes.longest * vertices.spread.max(axis=1) * residual  # |n_p (w_T - w)|
-    evaluation = ARRANGEMENT_ROUNDOFF * (planes.longest * size + np.abs(planes.rhs[:m, None]))
-    opening = (own | (gaps >= drift + evaluation)).all(axis=0)
-    exact = np.where(own, 0.0, gaps + drift + evaluation)  # at most this at the exact vertex
-    return any(admits_no_multipliers(exact[:, v], w[v]) for v in np.flatnonzero(opening))
+def _admissible(planes: _Planes, vertices: _Vertices | None) -> bool:
+    """Whether a computed vertex ``w``, or else the least-squares twist of the gap rows (where the normals do not span
+    R^3 there are no vertices), meets every gap row near enough to rule out every kinematic certificate
+    (:func:`~.diagnose.admits_no_multipliers`)."""
+    if vertices is not None and vertices.w.shape[0] and _admits(planes, vertices.w):
+        return True
+    m = planes.m
+    return _admits(planes, np.linalg.lstsq(planes.normals[:m], planes.rhs[:m])[0][None, :])
+
+
+def _admits(planes: _Planes, twists: np.ndarray) -> bool:
+    """:func:`~.diagnose.admits_no_multipliers` for the one of ``twists`` (V, 3) least below a gap row: each twist is
+    a point of its own, whose gap rates are known to their evaluation's round-off ``ARRANGEMENT_ROUNDOFF (|n| |w|_1 +
+    |r|)``, and may fall below 0 by round-off only."""
+    m = planes.m
+    normals, rhs = planes.normals[:m], planes.rhs[:m]
+    gaps = normals @ twists.T - rhs[:, None]  # (m, V)
+    error = ARRANGEMENT_ROUNDOFF * (planes.longest * np.abs(twists).sum(axis=1) + np.abs(rhs[:, None]))
+    best = int(np.argmin((error - gaps).max(axis=0)))
+    return admits_no_multipliers(gaps[:, best], twists[best], error[:, best])
 
 
 def _near_seed(vertices: _Vertices, held: np.ndarray, q: np.ndarray) -> bool:
@@ -426,23 +473,92 @@ def _near_seed(vertices: _Vertices, held: np.ndarray, q: np.ndarray) -> bool:
     return bool((reach.max(axis=(1, 2)) <= _WITHIN).all())
 
 
-def _edges_excluded(planes: _Planes, signs: np.ndarray, excluded: _Exclusions) -> bool:
-    """Whether every ray leaving the vertices not excluded (each a sign vector, 0 on its near planes), along a
-    line where two near planes meet and kept in loose ``Q0``, has its loads excluded. A rate along a plane within
-    round-off of the longest normals' (``ARRANGEMENT_ROUNDOFF`` of their cube) is taken as 0: it only adds loads."""
+def _edges_excluded(planes: _Planes, vertices: _Vertices, held: np.ndarray, excluded: _Exclusions, apart: float | None = None) -> bool:
+    """Whether every ray leaving the vertices ``held`` (each a sign vector, 0 on its near planes), along a line where
+    two near planes meet and kept in loose ``Q0``, has its loads excluded. A rate along a plane within round-off of
+    the longest normals' (``ARRANGEMENT_ROUNDOFF`` of their cube) is taken as 0: it only adds loads.
+
+    With ``apart`` (several motions, their vertices at least this far apart): a rate along a near plane ``p`` below
+    ``2 margin_p / apart`` per unit length is taken as 0 too, so that every edge of a loose cell from one motion's
+    vertices to another's is held by a ray checked here (see the module docstring); ``apart <= 0`` proves nothing."""
+    if apart is not None and apart <= 0.0:
+        return False
     P, m = planes.rhs.size, planes.m
+    signs = vertices.signs[held]
     masks = []
-    for sign in {row.tobytes(): row for row in signs}.values():
+    for key, sign in _by_sign(signs):
         near = np.flatnonzero(sign == 0)
         i, j = _pairs(near.size)
         pair = near[i] * P + near[j]
         lines = planes.flat_crosses[pair]
-        pair = pair[np.einsum("lj,lj->l", lines, lines) > planes.dependent**2 / planes.longest**2]  # not parallel
+        squares = np.einsum("lj,lj->l", lines, lines)
+        kept = squares > planes.dependent**2 / planes.longest**2  # not parallel
+        pair = pair[kept]
         along = planes.triple[near[:, None], pair].T  # (L, k): n_p . (n_a x n_b), p near
-        along[np.abs(along) <= planes.dependent] = 0.0
+        zero: np.ndarray | float = planes.dependent
+        if apart is not None:
+            rate = 2.0 * vertices.margin[held[key]][:, near].max(axis=0) / apart  # (k,): per unit length
+            zero = np.maximum(planes.dependent, np.sqrt(squares[kept])[:, None] * rate[None, :])
+        along[np.abs(along) <= zero] = 0.0
         rays = np.concatenate((along, -along))
         rays = rays[(rays[:, near < m] >= 0.0).all(axis=1)]  # no near gap row falls along it
         ray_signs = np.repeat(sign[None, :], rays.shape[0], axis=0)
         ray_signs[:, near] = np.sign(rays)
         masks.append(_load_masks(planes, ray_signs))
     return bool(excluded.excludes(np.concatenate(masks)).all())
+
+
+def _by_sign(signs: np.ndarray) -> list[tuple[list[int], np.ndarray]]:
+    """The distinct rows of ``signs``, each with the indices of the rows equal to it."""
+    groups: dict[bytes, tuple[list[int], np.ndarray]] = {}
+    for k, row in enumerate(signs):
+        groups.setdefault(row.tobytes(), ([], row))[0].append(k)
+    return list(groups.values())
+
+
+def _clusters(vertices: _Vertices, held: np.ndarray) -> list[np.ndarray]:
+    """The vertices ``held`` grouped by twist, best computed (least ``|N_T^-1|_1``) first: each joins the first group
+    whose first vertex is within ``DISTINCT_TWIST`` of it (each group is checked against its motion by
+    :func:`_near_seed`, and the groups' separation by :func:`_apart`)."""
+    order = held[np.argsort(vertices.spread[held].max(axis=1), kind="stable")]
+    heads: list[np.ndarray] = []
+    members: list[list[int]] = []
+    for v in order.tolist():
+        for head, group in zip(heads, members, strict=True):
+            if np.max(np.abs(vertices.w[v] - head)) <= DISTINCT_TWIST:
+                group.append(v)
+                break
+        else:
+            heads.append(vertices.w[v])
+            members.append([v])
+    return [np.array(group, dtype=np.intp) for group in members]
+
+
+def _listed(
+    form: LCPForm, planes: _Planes, vertices: _Vertices, clusters: list[np.ndarray], seed_x: np.ndarray | None
+) -> tuple[np.ndarray, ...] | None:
+    """One checked motion per group of vertices, every group's vertices near it (:func:`_near_seed`), the seed's
+    group first (with the seed itself), else None: too close to call."""
+    points: list[np.ndarray] = []
+    for cluster in clusters:
+        if seed_x is not None and _near_seed(vertices, cluster, seed_x[:3]):
+            points.insert(0, seed_x)
+            seed_x = None
+            continue
+        point = _vertex_point(form, planes, vertices, cluster)
+        if point is None or not _near_seed(vertices, cluster, point[:3]):
+            return None
+        points.append(point)
+    return None if seed_x is not None else tuple(points)  # a seed in no group: too close to call
+
+
+def _apart(vertices: _Vertices, clusters: list[np.ndarray]) -> float:
+    """How far apart (Euclidean) any two loose cell vertices near two different groups at least are: the least
+    distance between the groups' vertices, less each loose box's diagonal (``(tau + slack) |N_T^-1|_1`` per entry
+    at ``tau = LP_FEASIBILITY``)."""
+    radius = np.sqrt(3.0) * ((LP_FEASIBILITY + vertices.slack)[:, None] * vertices.spread).max(axis=1)
+    least = math.inf
+    for a, b in itertools.combinations(clusters, 2):
+        distance = np.linalg.norm(vertices.w[a][:, None, :] - vertices.w[b][None, :, :], axis=2)
+        least = min(least, float((distance - radius[a][:, None] - radius[b][None, :]).min()))
+    return least

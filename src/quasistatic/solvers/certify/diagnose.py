@@ -16,7 +16,7 @@ import numpy as np
 from ...laws import Problem
 from ...laws.polyhedral import edge_jacobian, force_polytope
 from ...solution import Certificate, CertificateKind, Diagnosis, Later, Status
-from ...tolerances import LP_FEASIBILITY
+from ...tolerances import KINEMATIC_MULTIPLIERS, LP_FEASIBILITY
 from ..numerics.highs import solve_lp
 from ..result import BackendResult
 
@@ -59,24 +59,34 @@ def no_motion(diagnosis: Diagnosis, certificate: Certificate) -> BackendResult:
 
 
 def kinematic_certificate(problem: Problem) -> np.ndarray | None:
-    """Multipliers y >= 0 with Jn^T y = 0, bn.y = 1 (proof of infeasibility), or None."""
+    """Multipliers y >= 0 with Jn^T y = 0, bn.y = 1 (proof of infeasibility), or None.
+
+    Accepted when they meet every row and ``y >= 0`` to ``LP_FEASIBILITY`` with ``|y|_1`` at most
+    ``KINEMATIC_MULTIPLIERS``: larger ones only say that every twist misses a gap row by round-off."""
     Jn, bn = problem.Jn, problem.bn
     m, n = Jn.shape
     A = np.vstack([Jn.T, bn[None, :]])
     rhs = np.r_[np.zeros(n), 1.0]
     lp = solve_lp(np.zeros(m), A, rhs, rhs, np.zeros(m))
-    if lp.status == "optimal" and np.max(np.abs(A @ lp.x - rhs), initial=0.0) <= LP_FEASIBILITY:
-        return lp.x
-    return None
+    if lp.status != "optimal" or np.max(np.abs(A @ lp.x - rhs), initial=0.0) > LP_FEASIBILITY:
+        return None
+    if np.min(lp.x, initial=0.0) < -LP_FEASIBILITY or np.abs(lp.x).sum() > KINEMATIC_MULTIPLIERS:
+        return None
+    return lp.x
 
 
-def admits_no_multipliers(gaps: np.ndarray, q: np.ndarray) -> bool:
-    """Whether a twist ``q`` whose gap rates ``gaps = Jn q - bn`` are all non-negative rules out every kinematic
-    certificate :func:`kinematic_certificate` accepts: such ``y >= -LP_FEASIBILITY`` meets ``|Jn^T y| <= LP_FEASIBILITY``
-    and ``bn.y >= 1 - LP_FEASIBILITY``, so ``-LP_FEASIBILITY sum(gaps) <= y.gaps = (Jn^T y).q - bn.y <=
-    LP_FEASIBILITY |q|_1 - 1 + LP_FEASIBILITY``, impossible while ``LP_FEASIBILITY (|q|_1 + sum(gaps) + 1) < 1``
-    (asked here with a factor 2 to spare)."""
-    return bool(np.all(gaps >= 0.0) and LP_FEASIBILITY * (np.abs(q).sum() + gaps.sum() + 1.0) < 0.5)
+def admits_no_multipliers(gaps: np.ndarray, q: np.ndarray, error: np.ndarray | float = 0.0) -> bool:
+    """Whether a twist ``q`` whose gap rates ``Jn q - bn`` lie within ``error`` of ``gaps`` rules out every kinematic
+    certificate :func:`kinematic_certificate` accepts.
+
+    Such ``y`` has ``y >= -LP_FEASIBILITY``, ``|y|_1 <= KINEMATIC_MULTIPLIERS``, ``|Jn^T y| <= LP_FEASIBILITY`` and
+    ``bn.y >= 1 - LP_FEASIBILITY``. With ``hi = max(gaps + error, 0)`` and ``lo`` the largest ``error - gaps`` (how far
+    below 0 a gap rate may be), ``y.(Jn q - bn) >= -LP_FEASIBILITY sum(hi) - KINEMATIC_MULTIPLIERS lo``, while it
+    equals ``(Jn^T y).q - bn.y <= LP_FEASIBILITY (|q|_1 + 1) - 1``: impossible while ``LP_FEASIBILITY (|q|_1 + sum(hi)
+    + 1) + KINEMATIC_MULTIPLIERS lo < 1`` (asked here with a factor 2 to spare)."""
+    hi = np.maximum(gaps + error, 0.0)
+    lo = max(float(np.max(error - gaps, initial=0.0)), 0.0)
+    return bool(LP_FEASIBILITY * (np.abs(q).sum() + hi.sum() + 1.0) + KINEMATIC_MULTIPLIERS * lo < 0.5)
 
 
 def equilibrium_exists(problem: Problem, edges: np.ndarray) -> bool:
@@ -151,8 +161,8 @@ def diagnose(
     no equilibrium with the outer cones proves none with the exact ones. ``equilibrium``: whether
     one exists in the inner cones, when the caller has decided it (the planar branch and bound's
     root: a balancing fit, or a checked Farkas vector); None runs the LP. ``admissible``: the caller
-    holds a twist ``q`` with ``Jn q >= bn`` and ``LP_FEASIBILITY (|q|_1 + sum(Jn q - bn) + 1) < 1/2``
-    (:func:`admits_no_multipliers`); then no multipliers pass the kinematic check, and its LP is not run.
+    holds a twist ``q`` whose gap rates ``Jn q - bn`` rule out every multipliers the kinematic check accepts
+    (:func:`admits_no_multipliers`: none below round-off); then its LP is not run.
     """
     multipliers = None if admissible else kinematic_certificate(problem)
     if multipliers is not None:
