@@ -204,3 +204,17 @@ def _mutations(tree: ast.Module, names: set[str]) -> Iterator[str]:
         call = isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and isinstance(node.func.value, ast.Name)
         if call and node.func.value.id in names and node.func.attr in mutators:  # type: ignore[attr-defined]
             yield f"{node.func.value.id}.{node.func.attr}(...)"  # type: ignore[attr-defined]
+
+
+def test_no_merge_conflict_markers_are_left_in_the_sources_or_docs() -> None:
+    """A merge resolved by hand once left its markers in CHANGELOG.md for a whole session."""
+    root = Path(__file__).resolve().parents[1]
+    files = [*root.glob("*.md"), *root.glob("docs/**/*.md"), *root.glob("src/**/*.py"), *root.glob("tests/**/*.py")]
+    markers = ("<" * 7 + " ", "=" * 7 + "\n", ">" * 7 + " ")
+    left = [
+        f"{path.relative_to(root)}:{number}"
+        for path in files
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(keepends=True), 1)
+        if line.startswith(markers)
+    ]
+    assert len(files) > 50 and not left, left
