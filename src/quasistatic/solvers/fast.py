@@ -16,21 +16,45 @@ with the contact modes of the current motion (:mod:`quasistatic.laws.fixed_modes
 force turns negative, closing one that would penetrate); that answer is kept
 only if every inequality holds, else re-alignment goes on.
 
-What it proves: nothing. It finds one motion, or reports ``failed`` (Lemke
-ended on a secondary ray or hit its pivot cap, or the exact-cone refinement
-did not converge) so that the caller can fall back to the certified search. A ray is
-no proof that no motion exists: Lemke's path reaches only solutions of index +1
-(``sgn det M_SS``), and some scenes' motions all have index -1 (docs/performance.md). It never
-reports jammed, unstable or ambiguous, checks neither uniqueness nor force
-ranges, and cannot prescribe contact modes.
+Where Lemke cannot answer (a secondary ray, its pivot cap, or an exact-cone
+refinement that did not converge), a complete method takes over. A ray is no
+proof that no motion exists: Lemke's path reaches only solutions of index +1
+(``sgn det M_SS``), and some scenes' motions all have index -1 (docs/performance.md).
 
-Everything numeric runs in one kernel, compiled by numba when it is installed.
+- One planar body: a motion at a vertex of the contacts' gap-rate and slip
+  planes (:func:`~.certify.arrangement.motion_vertex`); where no vertex holds
+  one, the vertex certificate proves that no motion exists.
+- Otherwise (several bodies, 3-D), and where the vertices decide nothing: the
+  mode branch and bound (:mod:`.certify.patterns`) stopped at its first
+  motion, on the problem's own polyhedral laws (exact 3-D cones: the same
+  inscribed pyramid as Lemke's, then Newton's method on the exact cones from
+  its motion, as above); a closed tree proves that no motion exists.
+
+What it proves: nothing about the motions it finds, which are never claimed
+unique (no ambiguous either), and force ranges are not checked. When a
+complete method proves that no motion exists (a polyhedral friction model;
+an inscribed pyramid proves nothing for the exact cones), the answer is
+``jammed`` or ``unstable`` with that certificate (:func:`~.certify.diagnose.diagnose`).
+Otherwise ``failed`` says why, so that the caller can fall back to the
+certified search. Prescribed contact modes are not supported.
+
+Lemke's method and Newton's run in one kernel, compiled by numba when it is installed.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
+import numpy as np
+
 from ..laws import Problem, RawMotion
-from .numerics.lcp import FAST_EDGES, NOT_CONVERGED, lemke_motion
+from ..laws.polyhedral import aligned_edges, polyhedral_form
+from ..solution import Diagnosis
+from .certify.arrangement import NO_VERTEX_PROOF, VertexVerdict, motion_vertex, prove_by_vertices
+from .certify.diagnose import diagnose
+from .certify.patterns import NO_MOTION_PROOF, PatternVerdict, prove_by_patterns
+from .certify.search import enumerate_motions
+from .numerics.lcp import FAST_EDGES, NOT_CONVERGED, exact_newton, lemke_motion
 from .numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION
 from .result import BackendResult, Options
 
@@ -42,6 +66,10 @@ _EXACT_STAGES = (  # how an exact 3-D answer was reached, by the kernel's stage
     "pyramid edges re-aligned with the slips",
     "exact laws solved by Newton's method with the contact modes of the pyramid's motion",
 )
+# Inscribed pyramid of the exact cones' fallback (the certified search's): Newton failed from 6 edges' motions on grasp-3d 8 #0.
+FALLBACK_EDGES = 8
+_NOT_EXACT = "no motion of the pyramid converged to the exact cones by Newton's method"
+_EXACT_FROM_PYRAMID = "exact laws solved by Newton's method with the contact modes of the branch and bound's pyramid motion"
 
 
 def solve_fast(problem: Problem, options: Options) -> BackendResult:
@@ -64,20 +92,86 @@ def solve_fast(problem: Problem, options: Options) -> BackendResult:
         return BackendResult("failed", "failed: the fast path (Lemke's method) cannot prescribe contact modes", certified=False)
     status, stage, q, c, pivots, realignments = lemke_motion(problem)
     if status != SOLUTION:
-        return _failed(int(status), int(stage), int(pivots))
+        return _complete_fallback(problem, options, _why_lemke_failed(int(status), int(stage), int(pivots)))
     notes: tuple[tuple[str, object], ...] = (("method", "lemke"), ("pivots", int(pivots)), ("realignments", int(realignments)))
     if problem.dimension == 3 and not problem.friction.is_polyhedral(3):
         notes += (("exact_cone", _EXACT_STAGES[int(stage)]),)
     return BackendResult("solved", _SOLVED, (RawMotion(q, c),), certified=False, notes=notes)
 
 
-def _failed(status: int, stage: int, pivots: int) -> BackendResult:
+def _complete_fallback(problem: Problem, options: Options, lemke: str) -> BackendResult:
+    """Where Lemke's method found nothing: one motion by a complete method, or its proof that none exists."""
+    options = options.start_clock()
+    exact = problem.dimension == 3 and not problem.friction.is_polyhedral(3)
+    edges = aligned_edges(problem, FALLBACK_EDGES if exact else problem.friction.edges)
+    form = polyhedral_form(problem, edges)
+    notes: tuple[tuple[str, object], ...] = (("lemke", lemke),)
+    point = motion_vertex(form)
+    if point is not None:
+        return _found(RawMotion(point[: form.n_q], form.forces(point)), notes + (("method", "arrangement vertex"),))
+    vertices = prove_by_vertices(form, None)
+    if vertices.verdict is VertexVerdict.NONE:
+        verdict = diagnose(problem, edges, equilibrium=vertices.equilibrium, admissible=vertices.admissible)
+        return verdict.with_notes(certificate=NO_VERTEX_PROOF, lemke=lemke)
+    accept = _Acceptance(problem, exact)
+    proof = prove_by_patterns(form, None, remaining=options.remaining, stop_at=accept)
+    if proof.verdict is PatternVerdict.FOUND and accept.motion is not None:
+        return _found(accept.motion, notes + (("method", "mode branch and bound"), *accept.notes))
+    if proof.verdict is PatternVerdict.NONE:
+        return _no_motion(problem, edges, exact, proof.equilibrium, lemke, NO_MOTION_PROOF)
+    if proof.verdict is not PatternVerdict.UNDECIDED:
+        return _failed(f"{lemke}; {_NOT_EXACT}")
+    motions, complete = enumerate_motions(form, dataclasses.replace(options, max_solutions=1))
+    if motions and accept(motions[0]) and accept.motion is not None:
+        return _found(accept.motion, notes + (("method", "SCIP search"), *accept.notes))
+    if complete and not motions:
+        return _no_motion(problem, edges, exact, None, lemke, "no motion found by the complete SCIP search")
+    return _failed(f"{lemke}; {_NOT_EXACT if motions else 'the complete search found no motion within its time limit'}")
+
+
+class _Acceptance:
+    """Which motion of the fallback's polyhedral laws answers: any (polyhedral friction), or on exact 3-D cones
+    one from which Newton's method converges to the exact laws (``motion`` then holds the exact motion)."""
+
+    def __init__(self, problem: Problem, exact: bool) -> None:
+        self.problem, self.exact = problem, exact
+        self.motion: RawMotion | None = None
+        self.notes: tuple[tuple[str, object], ...] = (("exact_cone", _EXACT_FROM_PYRAMID),) if exact else ()
+
+    def __call__(self, motion: RawMotion) -> bool:
+        if not self.exact:
+            self.motion = RawMotion(motion.q, motion.c)  # a continuum's inner point
+            return True
+        converged, q, c = exact_newton(self.problem, motion.q, motion.c)
+        if converged:
+            self.motion = RawMotion(q, c)
+        return bool(converged)
+
+
+def _no_motion(problem: Problem, edges: np.ndarray, exact: bool, equilibrium: bool | None, lemke: str, proof: str) -> BackendResult:
+    """The verdict of a complete search that found no motion: proven ``jammed`` or ``unstable``, except where an
+    inscribed pyramid cannot prove it for the exact cones (a wedge, or equilibrium too close to call): ``failed``."""
+    outer = edges / np.cos(np.pi / edges.shape[1]) if exact else None  # circumscribed: no equilibrium there, none in the circle
+    verdict = diagnose(problem, edges, outer, equilibrium=equilibrium)
+    if verdict.status == "failed" or (exact and verdict.diagnosis is Diagnosis.WEDGED):
+        return _failed(f"{lemke}; the inscribed {edges.shape[1]}-edge pyramid has no motion, which proves no jam of the exact cones")
+    return verdict.with_notes(certificate=proof, lemke=lemke)
+
+
+def _found(motion: RawMotion, notes: tuple[tuple[str, object], ...]) -> BackendResult:
+    """The fallback's motion, uncertified as the fast path's are."""
+    return BackendResult("solved", _SOLVED, (motion,), certified=False, notes=notes)
+
+
+def _why_lemke_failed(status: int, stage: int, pivots: int) -> str:
     when = " after re-aligning the pyramid edges" if stage else ""
-    why = {
-        RAY: f"Lemke's method ended on a secondary ray{when} ({pivots} pivots): no motion found "
-        "(there may be none, or only motions its path cannot reach)",
+    return {
+        RAY: f"Lemke's method ended on a secondary ray{when} ({pivots} pivots)",
         PIVOT_LIMIT: f"Lemke's method hit its pivot limit{when} ({pivots} pivots)",
         NOT_CONVERGED: "the pyramid's motion did not converge to one of the exact cones "
         "(edge re-alignment, then Newton's method with its contact modes)",
     }[status]
+
+
+def _failed(why: str) -> BackendResult:
     return BackendResult("failed", f"failed: {why} (fast path; the certified method can decide)", certified=False)
