@@ -174,3 +174,11 @@ def test_motion_vertex_none_where_no_motion_exists() -> None:
     """The toppling block has no motion (unstable): no vertex holds one."""
     problem = qs.assemble(qs.load_scene(ROOT / "examples" / "topple.yaml"))
     assert motion_vertex(polyhedral_form(problem, aligned_edges(problem, 2))) is None
+
+
+def test_first_solution_keeps_the_fast_paths_proven_jam() -> None:
+    """``certify=False``: a jam the fast path's fallback proves is the answer (no SCIP search after it)."""
+    scene = FAMILIES["grasp-2d"].make(4, 1)
+    first = qs.solve(scene, certify=False)
+    assert (first.status, first.method, first.certified, first.fallback) == ("jammed", "fast", True, ())
+    assert first.diagnosis is qs.solve(scene).diagnosis

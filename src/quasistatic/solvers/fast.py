@@ -26,15 +26,18 @@ proof that no motion exists: Lemke's path reaches only solutions of index +1
   one, the vertex certificate proves that no motion exists.
 - Otherwise (several bodies, 3-D), and where the vertices decide nothing: the
   mode branch and bound (:mod:`.certify.patterns`) stopped at its first
-  motion, on the problem's own polyhedral laws (exact 3-D cones: the same
-  inscribed pyramid as Lemke's, then Newton's method on the exact cones from
-  its motion, as above); a closed tree proves that no motion exists.
+  motion, on the problem's own polyhedral laws (exact 3-D cones: an inscribed
+  8-edge pyramid, and the first of its motions from which Newton's method, as
+  above, converges to the exact cones); a closed tree proves that no motion
+  exists. Past the branch and bound's node budget, SCIP's complete search
+  (:func:`~.certify.search.enumerate_motions`) stopped at its first motion.
 
 What it proves: nothing about the motions it finds, which are never claimed
 unique (no ambiguous either), and force ranges are not checked. When a
-complete method proves that no motion exists (a polyhedral friction model;
-an inscribed pyramid proves nothing for the exact cones), the answer is
-``jammed`` or ``unstable`` with that certificate (:func:`~.certify.diagnose.diagnose`).
+complete method proves that no motion exists, the answer is ``jammed`` or
+``unstable`` with that certificate (:func:`~.certify.diagnose.diagnose`); on
+exact 3-D cones only where the pyramid's proof holds for the circle (a
+kinematic jam, or no equilibrium even in the circumscribed pyramid), never a wedge.
 Otherwise ``failed`` says why, so that the caller can fall back to the
 certified search. Prescribed contact modes are not supported.
 
@@ -73,20 +76,21 @@ _EXACT_FROM_PYRAMID = "exact laws solved by Newton's method with the contact mod
 
 
 def solve_fast(problem: Problem, options: Options) -> BackendResult:
-    """One motion satisfying the laws, by Lemke's method; ``failed`` when it finds none.
+    """One motion satisfying the laws, by Lemke's method, else by the complete fallback (module docstring).
 
     Parameters
     ----------
     problem : Problem
         Scene-relative contact laws; any friction model (2-D, 3-D pyramid, 3-D exact).
     options : Options
-        Only ``modes`` is read: prescribed modes are not supported (``failed``).
+        ``modes``: prescribed modes are not supported (``failed``); ``time_limit``: the fallback's searches.
 
     Returns
     -------
     BackendResult
         ``solved`` with one motion (twist ``q`` (k n,), contact-frame forces
-        ``c`` (m, d)), not certified, or ``failed`` with the reason.
+        ``c`` (m, d)), not certified; ``jammed`` or ``unstable`` proven by the
+        fallback, with its certificate; or ``failed`` with the reason.
     """
     if options.modes is not None:
         return BackendResult("failed", "failed: the fast path (Lemke's method) cannot prescribe contact modes", certified=False)
