@@ -21,8 +21,9 @@ from quasistatic import Motion
 from quasistatic.laws import RawMotion
 from quasistatic.laws.polyhedral import LCPForm, aligned_edges, polyhedral_form
 from quasistatic.solvers.certify.arrangement import motion_vertex
-from quasistatic.solvers.certify.cheap import satisfies_form
+from quasistatic.solvers.certify.cheap import lemke_point, satisfies_form
 from quasistatic.solvers.certify.patterns import PatternVerdict, prove_by_patterns
+from quasistatic.solvers.numerics.lemke import RAY
 from quasistatic.tools.bench.families import FAMILIES
 from random_scenes import random_scene
 
@@ -182,3 +183,16 @@ def test_first_solution_keeps_the_fast_paths_proven_jam() -> None:
     first = qs.solve(scene, certify=False)
     assert (first.status, first.method, first.certified, first.fallback) == ("jammed", "fast", True, ())
     assert first.diagnosis is qs.solve(scene).diagnosis
+
+
+def test_a_hint_only_orders_the_branch_and_bound() -> None:
+    """grasp-3d 8 #1 on the fallback's 8-edge pyramid: ordered by where Lemke's path ended, the search proves the
+    same (its one motion, the same twist) as without."""
+    problem = qs.assemble(FAMILIES["grasp-3d"].make(8, 1))
+    form = polyhedral_form(problem, aligned_edges(problem, 8))
+    status, hint = lemke_point(form)
+    assert status == RAY
+    plain, hinted = prove_by_patterns(form, None), prove_by_patterns(form, None, hint_x=hint)
+    assert plain.verdict is hinted.verdict is PatternVerdict.UNIQUE
+    assert plain.seed is not None and hinted.seed is not None
+    assert np.allclose(plain.seed[: form.n_q], hinted.seed[: form.n_q], atol=1e-9)

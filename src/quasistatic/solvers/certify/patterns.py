@@ -593,6 +593,7 @@ def prove_by_patterns(
     remaining: Callable[[], float] | None = None,
     reuse: bool = True,
     stop_at: Callable[[RawMotion], bool] | None = None,
+    hint_x: np.ndarray | None = None,
 ) -> PatternProof:
     """Every motion of the polyhedral laws ``form`` (planar, two edges per contact, or a 3-D pyramid): whether
     each has the twist of ``seed_x`` (a point ``[q, cn, beta, lam]`` of it), or of a seed found on the way, or,
@@ -602,14 +603,17 @@ def prove_by_patterns(
     tried before a new one (False: each node's twists from all its rows, a new fit wherever the parent's uses a
     column taken away; the same proof, slower, for cross-checks). ``stop_at``: stop at the first motion a leaf
     holds that it accepts (``FOUND``, that motion alone, nothing proven about others; a 3-D continuum offers
-    one of its extremes); a closed tree proves as without it (``NONE`` without ``seed_x``)."""
+    one of its extremes); a closed tree proves as without it (``NONE`` without ``seed_x``). ``hint_x``: without
+    a seed, a point ``[q, cn, beta, lam]`` (no law checked: where Lemke's path ended) whose contacts and modes
+    are searched first, as a seed's are; it only orders the tree."""
     problem, n_q = form.problem, form.n_q
     planar = problem.dimension == 2
     if not planar and form.n_edges < 3:  # frictionless 3-D (no edges): its normals are no pyramid's columns
         return PatternProof(PatternVerdict.UNDECIDED, seed_x)
-    order = _order(problem, seed_x, n_q)
+    guide = seed_x if seed_x is not None else hint_x  # what orders the tree
+    order = _order(problem, guide, n_q)
     layout = _planar_layout(problem, order) if planar else _pyramid_layout(form, [order])
-    roots = layout.roots if planar or seed_x is None else _seed_modes_first(layout, form, seed_x)
+    roots = layout.roots if planar or guide is None else _seed_modes_first(layout, form, guide)
     seed = None if seed_x is None else seed_x[:n_q]
     budget = PATTERN_NODES if planar else PYRAMID_PATTERN_NODES
     width = 2 if planar else form.n_edges
