@@ -196,3 +196,15 @@ def test_a_hint_only_orders_the_branch_and_bound() -> None:
     assert plain.verdict is hinted.verdict is PatternVerdict.UNIQUE
     assert plain.seed is not None and hinted.seed is not None
     assert np.allclose(plain.seed[: form.n_q], hinted.seed[: form.n_q], atol=1e-9)
+
+
+def test_past_the_node_budget_scips_search_finds_the_motion(monkeypatch: pytest.MonkeyPatch) -> None:
+    """grasp-3d 8 #1 with the branch and bound held to 10 nodes: SCIP's search, stopped at its first motion,
+    gives the pyramid motion Newton's method carries to the exact cones, SCIP's own."""
+    from quasistatic.solvers.certify import patterns
+
+    monkeypatch.setattr(patterns, "PYRAMID_PATTERN_NODES", 10)
+    scene = FAMILIES["grasp-3d"].make(8, 1)
+    answer = qs.solve(scene, method="fast")
+    assert answer.status == "solved" and dict(answer.notes)["method"] == "SCIP search", answer.message
+    assert _agrees_with_scip(scene) == ("solved", "solved")
