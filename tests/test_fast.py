@@ -295,13 +295,16 @@ def test_no_motion_is_proven_by_the_fallback_where_lemke_ends_on_a_ray(name: str
     assert "secondary ray" in fast.details["lemke"] and "vertex certificate" in fast.details["certificate"]
 
 
-def test_no_motion_of_an_inscribed_pyramid_is_no_verdict_on_exact_cones() -> None:
-    """grasp-3d 4 #1 is jammed, but the fallback's 8-edge pyramid proves that only for itself: ``failed``."""
+def test_a_wedge_of_exact_cones_is_proven_by_the_sector_relaxation() -> None:
+    """grasp-3d 4 #1 is jammed (a wedge); the fallback's 8-edge pyramid proves that only for itself, so the
+    exact cones' sector relaxation is proven infeasible before the fast path says ``jammed``."""
     from quasistatic.tools.bench.families import grasp_3d
 
-    fast = qs.solve(grasp_3d(4, 1), method="fast")
-    assert fast.status == "failed" and not fast.certified
-    assert "secondary ray" in fast.message and "proves no jam of the exact cones" in fast.message
+    problem = qs.assemble(grasp_3d(4, 1))
+    fast = qs.solve(problem, method="fast")
+    assert fast.status == "jammed" and fast.certified and fast.diagnosis is qs.Diagnosis.WEDGED, fast.message
+    assert "slip sectors" in fast.details["certificate"] and "secondary ray" in fast.details["lemke"]
+    assert qs.solve(problem, method="scip").status == "jammed"
 
 
 @pytest.mark.parametrize("name", ["examples/two_finger_lift.yaml", "examples/squeeze.yaml", "examples/box_push_3d.yaml"])

@@ -35,9 +35,11 @@ proof that no motion exists: Lemke's path reaches only solutions of index +1
 What it proves: nothing about the motions it finds, which are never claimed
 unique (no ambiguous either), and force ranges are not checked. When a
 complete method proves that no motion exists, the answer is ``jammed`` or
-``unstable`` with that certificate (:func:`~.certify.diagnose.diagnose`); on
-exact 3-D cones only where the pyramid's proof holds for the circle (a
-kinematic jam, or no equilibrium even in the circumscribed pyramid), never a wedge.
+``unstable`` with that certificate (:func:`~.certify.diagnose.diagnose`). On
+exact 3-D cones the pyramid's proof holds for the circle for a kinematic jam,
+or no equilibrium even in the circumscribed pyramid; a wedge is proven by the
+exact cones' sector relaxation (:mod:`.certify.wedge`), whose points are tried
+as starts of Newton's method.
 Otherwise ``failed`` says why, so that the caller can fall back to the
 certified search. Prescribed contact modes are not supported.
 
@@ -52,12 +54,13 @@ import numpy as np
 
 from ..laws import Problem, RawMotion
 from ..laws.polyhedral import aligned_edges, polyhedral_form
-from ..solution import Diagnosis
+from ..solution import Certificate, CertificateKind, Diagnosis
 from .certify.arrangement import NO_VERTEX_PROOF, VertexVerdict, motion_vertex, prove_by_vertices
 from .certify.cheap import lemke_point
-from .certify.diagnose import diagnose
+from .certify.diagnose import diagnose, no_motion
 from .certify.patterns import NO_MOTION_PROOF, PatternVerdict, prove_by_patterns
 from .certify.search import enumerate_motions
+from .certify.wedge import exact_cones_jam
 from .numerics.lcp import FAST_EDGES, NOT_CONVERGED, exact_newton, lemke_motion
 from .numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION
 from .result import BackendResult, Options
@@ -72,6 +75,7 @@ _EXACT_STAGES = (  # how an exact 3-D answer was reached, by the kernel's stage
 )
 # Inscribed pyramid of the exact cones' fallback (the certified search's): Newton failed from 6 edges' motions on grasp-3d 8 #0.
 FALLBACK_EDGES = 8
+_EXACT_FROM_RELAXATION = "exact laws solved by Newton's method from a point of the exact cones' sector relaxation"
 _NOT_EXACT = "no motion of the pyramid converged to the exact cones by Newton's method"
 _EXACT_FROM_PYRAMID = "exact laws solved by Newton's method with the contact modes of the branch and bound's pyramid motion"
 
@@ -124,14 +128,14 @@ def _complete_fallback(problem: Problem, options: Options, lemke: str) -> Backen
     if proof.verdict is PatternVerdict.FOUND and accept.motion is not None:
         return _found(accept.motion, notes + (("method", "mode branch and bound"), *accept.notes))
     if proof.verdict is PatternVerdict.NONE:
-        return _no_motion(problem, edges, exact, proof.equilibrium, lemke, NO_MOTION_PROOF)
+        return _no_motion(problem, options, edges, exact, proof.equilibrium, lemke, NO_MOTION_PROOF)
     if proof.verdict is not PatternVerdict.UNDECIDED:
         return _failed(f"{lemke}; {_NOT_EXACT}")
     motions, complete = enumerate_motions(form, dataclasses.replace(options, max_solutions=1))
     if motions and accept(motions[0]) and accept.motion is not None:
         return _found(accept.motion, notes + (("method", "SCIP search"), *accept.notes))
     if complete and not motions:
-        return _no_motion(problem, edges, exact, None, lemke, "no motion found by the complete SCIP search")
+        return _no_motion(problem, options, edges, exact, None, lemke, "no motion found by the complete SCIP search")
     return _failed(f"{lemke}; {_NOT_EXACT if motions else 'the complete search found no motion within its time limit'}")
 
 
@@ -154,14 +158,39 @@ class _Acceptance:
         return bool(converged)
 
 
-def _no_motion(problem: Problem, edges: np.ndarray, exact: bool, equilibrium: bool | None, lemke: str, proof: str) -> BackendResult:
-    """The verdict of a complete search that found no motion: proven ``jammed`` or ``unstable``, except where an
-    inscribed pyramid cannot prove it for the exact cones (a wedge, or equilibrium too close to call): ``failed``."""
+def _no_motion(
+    problem: Problem, options: Options, edges: np.ndarray, exact: bool, equilibrium: bool | None, lemke: str, proof: str
+) -> BackendResult:
+    """The verdict of a complete search that found no motion: proven ``jammed`` or ``unstable``. On exact cones
+    an inscribed pyramid's proof holds for a kinematic jam, or no equilibrium even in the circumscribed pyramid;
+    a wedge needs its own proof (:func:`_exact_wedge`); equilibrium too close to call: ``failed``."""
     outer = edges / np.cos(np.pi / edges.shape[1]) if exact else None  # circumscribed: no equilibrium there, none in the circle
     verdict = diagnose(problem, edges, outer, equilibrium=equilibrium)
-    if verdict.status == "failed" or (exact and verdict.diagnosis is Diagnosis.WEDGED):
-        return _failed(f"{lemke}; the inscribed {edges.shape[1]}-edge pyramid has no motion, which proves no jam of the exact cones")
+    if exact and verdict.diagnosis is Diagnosis.WEDGED:
+        return _exact_wedge(problem, options, lemke)
+    if verdict.status == "failed":
+        return _failed(f"{lemke}; the pyramid has no motion, and whether the exact cones admit an equilibrium is too close to call")
     return verdict.with_notes(certificate=proof, lemke=lemke)
+
+
+def _exact_wedge(problem: Problem, options: Options, lemke: str) -> BackendResult:
+    """The inscribed pyramid wedges: proven for the exact cones by the sector relaxation (:mod:`.certify.wedge`), or
+    a relaxed point from which Newton's method reaches an exact motion (the relaxation then stops), else ``failed``."""
+    found: list[RawMotion] = []
+
+    def is_motion(q: np.ndarray) -> bool:
+        converged, q_exact, c_exact = exact_newton(problem, q, np.zeros((problem.n_contacts, 3)))
+        if converged:
+            found.append(RawMotion(q_exact, c_exact))
+        return bool(converged)
+
+    proven, sectors, method = exact_cones_jam(problem, options, None, is_motion)
+    if proven:
+        text = f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; {method})"
+        return no_motion(Diagnosis.WEDGED, Certificate(CertificateKind.SECTOR_RELAXATION, text)).with_notes(lemke=lemke)
+    if found:
+        return _found(found[-1], (("lemke", lemke), ("method", "sector relaxation"), ("exact_cone", _EXACT_FROM_RELAXATION)))
+    return _failed(f"{lemke}; the inscribed pyramid wedges, and the exact cones' sector relaxation decided nothing")
 
 
 def _found(motion: RawMotion, notes: tuple[tuple[str, object], ...]) -> BackendResult:
