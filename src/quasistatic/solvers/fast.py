@@ -28,7 +28,8 @@ proof that no motion exists: Lemke's path reaches only solutions of index +1
   mode branch and bound (:mod:`.certify.patterns`) stopped at its first
   motion, on the problem's own polyhedral laws (exact 3-D cones: an inscribed
   8-edge pyramid, and the first of its motions from which Newton's method, as
-  above, converges to the exact cones); a closed tree proves that no motion
+  above, converges to the exact cones; where none does, or equilibrium is too
+  close to call, the same with 32 edges); a closed tree proves that no motion
   exists. Past the branch and bound's node budget, SCIP's complete search
   (:func:`~.certify.search.enumerate_motions`) stopped at its first motion.
 
@@ -73,10 +74,11 @@ _EXACT_STAGES = (  # how an exact 3-D answer was reached, by the kernel's stage
     "pyramid edges re-aligned with the slips",
     "exact laws solved by Newton's method with the contact modes of the pyramid's motion",
 )
-# Inscribed pyramid of the exact cones' fallback (the certified search's): Newton failed from 6 edges' motions on grasp-3d 8 #0.
-FALLBACK_EDGES = 8
+# Inscribed pyramids of the exact cones' fallback (the certified search's two): Newton failed from 6 edges'
+# motions on grasp-3d 8 #0; 32 where 8 leave it undecided (3 of 400 random 3-D scenes).
+FALLBACK_EDGES = (8, 32)
 _EXACT_FROM_RELAXATION = "exact laws solved by Newton's method from a point of the exact cones' sector relaxation"
-_NOT_EXACT = "no motion of the pyramid converged to the exact cones by Newton's method"
+_NOT_EXACT = "no motion of the 8- or 32-edge pyramid converged to the exact cones by Newton's method"
 _EXACT_FROM_PYRAMID = "exact laws solved by Newton's method with the contact modes of the branch and bound's pyramid motion"
 
 
@@ -109,10 +111,25 @@ def solve_fast(problem: Problem, options: Options) -> BackendResult:
 
 
 def _complete_fallback(problem: Problem, options: Options, lemke: str) -> BackendResult:
-    """Where Lemke's method found nothing: one motion by a complete method, or its proof that none exists."""
+    """Where Lemke's method found nothing: one motion by a complete method, or its proof that none exists.
+
+    Exact 3-D cones: the 8-edge pyramid first; where its motions do not converge to the exact cones, or whether
+    the exact cones admit an equilibrium is too close to call, the 32-edge pyramid (as the certified search).
+    """
     options = options.start_clock()
-    exact = problem.dimension == 3 and not problem.friction.is_polyhedral(3)
-    edges = aligned_edges(problem, FALLBACK_EDGES if exact else problem.friction.edges)
+    if problem.dimension == 2 or problem.friction.is_polyhedral(3):
+        return _on_pyramid(problem, options, lemke, problem.friction.edges, exact=False) or _failed(lemke)
+    for count in FALLBACK_EDGES:
+        result = _on_pyramid(problem, options, lemke, count, exact=True)
+        if result is not None:
+            return result
+    return _failed(f"{lemke}; {_NOT_EXACT}, or whether the exact cones admit an equilibrium was too close to call")
+
+
+def _on_pyramid(problem: Problem, options: Options, lemke: str, count: int, exact: bool) -> BackendResult | None:
+    """The fallback on the polyhedral laws with ``count`` edges (exact cones: an inscribed pyramid); None where a
+    finer pyramid may decide (exact cones only)."""
+    edges = aligned_edges(problem, count)
     form = polyhedral_form(problem, edges)
     notes: tuple[tuple[str, object], ...] = (("lemke", lemke),)
     point = motion_vertex(form)
@@ -126,17 +143,17 @@ def _complete_fallback(problem: Problem, options: Options, lemke: str) -> Backen
     hint = lemke_point(form)[1] if form.n_edges > 2 else None  # 3-D: where Lemke ended orders the tree (2x fewer nodes)
     proof = prove_by_patterns(form, None, remaining=options.remaining, stop_at=accept, hint_x=hint)
     if proof.verdict is PatternVerdict.FOUND and accept.motion is not None:
-        return _found(accept.motion, notes + (("method", "mode branch and bound"), *accept.notes))
+        return _found(accept.motion, notes + (("method", f"mode branch and bound ({count} edges)"), *accept.notes))
     if proof.verdict is PatternVerdict.NONE:
         return _no_motion(problem, options, edges, exact, proof.equilibrium, lemke, NO_MOTION_PROOF)
     if proof.verdict is not PatternVerdict.UNDECIDED:
-        return _failed(f"{lemke}; {_NOT_EXACT}")
+        return None  # pyramid motions, none of which Newton's method carried to the exact cones
     motions, complete = enumerate_motions(form, dataclasses.replace(options, max_solutions=1))
     if motions and accept(motions[0]) and accept.motion is not None:
-        return _found(accept.motion, notes + (("method", "SCIP search"), *accept.notes))
+        return _found(accept.motion, notes + (("method", f"SCIP search ({count} edges)"), *accept.notes))
     if complete and not motions:
         return _no_motion(problem, options, edges, exact, None, lemke, "no motion found by the complete SCIP search")
-    return _failed(f"{lemke}; {_NOT_EXACT if motions else 'the complete search found no motion within its time limit'}")
+    return None if motions else _failed(f"{lemke}; the complete search found no motion within its time limit")
 
 
 class _Acceptance:
@@ -160,16 +177,16 @@ class _Acceptance:
 
 def _no_motion(
     problem: Problem, options: Options, edges: np.ndarray, exact: bool, equilibrium: bool | None, lemke: str, proof: str
-) -> BackendResult:
+) -> BackendResult | None:
     """The verdict of a complete search that found no motion: proven ``jammed`` or ``unstable``. On exact cones
     an inscribed pyramid's proof holds for a kinematic jam, or no equilibrium even in the circumscribed pyramid;
-    a wedge needs its own proof (:func:`_exact_wedge`); equilibrium too close to call: ``failed``."""
+    a wedge needs its own proof (:func:`_exact_wedge`); equilibrium too close to call: None (a finer pyramid)."""
     outer = edges / np.cos(np.pi / edges.shape[1]) if exact else None  # circumscribed: no equilibrium there, none in the circle
     verdict = diagnose(problem, edges, outer, equilibrium=equilibrium)
     if exact and verdict.diagnosis is Diagnosis.WEDGED:
         return _exact_wedge(problem, options, lemke)
     if verdict.status == "failed":
-        return _failed(f"{lemke}; the pyramid has no motion, and whether the exact cones admit an equilibrium is too close to call")
+        return None  # equilibrium in the circumscribed pyramid, none in the inscribed: a finer one may decide
     return verdict.with_notes(certificate=proof, lemke=lemke)
 
 
