@@ -219,3 +219,12 @@ def test_exact_motions_the_8_edge_pyramid_misses(seed: int, method: str) -> None
     answer = qs.solve(scene, method="fast")
     assert answer.status == "solved" and method in dict(answer.notes)["method"], answer.message
     assert _agrees_with_scip(scene)[0] == "solved"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("chunk", range(20))
+def test_fast_never_fails_or_contradicts_scip_3d_sweep(chunk: int) -> None:
+    """400 more random 3-D scenes with exact cones (20 a chunk), where the 32-edge retry and the sector
+    relaxation's motions were found needed."""
+    for k in range(20):
+        _agrees_with_scip(random_scene(3, 7000 + 20 * chunk + k))
