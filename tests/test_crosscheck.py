@@ -12,7 +12,8 @@ fingertips, 2-D and 3-D, exact friction cones) is solved by
   claim ``solved`` with an audited motion); when ``scip`` says ``ambiguous``
   its motion must be one of those listed (or lie in a listed continuum);
 - ``fast`` (when registered): ``solved`` means its twist is one of ``scip``'s
-  motions; ``failed`` is allowed (it proves nothing and falls back).
+  motions; ``jammed`` or ``unstable`` (proven by its complete fallback) must be
+  ``scip``'s verdict; ``failed`` is allowed (it falls back).
 
 The default run takes 100 2-D and 30 3-D scenes; ``pytest -m slow`` sweeps
 500 more 2-D and 120 more 3-D ones. Two more tests: ``paper`` agrees with
@@ -114,6 +115,8 @@ def _crosscheck(dimension: int, seed: int) -> None:
             assert fast.motion is not None and fast.motion.audit.passed
             assert certified.status in ("solved", "ambiguous"), f"fast solved where scip says {certified.status}"
             assert _among(problem, _twist(problem, fast.motion), certified)
+        elif fast.status in ("jammed", "unstable"):  # proven by the fast path's complete fallback
+            assert fast.status == certified.status and fast.certified, f"fast: {fast.message}; scip: {certified.message}"
         else:
             assert fast.status == "failed", fast.message
 

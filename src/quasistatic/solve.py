@@ -60,7 +60,8 @@ def solve(
         solves frictionless scenes by LP and frictional ones by ``certified``
         (cheap certificates, then the certified search; ``scip`` with
         prescribed modes) or, with ``certify=False``, by the fast path first,
-        falling back to the certified search when it finds no audited motion.
+        falling back to the certified search when it finds no audited motion
+        and proves no ``jammed`` or ``unstable``.
     certify : bool
         True (default): ``solved`` means proven unique and ``ambiguous`` lists
         every motion. False: with ``method="auto"``, accept the first audited
@@ -123,9 +124,11 @@ def solve(
         result = _run(backend, problem, options) if reuse is None else _recalled_or_run(reuse, backend, problem, options)
         solution = _audited(problem, result, name, tolerance, options, tuple(tried), started)
         solution = _compliant(problem, solution, result, tolerance, options.time_limit)
-        # A certifying method's verdict stands unless the audit turned its motion down; the fast path's only when solved.
+        # A certifying method's verdict stands unless the audit turned its motion down; the fast path's when solved,
+        # or when it proved that no motion exists (its complete fallback's certified jammed/unstable).
         rejected = solution.status == "failed" and result.status != "failed"
-        if name == names[-1] or (not rejected if backend.certifies else solution.ok):
+        proven = backend.certifies or (solution.certified and solution.status in ("jammed", "unstable"))
+        if name == names[-1] or (not rejected if proven else solution.ok):
             return solution
         tried.append(Attempt(name, solution.message))
     raise AssertionError("unreachable: the last method always returns")

@@ -16,21 +16,53 @@ with the contact modes of the current motion (:mod:`quasistatic.laws.fixed_modes
 force turns negative, closing one that would penetrate); that answer is kept
 only if every inequality holds, else re-alignment goes on.
 
-What it proves: nothing. It finds one motion, or reports ``failed`` (Lemke
-ended on a secondary ray or hit its pivot cap, or the exact-cone refinement
-did not converge) so that the caller can fall back to the certified search. A ray is
-no proof that no motion exists: Lemke's path reaches only solutions of index +1
-(``sgn det M_SS``), and some scenes' motions all have index -1 (docs/performance.md). It never
-reports jammed, unstable or ambiguous, checks neither uniqueness nor force
-ranges, and cannot prescribe contact modes.
+Where Lemke cannot answer (a secondary ray, its pivot cap, or an exact-cone
+refinement that did not converge), a complete method takes over. A ray is no
+proof that no motion exists: Lemke's path reaches only solutions of index +1
+(``sgn det M_SS``), and some scenes' motions all have index -1 (docs/performance.md).
 
-Everything numeric runs in one kernel, compiled by numba when it is installed.
+- One planar body: a motion at a vertex of the contacts' gap-rate and slip
+  planes (:func:`~.certify.arrangement.motion_vertex`); where no vertex holds
+  one, the vertex certificate proves that no motion exists.
+- Otherwise (several bodies, 3-D), and where the vertices decide nothing: the
+  mode branch and bound (:mod:`.certify.patterns`) stopped at its first
+  motion, on the problem's own polyhedral laws (exact 3-D cones: an inscribed
+  8-edge pyramid, and the first of its motions from which Newton's method, as
+  above, converges to the exact cones; where none does, or equilibrium is too
+  close to call, the same with 32 edges); a closed tree proves that no motion
+  exists. Past the branch and bound's node budget, SCIP's complete search
+  (:func:`~.certify.search.enumerate_motions`) stopped at its first motion.
+
+What it proves: nothing about the motions it finds, which are never claimed
+unique (no ambiguous either), and force ranges are not checked. When a
+complete method proves that no motion exists, the answer is ``jammed`` or
+``unstable`` with that certificate (:func:`~.certify.diagnose.diagnose`). On
+exact 3-D cones the pyramid's proof holds for the circle for a kinematic jam,
+or no equilibrium even in the circumscribed pyramid; a wedge is proven by the
+exact cones' sector relaxation (:mod:`.certify.wedge`), whose points are tried
+as starts of Newton's method.
+Otherwise ``failed`` says why, so that the caller can fall back to the
+certified search. Prescribed contact modes are not supported.
+
+Lemke's method and Newton's run in one kernel, compiled by numba when it is installed.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
+import numpy as np
+
 from ..laws import Problem, RawMotion
-from .numerics.lcp import FAST_EDGES, NOT_CONVERGED, lemke_motion
+from ..laws.polyhedral import aligned_edges, polyhedral_form
+from ..solution import Certificate, CertificateKind, Diagnosis
+from .certify.arrangement import NO_VERTEX_PROOF, VertexVerdict, motion_vertex, prove_by_vertices
+from .certify.cheap import lemke_point
+from .certify.diagnose import diagnose, no_motion
+from .certify.patterns import NO_MOTION_PROOF, PatternVerdict, prove_by_patterns
+from .certify.search import enumerate_motions
+from .certify.wedge import exact_cones_jam
+from .numerics.lcp import FAST_EDGES, NOT_CONVERGED, exact_newton, lemke_motion
 from .numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION
 from .result import BackendResult, Options
 
@@ -42,42 +74,156 @@ _EXACT_STAGES = (  # how an exact 3-D answer was reached, by the kernel's stage
     "pyramid edges re-aligned with the slips",
     "exact laws solved by Newton's method with the contact modes of the pyramid's motion",
 )
+# Inscribed pyramids of the exact cones' fallback (the certified search's two): Newton failed from 6 edges'
+# motions on grasp-3d 8 #0; 32 where 8 leave it undecided (3 of 400 random 3-D scenes).
+FALLBACK_EDGES = (8, 32)
+_EXACT_FROM_RELAXATION = "exact laws solved by Newton's method from a point of the exact cones' sector relaxation"
+_NOT_EXACT = "no motion of the 8- or 32-edge pyramid converged to the exact cones by Newton's method"
+_EXACT_FROM_PYRAMID = "exact laws solved by Newton's method with the contact modes of the branch and bound's pyramid motion"
 
 
 def solve_fast(problem: Problem, options: Options) -> BackendResult:
-    """One motion satisfying the laws, by Lemke's method; ``failed`` when it finds none.
+    """One motion satisfying the laws, by Lemke's method, else by the complete fallback (module docstring).
 
     Parameters
     ----------
     problem : Problem
         Scene-relative contact laws; any friction model (2-D, 3-D pyramid, 3-D exact).
     options : Options
-        Only ``modes`` is read: prescribed modes are not supported (``failed``).
+        ``modes``: prescribed modes are not supported (``failed``); ``time_limit``: the fallback's searches.
 
     Returns
     -------
     BackendResult
         ``solved`` with one motion (twist ``q`` (k n,), contact-frame forces
-        ``c`` (m, d)), not certified, or ``failed`` with the reason.
+        ``c`` (m, d)), not certified; ``jammed`` or ``unstable`` proven by the
+        fallback, with its certificate; or ``failed`` with the reason.
     """
     if options.modes is not None:
         return BackendResult("failed", "failed: the fast path (Lemke's method) cannot prescribe contact modes", certified=False)
     status, stage, q, c, pivots, realignments = lemke_motion(problem)
     if status != SOLUTION:
-        return _failed(int(status), int(stage), int(pivots))
+        return _complete_fallback(problem, options, _why_lemke_failed(int(status), int(stage), int(pivots)))
     notes: tuple[tuple[str, object], ...] = (("method", "lemke"), ("pivots", int(pivots)), ("realignments", int(realignments)))
     if problem.dimension == 3 and not problem.friction.is_polyhedral(3):
         notes += (("exact_cone", _EXACT_STAGES[int(stage)]),)
     return BackendResult("solved", _SOLVED, (RawMotion(q, c),), certified=False, notes=notes)
 
 
-def _failed(status: int, stage: int, pivots: int) -> BackendResult:
+def _complete_fallback(problem: Problem, options: Options, lemke: str) -> BackendResult:
+    """Where Lemke's method found nothing: one motion by a complete method, or its proof that none exists.
+
+    Exact 3-D cones: the 8-edge pyramid first; where its motions do not converge to the exact cones, or whether
+    the exact cones admit an equilibrium is too close to call, the 32-edge pyramid (as the certified search).
+    """
+    options = options.start_clock()
+    if problem.dimension == 2 or problem.friction.is_polyhedral(3):
+        return _on_pyramid(problem, options, lemke, problem.friction.edges, exact=False) or _failed(lemke)
+    for count in FALLBACK_EDGES:
+        result = _on_pyramid(problem, options, lemke, count, exact=True)
+        if result is not None:
+            return result
+    return _failed(f"{lemke}; {_NOT_EXACT}, or whether the exact cones admit an equilibrium was too close to call")
+
+
+def _on_pyramid(problem: Problem, options: Options, lemke: str, count: int, exact: bool) -> BackendResult | None:
+    """The fallback on the polyhedral laws with ``count`` edges (exact cones: an inscribed pyramid); None where a
+    finer pyramid may decide (exact cones only)."""
+    edges = aligned_edges(problem, count)
+    form = polyhedral_form(problem, edges)
+    notes: tuple[tuple[str, object], ...] = (("lemke", lemke),)
+    point = motion_vertex(form)
+    if point is not None:
+        return _found(RawMotion(point[: form.n_q], form.forces(point)), notes + (("method", "arrangement vertex"),))
+    vertices = prove_by_vertices(form, None)
+    if vertices.verdict is VertexVerdict.NONE:
+        verdict = diagnose(problem, edges, equilibrium=vertices.equilibrium, admissible=vertices.admissible)
+        return verdict.with_notes(certificate=NO_VERTEX_PROOF, lemke=lemke)
+    accept = _Acceptance(problem, exact)
+    hint = lemke_point(form)[1] if form.n_edges > 2 else None  # 3-D: where Lemke ended orders the tree (2x fewer nodes)
+    proof = prove_by_patterns(form, None, remaining=options.remaining, stop_at=accept, hint_x=hint)
+    if proof.verdict is PatternVerdict.FOUND and accept.motion is not None:
+        return _found(accept.motion, notes + (("method", f"mode branch and bound ({count} edges)"), *accept.notes))
+    if proof.verdict is PatternVerdict.NONE:
+        return _no_motion(problem, options, edges, exact, proof.equilibrium, lemke, NO_MOTION_PROOF)
+    if proof.verdict is not PatternVerdict.UNDECIDED:
+        return None  # pyramid motions, none of which Newton's method carried to the exact cones
+    motions, complete = enumerate_motions(form, dataclasses.replace(options, max_solutions=1))
+    if motions and accept(motions[0]) and accept.motion is not None:
+        return _found(accept.motion, notes + (("method", f"SCIP search ({count} edges)"), *accept.notes))
+    if complete and not motions:
+        return _no_motion(problem, options, edges, exact, None, lemke, "no motion found by the complete SCIP search")
+    return None if motions else _failed(f"{lemke}; the complete search found no motion within its time limit")
+
+
+class _Acceptance:
+    """Which motion of the fallback's polyhedral laws answers: any (polyhedral friction), or on exact 3-D cones
+    one from which Newton's method converges to the exact laws (``motion`` then holds the exact motion)."""
+
+    def __init__(self, problem: Problem, exact: bool) -> None:
+        self.problem, self.exact = problem, exact
+        self.motion: RawMotion | None = None
+        self.notes: tuple[tuple[str, object], ...] = (("exact_cone", _EXACT_FROM_PYRAMID),) if exact else ()
+
+    def __call__(self, motion: RawMotion) -> bool:
+        if not self.exact:
+            self.motion = RawMotion(motion.q, motion.c)  # a continuum's inner point
+            return True
+        converged, q, c = exact_newton(self.problem, motion.q, motion.c)
+        if converged:
+            self.motion = RawMotion(q, c)
+        return bool(converged)
+
+
+def _no_motion(
+    problem: Problem, options: Options, edges: np.ndarray, exact: bool, equilibrium: bool | None, lemke: str, proof: str
+) -> BackendResult | None:
+    """The verdict of a complete search that found no motion: proven ``jammed`` or ``unstable``. On exact cones
+    an inscribed pyramid's proof holds for a kinematic jam, or no equilibrium even in the circumscribed pyramid;
+    a wedge needs its own proof (:func:`_exact_wedge`); equilibrium too close to call: None (a finer pyramid)."""
+    outer = edges / np.cos(np.pi / edges.shape[1]) if exact else None  # circumscribed: no equilibrium there, none in the circle
+    verdict = diagnose(problem, edges, outer, equilibrium=equilibrium)
+    if exact and verdict.diagnosis is Diagnosis.WEDGED:
+        return _exact_wedge(problem, options, lemke)
+    if verdict.status == "failed":
+        return None  # equilibrium in the circumscribed pyramid, none in the inscribed: a finer one may decide
+    return verdict.with_notes(certificate=proof, lemke=lemke)
+
+
+def _exact_wedge(problem: Problem, options: Options, lemke: str) -> BackendResult:
+    """The inscribed pyramid wedges: proven for the exact cones by the sector relaxation (:mod:`.certify.wedge`), or
+    a relaxed point from which Newton's method reaches an exact motion (the relaxation then stops), else ``failed``."""
+    found: list[RawMotion] = []
+
+    def is_motion(q: np.ndarray) -> bool:
+        converged, q_exact, c_exact = exact_newton(problem, q, np.zeros((problem.n_contacts, 3)))
+        if converged:
+            found.append(RawMotion(q_exact, c_exact))
+        return bool(converged)
+
+    proven, sectors, method = exact_cones_jam(problem, options, None, is_motion)
+    if proven:
+        text = f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; {method})"
+        return no_motion(Diagnosis.WEDGED, Certificate(CertificateKind.SECTOR_RELAXATION, text)).with_notes(lemke=lemke)
+    if found:
+        return _found(found[-1], (("lemke", lemke), ("method", "sector relaxation"), ("exact_cone", _EXACT_FROM_RELAXATION)))
+    return _failed(f"{lemke}; the inscribed pyramid wedges, and the exact cones' sector relaxation decided nothing")
+
+
+def _found(motion: RawMotion, notes: tuple[tuple[str, object], ...]) -> BackendResult:
+    """The fallback's motion, uncertified as the fast path's are."""
+    return BackendResult("solved", _SOLVED, (motion,), certified=False, notes=notes)
+
+
+def _why_lemke_failed(status: int, stage: int, pivots: int) -> str:
     when = " after re-aligning the pyramid edges" if stage else ""
-    why = {
-        RAY: f"Lemke's method ended on a secondary ray{when} ({pivots} pivots): no motion found "
-        "(there may be none, or only motions its path cannot reach)",
+    return {
+        RAY: f"Lemke's method ended on a secondary ray{when} ({pivots} pivots)",
         PIVOT_LIMIT: f"Lemke's method hit its pivot limit{when} ({pivots} pivots)",
         NOT_CONVERGED: "the pyramid's motion did not converge to one of the exact cones "
         "(edge re-alignment, then Newton's method with its contact modes)",
     }[status]
+
+
+def _failed(why: str) -> BackendResult:
     return BackendResult("failed", f"failed: {why} (fast path; the certified method can decide)", certified=False)

@@ -126,8 +126,8 @@ BACKENDS: dict[str, Backend] = {
             "fast",
             ".fast",
             "solve_fast",
-            "fast path: Lemke's method on the polyhedral LCP (numba), exact 3-D cones by re-aligned edges; "
-            "finds one motion, proves nothing",
+            "fast path: Lemke's method on the polyhedral LCP (numba), exact 3-D cones by re-aligned edges, "
+            "a complete method where Lemke ends on a ray; finds one motion, proves only that none exists",
             certifies=False,
         ),
     )

@@ -148,7 +148,15 @@ from ...tolerances import ARRANGEMENT_CONTACTS, ARRANGEMENT_ROUNDOFF, DISTINCT_T
 from .cheap import satisfies_form
 from .diagnose import admits_no_multipliers
 
-__all__ = ["VertexVerdict", "VertexProof", "prove_by_vertices", "VERTEX_PROOF", "NO_VERTEX_PROOF", "VERTEX_LISTING_PROOF"]
+__all__ = [
+    "VertexVerdict",
+    "VertexProof",
+    "prove_by_vertices",
+    "motion_vertex",
+    "VERTEX_PROOF",
+    "NO_VERTEX_PROOF",
+    "VERTEX_LISTING_PROOF",
+]
 
 VERTEX_PROOF = (
     "the found twist is the only motion vertex of the contacts' twist planes and no motion edge leaves it "
@@ -248,6 +256,30 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None, max_solutions: i
     if motions is None or not _edges_excluded(planes, vertices, held, excluded, _apart(vertices, clusters)):
         return _UNDECIDED
     return VertexProof(VertexVerdict.ENUMERATED, None, vertices.count, motions[0], motions)
+
+
+def motion_vertex(form: LCPForm) -> np.ndarray | None:
+    """One motion of the planar laws ``form`` at a vertex of the arrangement, as a point ``[q, cn, beta, lam]``
+    checked on every law of the form, or None (no vertex holds one that passes the check: the caller decides).
+
+    For the fast path, which wants any motion: the vertices not excluded are tried best computed first (least
+    ``|N_T^-1|_1``). No uniqueness is claimed; when the normals span R^3 every motion face has a motion vertex.
+    """
+    problem = form.problem
+    m = problem.n_contacts
+    if problem.dimension != 2 or form.n_q != 3 or form.n_edges != 2 or not 0 < m <= ARRANGEMENT_CONTACTS:
+        return None
+    planes = _planes(problem.J, problem.b, problem.mu)
+    excluded = _Exclusions.of(planes.loads, problem.g)
+    vertices = None if excluded.every_load() else _vertices(planes)
+    if vertices is None:
+        return None
+    held = np.flatnonzero(~excluded.excludes(_load_masks(planes, vertices.signs)))
+    for vertex in held[np.argsort(vertices.spread[held].max(axis=1), kind="stable")]:
+        point = _vertex_point(form, planes, vertices, np.array([vertex]))
+        if point is not None:
+            return point
+    return None
 
 
 def _planes(J: np.ndarray, b: np.ndarray, mu: np.ndarray) -> _Planes:

@@ -48,7 +48,7 @@ from ...tolerances import (
 from ..numerics.lcp import PIVOTS_PER_ROW, LemkeInputs, lemke_motion, split_lcp_point
 from ..numerics.lemke import SOLUTION
 
-__all__ = ["seed_point", "satisfies_form", "exact_motion", "kinematically_unique", "kinematic_radius"]
+__all__ = ["seed_point", "lemke_point", "satisfies_form", "exact_motion", "kinematically_unique", "kinematic_radius"]
 
 
 def seed_point(form: LCPForm) -> np.ndarray | None:
@@ -57,15 +57,19 @@ def seed_point(form: LCPForm) -> np.ndarray | None:
     ``form`` must use unrotated edges (:func:`~quasistatic.laws.polyhedral.aligned_edges` without slips),
     as the certified search does: Lemke's kernel builds the same ones.
     """
+    status, x = lemke_point(form)
+    return x if status == SOLUTION and satisfies_form(form, x) else None
+
+
+def lemke_point(form: LCPForm) -> tuple[int, np.ndarray]:
+    """Lemke's status on ``form``'s LCP (unrotated edges, as :func:`seed_point`) and its last point as a point
+    ``[q, cn, beta, lam]`` of the form: a solution, or where the path ended (no law checked)."""
     problem = form.problem
-    m, K = form.edges.shape[:2]
+    K = form.edges.shape[1]
     data = problem.derived("fast", LemkeInputs)  # the fast path's contiguous copies, kept with the problem
     base = np.array([1.0, -1.0]) if problem.dimension == 2 else 2.0 * np.pi * np.arange(K) / K
     status, z = split_lcp_point(data.J, data.b, data.mu, data.g, data.frictional, base, PIVOT, PIVOTS_PER_ROW)
-    if status != SOLUTION:
-        return None
-    x = _form_point(form, z, data.frictional)
-    return x if satisfies_form(form, x) else None
+    return int(status), _form_point(form, z, data.frictional)
 
 
 def exact_motion(problem: Problem) -> RawMotion | None:

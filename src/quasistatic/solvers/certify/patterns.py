@@ -178,6 +178,7 @@ class PatternVerdict(Enum):
     NONE = "none"  # no motion at all (no seed given)
     ENUMERATED = "enumerated"  # several motions, or a continuum: every one of them listed in ``motions``
     UNDECIDED = "undecided"  # a leaf too close to call, or a budget ran out: run the SCIP search
+    FOUND = "found"  # ``stop_at``: the search stopped at the first motion it accepts (``motions``), proving nothing more
 
 
 @dataclass
@@ -253,6 +254,7 @@ class _Rows:
     max_motions: int = 16
     remaining: Callable[[], float] | None = None  # seconds left to the caller
     reuse: bool = True  # narrow a node's twists from its parent's; try earlier nodes' fits (see prove_by_patterns)
+    stop_at: Callable[[RawMotion], bool] | None = None  # stop at the first motion this accepts (the fast path's fallback)
     width: int = 2  # load columns per contact
     survivor: _Node | None = None  # the sector relaxation's leaf whose twists and forces were not excluded
     survivor_twist: np.ndarray | None = None  # a twist of it (None: its LP did not answer)
@@ -590,6 +592,8 @@ def prove_by_patterns(
     max_motions: int = 16,
     remaining: Callable[[], float] | None = None,
     reuse: bool = True,
+    stop_at: Callable[[RawMotion], bool] | None = None,
+    hint_x: np.ndarray | None = None,
 ) -> PatternProof:
     """Every motion of the polyhedral laws ``form`` (planar, two edges per contact, or a 3-D pyramid): whether
     each has the twist of ``seed_x`` (a point ``[q, cn, beta, lam]`` of it), or of a seed found on the way, or,
@@ -597,18 +601,25 @@ def prove_by_patterns(
     docstring. ``remaining``: seconds left to the caller (the search gives up, undecided, once none are).
     ``reuse``: a node's twists narrowed from its parent's line or polygon, and balancing fits of earlier nodes
     tried before a new one (False: each node's twists from all its rows, a new fit wherever the parent's uses a
-    column taken away; the same proof, slower, for cross-checks)."""
+    column taken away; the same proof, slower, for cross-checks). ``stop_at``: stop at the first motion a leaf
+    holds that it accepts (``FOUND``, that motion alone, nothing proven about others; a 3-D continuum offers
+    one of its extremes); a closed tree proves as without it (``NONE`` without ``seed_x``). ``hint_x``: without
+    a seed, a point ``[q, cn, beta, lam]`` (no law checked: where Lemke's path ended) whose contacts and modes
+    are searched first, as a seed's are; it only orders the tree."""
     problem, n_q = form.problem, form.n_q
     planar = problem.dimension == 2
     if not planar and form.n_edges < 3:  # frictionless 3-D (no edges): its normals are no pyramid's columns
         return PatternProof(PatternVerdict.UNDECIDED, seed_x)
-    order = _order(problem, seed_x, n_q)
+    guide = seed_x if seed_x is not None else hint_x  # what orders the tree
+    order = _order(problem, guide, n_q)
     layout = _planar_layout(problem, order) if planar else _pyramid_layout(form, [order])
-    roots = layout.roots if planar or seed_x is None else _seed_modes_first(layout, form, seed_x)
+    roots = layout.roots if planar or guide is None else _seed_modes_first(layout, form, guide)
     seed = None if seed_x is None else seed_x[:n_q]
     budget = PATTERN_NODES if planar else PYRAMID_PATTERN_NODES
     width = 2 if planar else form.n_edges
-    rows = _Rows.of(layout, problem.g, width, budget, seed=seed, form=form, max_motions=max_motions, remaining=remaining, reuse=reuse)
+    rows = _Rows.of(
+        layout, problem.g, width, budget, seed=seed, form=form, max_motions=max_motions, remaining=remaining, reuse=reuse, stop_at=stop_at
+    )
     rows.proof.seed = seed_x
     m = problem.n_contacts
     root = _Node(0, (1 << m) - 1, (1 << layout.loads.shape[1]) - 1, roots, 0)
@@ -654,17 +665,34 @@ def _seed_modes_first(layout: _Layout, form: LCPForm, seed_x: np.ndarray) -> tup
 def _verdict(rows: _Rows, closed: bool) -> PatternVerdict:
     """The search's verdict; a closed tree with other motions than the seed's lists them all, the seed's first."""
     seed_x = rows.proof.seed
+    if not closed and rows.proof.verdict is PatternVerdict.FOUND:
+        return PatternVerdict.FOUND  # stop_at accepted a motion (see _accepted)
     if not closed:
         return PatternVerdict.UNDECIDED
     if not rows.found:
         return PatternVerdict.NONE if seed_x is None else PatternVerdict.UNIQUE
     found = list(rows.found)
     if seed_x is not None and not any(_on_continuum(rows, f, rows.seed) for f in found):  # unless a continuum has it
-        found.insert(0, _Found(RawMotion(seed_x[: rows.lcp.n_q], rows.lcp.forces(seed_x)), np.zeros(0, dtype=bool)))
+        found.insert(0, _Found(_seed_motion(rows), np.zeros(0, dtype=bool)))
     if len(found) > rows.max_motions:
         return PatternVerdict.UNDECIDED  # the SCIP search lists as many as asked and says the list is incomplete
     rows.proof.motions = tuple(f.motion for f in found)
     return PatternVerdict.ENUMERATED
+
+
+def _accepted(rows: _Rows, motion: RawMotion) -> bool:
+    """Whether ``stop_at`` takes ``motion`` (a leaf's): then it is the proof's one motion and the search stops."""
+    if rows.stop_at is None or not rows.stop_at(motion):
+        return False
+    rows.proof.motions, rows.proof.verdict = (motion,), PatternVerdict.FOUND
+    return True
+
+
+def _seed_motion(rows: _Rows) -> RawMotion:
+    """The seed (adopted or given) as a motion."""
+    seed_x = rows.proof.seed
+    assert seed_x is not None
+    return RawMotion(seed_x[: rows.lcp.n_q], rows.lcp.forces(seed_x))
 
 
 def _order(problem: Problem, seed_x: np.ndarray | None, n_q: int) -> list[int]:
@@ -717,13 +745,18 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
                 if child_twists.pruned:
                     continue
             if child_twists.point and child_twists.ball is not None and _adopted(rows, child_twists.ball.center, child_fit.forces):
+                if _accepted(rows, _seed_motion(rows)):
+                    return False  # stopped at it
                 continue
+            count = len(rows.found)  # a motion listed at this leaf is offered to stop_at
             if child_twists.point and child_twists.ball is not None:
                 listed = _record_point(rows, child_twists.ball.center, child_fit.forces, rows.columns(child.columns))
             else:
                 listed = _record_polyhedron(rows, child, child_fit.forces)
             if not listed:
                 return False  # too close to call, or too many motions
+            if len(rows.found) > count and _accepted(rows, rows.found[-1].motion):
+                return False  # stopped at it
             continue
         if not _search(rows, child, child_fit, child_twists):
             return False
@@ -865,6 +898,8 @@ def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
         return True  # the seed's twist alone
     if not free and len(extremes) == 1:
         return _record_point(rows, extremes[0], fit, rows.columns(node.columns))
+    if rows.width > 2 and rows.stop_at is not None and extremes:
+        return _record_point(rows, extremes[0], fit, rows.columns(node.columns))  # one motion of the continuum
     if rows.width > 2:
         # 3-D: a pyramid's continua come in families whose faces (a contact rolling at the end of its slip, on
         # the same edge) are continua of other patterns; SCIP lists the family once (its cut leaves each listed

@@ -30,7 +30,16 @@ from ...laws.fixed_modes import columns, system
 from ...tolerances import BASIS_FEASIBILITY, CONE_ROUNDOFF, FRICTION_ALIGNMENT, MODE_SPEED, NEWTON_DAMPING, NEWTON_STOP, PIVOT
 from .lemke import SOLUTION, lemke
 
-__all__ = ["solve_split_lcp", "split_lcp_point", "lemke_motion", "LemkeInputs", "NOT_CONVERGED", "PIVOTS_PER_ROW", "FAST_EDGES"]
+__all__ = [
+    "solve_split_lcp",
+    "split_lcp_point",
+    "lemke_motion",
+    "exact_newton",
+    "LemkeInputs",
+    "NOT_CONVERGED",
+    "PIVOTS_PER_ROW",
+    "FAST_EDGES",
+]
 
 PIVOTS_PER_ROW = 20  # Lemke pivot cap per LCP row
 NOT_CONVERGED = 3  # kernel status beyond Lemke's: neither re-alignment nor Newton's method reached the exact cone
@@ -83,6 +92,14 @@ def lemke_motion(problem: Problem) -> tuple[int, int, np.ndarray, np.ndarray, in
         BASIS_FEASIBILITY,
         PIVOTS_PER_ROW,
     )
+
+
+def exact_newton(problem: Problem, q: np.ndarray, c: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray]:
+    """The exact 3-D laws with the contact modes of a pyramid's motion ``(q, c)``, by the kernel's Newton method
+    (the one :func:`solve_split_lcp` runs on Lemke's motion). Returns whether it converged with every mode and
+    inequality kept, the twist ``q`` (n,) and forces ``c`` (m, 3)."""
+    data = problem.derived("fast", LemkeInputs)
+    return _newton(data.J, data.b, data.mu, data.g, q, c, MODE_SPEED, FRICTION_ALIGNMENT)
 
 
 @njit

@@ -1,0 +1,230 @@
+"""The fast path's complete fallback: where Lemke's method ends on a ray, a motion is still found, or none proven.
+
+Lemke's path reaches only solutions of index +1 (``tests/test_fast.py``), so on some scenes it ends on a
+secondary ray although motions exist. The fast path then asks a complete method (a motion vertex of the
+planar arrangement, else the mode branch and bound stopped at its first motion, then Newton's method on
+exact 3-D cones). Its answers are checked here against the certified SCIP search: every motion it gives
+passes the audit and is one of SCIP's motions (a listed twist, or a point of a listed continuum); it never
+says ``failed`` where SCIP finds a motion; a ``jammed`` or ``unstable`` from it is SCIP's verdict too.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import nnls
+
+import quasistatic as qs
+from quasistatic import Motion
+from quasistatic.laws import RawMotion
+from quasistatic.laws.polyhedral import LCPForm, aligned_edges, polyhedral_form
+from quasistatic.solvers.certify.arrangement import motion_vertex
+from quasistatic.solvers.certify.cheap import lemke_point, satisfies_form
+from quasistatic.solvers.certify.patterns import PatternVerdict, prove_by_patterns
+from quasistatic.solvers.numerics.lemke import RAY
+from quasistatic.tools.bench.families import FAMILIES
+from random_scenes import random_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+
+TWIST_RTOL = 1e-6  # scene-relative twist agreement between methods (as tests/test_crosscheck.py)
+
+
+def _twist(problem: qs.Problem, twists: dict[str, np.ndarray]) -> np.ndarray:
+    """Stacked scene-relative twist."""
+    units = np.tile(problem.scales.twist_units(problem.dimension), len(problem.scene.bodies))
+    return np.concatenate([twists[b.name] for b in problem.scene.bodies]) / units
+
+
+def _free_axes(problem: qs.Problem, motion: Motion) -> list[np.ndarray]:
+    """The unit twist directions of an unbounded continuum (``"box v_x +"``: body, component, sign)."""
+    components = ("v_x", "v_y", "omega_z") if problem.dimension == 2 else ("v_x", "v_y", "v_z", "omega_x", "omega_y", "omega_z")
+    names = [b.name for b in problem.scene.bodies]
+    axes = []
+    for text in motion.free_directions:
+        body, component, sign = text.rsplit(" ", 2)
+        axis = np.zeros(len(names) * len(components))
+        axis[names.index(body) * len(components) + components.index(component)] = 1.0 if sign == "+" else -1.0
+        axes.append(axis)
+    return axes
+
+
+def _in_motion(problem: qs.Problem, twist: np.ndarray, motion: Motion) -> bool:
+    """Whether ``twist`` is ``motion``'s, or for a continuum a point of the hull of its extremes plus its free
+    directions (a non-negative fit to within the twist tolerance)."""
+    scale = max(1.0, float(np.max(np.abs(twist))))
+    if not motion.continuum:
+        return bool(np.max(np.abs(_twist(problem, motion.twists) - twist)) <= TWIST_RTOL * scale)
+    extremes = [_twist(problem, e) for e in motion.extreme_twists] or [_twist(problem, motion.twists)]
+    free = _free_axes(problem, motion)
+    columns = np.array([np.r_[e, 1.0] for e in extremes] + [np.r_[d, 0.0] for d in free]).T
+    _, residual = nnls(columns, np.r_[twist, 1.0])
+    return bool(residual <= 10 * TWIST_RTOL * scale)
+
+
+def _agrees_with_scip(scene: qs.Scene) -> tuple[str, str]:
+    """The fast path's status and SCIP's, after checking that the fast path never contradicts SCIP."""
+    problem = qs.assemble(scene)
+    fast = qs.solve(problem, method="fast")
+    scip = qs.solve(problem, method="scip")
+    assert scip.status != "failed", scip.message
+    if scip.status in ("solved", "ambiguous"):
+        assert fast.status == "solved", f"fast: {fast.message}; scip: {scip.message}"
+    if fast.status == "solved":
+        assert fast.motion is not None and fast.motion.audit.passed and not fast.certified
+        motions = scip.solutions or ((scip.motion,) if scip.motion is not None else ())
+        twist = _twist(problem, fast.motion.twists)
+        assert any(_in_motion(problem, twist, motion) for motion in motions), f"fast's motion is none of scip's: {scip.message}"
+    elif fast.status in ("jammed", "unstable"):
+        assert fast.status == scip.status and fast.certified, f"fast: {fast.message}; scip: {scip.message}"
+    return fast.status, scip.status
+
+
+# --------------------------------------------------------------------------- the bench grasps Lemke cannot answer
+
+RAY_SCENES = [
+    ("grasp-3d", 8, 0, "ambiguous"),
+    ("grasp-3d", 8, 1, "solved"),
+    ("grasp-2d", 2, 2, "solved"),
+    ("grasp-2d", 2, 4, "solved"),
+    ("grasp-2d", 2, 5, "ambiguous"),
+]
+
+
+@pytest.mark.parametrize(("family", "size", "instance", "certified_status"), RAY_SCENES)
+def test_fast_answers_the_bench_grasps_where_lemke_ends_on_a_ray(family: str, size: int, instance: int, certified_status: str) -> None:
+    """Issue 11's target: these five bench scenes have motions, which Lemke's path cannot reach."""
+    scene = FAMILIES[family].make(size, instance)
+    problem = qs.assemble(scene)
+    from quasistatic.solvers.numerics.lcp import lemke_motion
+    from quasistatic.solvers.numerics.lemke import SOLUTION
+
+    assert lemke_motion(problem)[0] != SOLUTION  # the fallback is what answers
+    fast, scip = _agrees_with_scip(scene)
+    assert (fast, scip) == ("solved", certified_status)
+    answer = qs.solve(problem, method="fast")
+    assert dict(answer.notes)["method"].startswith(("arrangement vertex", "mode branch and bound"))
+    assert "secondary ray" in dict(answer.notes)["lemke"]
+
+
+def test_fast_proves_a_jammed_bench_grasp_jammed() -> None:
+    """grasp-2d 4 #1 ends Lemke on a ray and has no motion: the vertex certificate proves it, as SCIP says."""
+    scene = FAMILIES["grasp-2d"].make(4, 1)
+    answer = qs.solve(scene, method="fast")
+    assert answer.status in ("jammed", "unstable") and answer.certified, answer.message
+    assert "certificate" in dict(answer.notes)
+    assert _agrees_with_scip(scene)[1] == answer.status
+
+
+# --------------------------------------------------------------------------- property: never failed where SCIP finds a motion
+
+
+@pytest.mark.parametrize("chunk", range(8))
+def test_fast_never_fails_or_contradicts_scip_2d(chunk: int) -> None:
+    """200 random planar scenes (25 a chunk): every one with a motion is solved by the fast path, consistently."""
+    statuses = [_agrees_with_scip(random_scene(2, 5000 + 25 * chunk + k)) for k in range(25)]
+    assert any(scip in ("solved", "ambiguous") for _, scip in statuses)
+
+
+@pytest.mark.parametrize("chunk", range(4))
+def test_fast_never_fails_or_contradicts_scip_3d(chunk: int) -> None:
+    """60 random 3-D scenes with exact cones (15 a chunk), as above."""
+    statuses = [_agrees_with_scip(random_scene(3, 5000 + 15 * chunk + k)) for k in range(15)]
+    assert any(scip in ("solved", "ambiguous") for _, scip in statuses)
+
+
+@pytest.mark.parametrize("chunk", range(2))
+def test_fast_never_fails_or_contradicts_scip_3d_pyramid(chunk: int) -> None:
+    """40 random 3-D scenes with a 4-edge pyramid (20 a chunk): there the branch and bound's "no motion" is a proof."""
+    statuses = [_agrees_with_scip(random_scene(3, 6000 + 20 * chunk + k, friction="pyramid:4")) for k in range(20)]
+    assert any(scip in ("solved", "ambiguous") for _, scip in statuses)
+
+
+# --------------------------------------------------------------------------- the two small pieces it adds to the certificates
+
+
+def _planar_form(family: str, size: int, instance: int) -> LCPForm:
+    problem = qs.assemble(FAMILIES[family].make(size, instance))
+    return polyhedral_form(problem, aligned_edges(problem, problem.friction.edges))
+
+
+def test_stop_at_ends_the_branch_and_bound_at_the_first_motion_it_accepts() -> None:
+    """grasp-2d 2 #5 has several motions: accepting any stops at one of them; refusing all changes nothing."""
+    form = _planar_form("grasp-2d", 2, 5)
+    full = prove_by_patterns(form, None)
+    assert full.verdict is PatternVerdict.ENUMERATED and len(full.motions) >= 2
+    offered: list[RawMotion] = []
+    refused = prove_by_patterns(form, None, stop_at=lambda motion: offered.append(motion) is not None)
+    assert refused.verdict is full.verdict and refused.nodes == full.nodes and len(offered) >= 2
+    first = prove_by_patterns(form, None, stop_at=lambda motion: True)
+    assert first.verdict is PatternVerdict.FOUND and len(first.motions) == 1 and first.nodes < full.nodes
+    assert np.allclose(first.motions[0].q, offered[0].q)  # the same first motion, the search stopped there
+
+
+@pytest.mark.parametrize("instance", [2, 4, 5])
+def test_motion_vertex_is_a_checked_motion(instance: int) -> None:
+    """A motion vertex of grasp-2d 2 #2, #4, #5 (where Lemke ends on a ray) satisfies every law of the form."""
+    form = _planar_form("grasp-2d", 2, instance)
+    point = motion_vertex(form)
+    assert point is not None and satisfies_form(form, point)
+
+
+def test_motion_vertex_none_where_no_motion_exists() -> None:
+    """The toppling block has no motion (unstable): no vertex holds one."""
+    problem = qs.assemble(qs.load_scene(ROOT / "examples" / "topple.yaml"))
+    assert motion_vertex(polyhedral_form(problem, aligned_edges(problem, 2))) is None
+
+
+def test_first_solution_keeps_the_fast_paths_proven_jam() -> None:
+    """``certify=False``: a jam the fast path's fallback proves is the answer (no SCIP search after it)."""
+    scene = FAMILIES["grasp-2d"].make(4, 1)
+    first = qs.solve(scene, certify=False)
+    assert (first.status, first.method, first.certified, first.fallback) == ("jammed", "fast", True, ())
+    assert first.diagnosis is qs.solve(scene).diagnosis
+
+
+def test_a_hint_only_orders_the_branch_and_bound() -> None:
+    """grasp-3d 8 #1 on the fallback's 8-edge pyramid: ordered by where Lemke's path ended, the search proves the
+    same (its one motion, the same twist) as without."""
+    problem = qs.assemble(FAMILIES["grasp-3d"].make(8, 1))
+    form = polyhedral_form(problem, aligned_edges(problem, 8))
+    status, hint = lemke_point(form)
+    assert status == RAY
+    plain, hinted = prove_by_patterns(form, None), prove_by_patterns(form, None, hint_x=hint)
+    assert plain.verdict is hinted.verdict is PatternVerdict.UNIQUE
+    assert plain.seed is not None and hinted.seed is not None
+    assert np.allclose(plain.seed[: form.n_q], hinted.seed[: form.n_q], atol=1e-9)
+
+
+def test_past_the_node_budget_scips_search_finds_the_motion(monkeypatch: pytest.MonkeyPatch) -> None:
+    """grasp-3d 8 #1 with the branch and bound held to 10 nodes: SCIP's search, stopped at its first motion,
+    gives the pyramid motion Newton's method carries to the exact cones, SCIP's own."""
+    from quasistatic.solvers.certify import patterns
+
+    monkeypatch.setattr(patterns, "PYRAMID_PATTERN_NODES", 10)
+    scene = FAMILIES["grasp-3d"].make(8, 1)
+    answer = qs.solve(scene, method="fast")
+    assert answer.status == "solved" and dict(answer.notes)["method"] == "SCIP search (8 edges)", answer.message
+    assert _agrees_with_scip(scene) == ("solved", "solved")
+
+
+@pytest.mark.parametrize(("seed", "method"), [(7128, "sector relaxation"), (7040, "(32 edges)"), (7339, "(32 edges)")])
+def test_exact_motions_the_8_edge_pyramid_misses(seed: int, method: str) -> None:
+    """Random 3-D scenes where the 8-edge pyramid has no motion that Newton's method carries to the exact cones
+    (7339), or none at all (7128: a wedge of the pyramid, not of the circles; 7040: no equilibrium in it): a point
+    of the exact cones' sector relaxation, or the 32-edge pyramid, gives the motion, one of SCIP's."""
+    scene = random_scene(3, seed)
+    answer = qs.solve(scene, method="fast")
+    assert answer.status == "solved" and method in dict(answer.notes)["method"], answer.message
+    assert _agrees_with_scip(scene)[0] == "solved"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("chunk", range(20))
+def test_fast_never_fails_or_contradicts_scip_3d_sweep(chunk: int) -> None:
+    """400 more random 3-D scenes with exact cones (20 a chunk), where the 32-edge retry and the sector
+    relaxation's motions were found needed."""
+    for k in range(20):
+        _agrees_with_scip(random_scene(3, 7000 + 20 * chunk + k))
