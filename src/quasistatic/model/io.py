@@ -417,13 +417,28 @@ def _read(path: str | Path) -> Any:
     except json.JSONDecodeError as exc:
         raise SceneError("", str(path), f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}") from None
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        raise SceneError("", str(path), f"not valid YAML{where}: {getattr(exc, 'problem', None) or exc}") from None
+        raise _yaml_error(path, text, exc) from None
     except RecursionError:  # a parser's own recursion (e.g. a YAML merge chain); nesting is limited before it
         raise SceneError("", str(path), f"nested deeper than {MAX_DEPTH} levels") from None
     except (ValueError, TypeError, OverflowError) as exc:  # a YAML tag's constructor, e.g. !!timestamp 2001-13-45
         raise SceneError("", str(path), f"not valid {'JSON' if path.suffix.lower() == '.json' else 'YAML'}: {exc}") from None
+
+
+def _yaml_error(path: Path, text: str, exc: yaml.YAMLError) -> SceneError:
+    """The error of a YAML file PyYAML refused. libyaml (0.2.6 on) stops at its own nesting depth, reading ahead of
+    the events, before the composer's :data:`MAX_DEPTH` check can name the path; the pure-Python parser reads no
+    deeper than a simple key's 1024 characters, so parsed again with it the check names the path and the value."""
+    problem = str(getattr(exc, "problem", None) or exc)
+    if "nesting depth" in problem and _YAML_EVENTS is not yaml.SafeLoader:
+        try:
+            _SceneYamlLoader(text, yaml.SafeLoader).load()
+        except SceneError as named:
+            return named
+        except (yaml.YAMLError, RecursionError, ValueError, TypeError, OverflowError):
+            pass
+    mark = getattr(exc, "problem_mark", None)
+    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+    return SceneError("", str(path), f"not valid YAML{where}: {problem}")
 
 
 def read_text(path: Path, field: str = "", what: str = "the scene file") -> str:
@@ -560,12 +575,12 @@ class _SceneYamlLoader(yaml.composer.Composer, yaml.constructor.SafeConstructor,
     anchor and a key given twice in one mapping are rejected too, each naming its path.
     """
 
-    def __init__(self, text: str) -> None:
+    def __init__(self, text: str, events: type = _YAML_EVENTS) -> None:
         yaml.composer.Composer.__init__(self)
         yaml.constructor.SafeConstructor.__init__(self)
         yaml.resolver.Resolver.__init__(self)
         self._text = text
-        self._events: Iterator[Any] = yaml.parse(text, Loader=_YAML_EVENTS)
+        self._events: Iterator[Any] = yaml.parse(text, Loader=events)
         self._next: Any = None
         self._sizes: dict[Any, int] = {}  # node -> values it holds, aliases expanded; absent while it is composed
         self._composed = 0  # values composed so far: past MAX_VALUES the file is refused before its collection closes
