@@ -229,7 +229,7 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None, max_solutions: i
         return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False, admissible=_admissible(planes, vertices))
     if vertices is None:
         return _UNDECIDED  # the normals do not span R^3: every motion lies on a line of motions
-    held = np.flatnonzero(~excluded.excludes(_load_masks(planes, vertices.signs)))
+    held = (~excluded.excludes(_load_masks(planes, vertices.signs))).nonzero()[0]  # (methods: numpy's wrappers cost more here)
     if not held.size:
         if seed_x is not None:
             return _UNDECIDED  # a checked motion, yet every vertex excluded: too close to call
@@ -494,7 +494,7 @@ def _edges_excluded(planes: _Planes, vertices: _Vertices, held: np.ndarray, excl
     signs = vertices.signs[held]
     masks = []
     for key, sign in _by_sign(signs):
-        near = np.flatnonzero(sign == 0)
+        near = (sign == 0).nonzero()[0]
         i, j = _pairs(near.size)
         pair = near[i] * P + near[j]
         lines = planes.flat_crosses[pair]
@@ -509,7 +509,7 @@ def _edges_excluded(planes: _Planes, vertices: _Vertices, held: np.ndarray, excl
         along[np.abs(along) <= zero] = 0.0
         rays = np.concatenate((along, -along))
         rays = rays[(rays[:, near < m] >= 0.0).all(axis=1)]  # no near gap row falls along it
-        ray_signs = np.repeat(sign[None, :], rays.shape[0], axis=0)
+        ray_signs = sign[None, :].repeat(rays.shape[0], axis=0)
         ray_signs[:, near] = np.sign(rays)
         masks.append(_load_masks(planes, ray_signs))
     return bool(excluded.excludes(np.concatenate(masks)).all())
