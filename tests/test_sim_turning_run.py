@@ -1,9 +1,9 @@
 """The turning run of the benchmark (``examples/sim/tip_box_planar.yaml``, dt 0.05 s, to its ``unstable`` end)
 saved byte for byte as ``main`` saved it before the step was made faster (``tests/data/tip_box_planar_run.jsonl.gz``,
-written at commit 2a7070a, NumPy 2 on x86-64): every step is proven anew there (the box turns, so no step takes the
-previous answer again), and a faster proof, assembly or integration must give the same statuses, modes, twists,
-forces, poses and events to the last bit. Regenerate the file only for a change that is meant to alter the run, and
-say why in the commit.
+written at commit 2a7070a, NumPy 2 on x86-64; its header's ``scene_file`` made relative): every step is proven
+anew there (the box turns, so no step takes the previous answer again), and a faster proof, assembly or
+integration must give the same statuses, modes, twists, forces, poses and events to the last bit. Regenerate the
+file only for a change that is meant to alter the run, and say why in the commit.
 """
 
 from __future__ import annotations
