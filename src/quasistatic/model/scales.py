@@ -7,7 +7,9 @@ answer does not depend on where the world origin is.
 
 from __future__ import annotations
 
+import functools
 import math
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,6 +63,9 @@ def scene_scales(scene: Scene, mover_velocities: FloatArray | None = None) -> Sc
 
     ``mover_velocities`` (m, d), when the caller has them: :func:`~.kinematics.mover_point_velocities`.
     """
+    velocities = mover_point_velocities(scene) if mover_velocities is None else mover_velocities
+    if 0 < len(scene.contacts) + len(scene.bodies) < ORDERED_SUMS:
+        return _few_point_scales(scene, velocities)
     points = np.array([c.point for c in scene.contacts] + [b.com for b in scene.bodies], dtype=float)
     origin = points.sum(axis=0) / len(points)  # a mean without np.mean's checks (small scenes solve in ~1 ms)
     length = _length(points, origin)
@@ -68,10 +73,41 @@ def scene_scales(scene: Scene, mover_velocities: FloatArray | None = None) -> Sc
     loads = _loads(scene)
     linear, angular = np.sqrt(np.square(loads[:, :dim]).sum(axis=1)), np.sqrt(np.square(loads[:, dim:]).sum(axis=1))
     force = max(float(linear.max(initial=0.0)), float(angular.max(initial=0.0)) / length)
-    velocities = mover_point_velocities(scene) if mover_velocities is None else mover_velocities
     velocity = math.sqrt(float(np.square(velocities).sum(axis=1).max(initial=0.0)))
     origin.setflags(write=False)
     return Scales(length=length, force=force or 1.0, velocity=velocity or 1.0, origin=origin)
+
+
+ORDERED_SUMS = 8
+"""Below this many rows NumPy adds a column in order (its pairwise sums start at 8), as the Python loops of
+:func:`_few_point_scales` do, so both give the same bits."""
+
+
+def _few_point_scales(scene: Scene, velocities: FloatArray) -> Scales:
+    """:func:`scene_scales` in Python floats, term for term in NumPy's order: a step of a small scene pays for
+    a dozen numpy calls on arrays of two or three entries otherwise."""
+    points = [c.point.tolist() for c in scene.contacts] + [b.com.tolist() for b in scene.bodies]
+    centroid = [functools.reduce(operator.add, column) / len(points) for column in zip(*points, strict=True)]
+    length = math.sqrt(max(_square_sum([p - o for p, o in zip(point, centroid, strict=True)]) for point in points))
+    origin = np.array(centroid)
+    if length == 0.0:
+        length = _length(np.array(points), origin)  # every point coincides
+    dim = scene.dimension
+    loads = _loads(scene).tolist()
+    force = max([0.0, *(math.sqrt(_square_sum(load[:dim])) for load in loads)])
+    torque = max([0.0, *(math.sqrt(_square_sum(load[dim:])) for load in loads)])
+    force = max(force, torque / length)
+    velocity = math.sqrt(max([0.0, *(_square_sum(v) for v in velocities.tolist())]))
+    origin.setflags(write=False)
+    return Scales(length=length, force=force or 1.0, velocity=velocity or 1.0, origin=origin)
+
+
+def _square_sum(values: list[float]) -> float:
+    """``sum(v * v)`` added in order from the first term, as NumPy's ``square(...).sum()`` does for a few entries."""
+    total = values[0] * values[0]
+    for value in values[1:]:
+        total += value * value
+    return total
 
 
 def _loads(scene: Scene) -> FloatArray:

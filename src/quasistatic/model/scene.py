@@ -665,7 +665,7 @@ class _Parts:
         """A contact whose pair is known to be valid here: its point, unit normal, jacobian and stiffness checked."""
         point = _sized(contact.point, self.dimension, f"{path}.point")
         normal = _sized(contact.normal, self.dimension, f"{path}.normal")
-        length = float(np.linalg.norm(normal))
+        length = math.sqrt(float(normal @ normal))  # np.linalg.norm's own arithmetic for a vector, without its checks
         if abs(length - 1.0) > NORMAL_LENGTH:
             raise SceneError(f"{path}.normal", normal.tolist(), f"must be a unit vector (its length is {length:.6g})")
         unit = normal / length

@@ -237,7 +237,7 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None, max_solutions: i
         return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False, admissible=_admissible(planes, vertices))
     if vertices is None:
         return _UNDECIDED  # the normals do not span R^3: every motion lies on a line of motions
-    held = np.flatnonzero(~excluded.excludes(_load_masks(planes, vertices.signs)))
+    held = (~excluded.excludes(_load_masks(planes, vertices.signs))).nonzero()[0]  # (methods: numpy's wrappers cost more here)
     if not held.size:
         if seed_x is not None:
             return _UNDECIDED  # a checked motion, yet every vertex excluded: too close to call
@@ -387,17 +387,17 @@ def _load_masks(planes: _Planes, signs: np.ndarray) -> np.ndarray:
     else:
         slip = np.zeros((signs.shape[0], m), dtype=np.int8)
         slip[:, planes.frictional] = signs[:, m:]
-    bits = np.take(_EDGE_BITS, slip.astype(np.intp) + 1) * (signs[:, :m] == 0)
-    return (bits @ _weights(m)).astype(np.uint64)
+    bits = _EDGE_BITS[slip + 1] * (signs[:, :m] == 0)  # integers throughout: no float round trip
+    return bits @ _weights(m)
 
 
-_EDGE_BITS = np.array([1.0, 3.0, 2.0])  # by slip sign -1, 0, +1: the edge n + mu t, both, the edge n - mu t
+_EDGE_BITS = np.array([1, 3, 2], dtype=np.uint64)  # by slip sign -1, 0, +1: the edge n + mu t, both, the edge n - mu t
 
 
 @functools.cache
 def _weights(m: int) -> np.ndarray:
-    """``4^i`` for each of ``m`` contacts, as floats (exact up to 2^53: at most 26 contacts)."""
-    return 4.0 ** np.arange(m)
+    """``4^i`` for each of ``m`` contacts (exact in 64 bits up to 32 contacts)."""
+    return np.uint64(4) ** np.arange(m, dtype=np.uint64)
 
 
 @dataclass(frozen=True)
@@ -422,7 +422,7 @@ class _Exclusions:
         reserve = directions @ -g - _margin(g) * np.sqrt(np.einsum("yj,yj->y", directions, directions))
         useful = reserve > 0.0
         blocked = (directions[useful] @ loads) * FORCE_CEILING < reserve[useful, None]
-        return cls(loads, g, (blocked @ 2.0 ** np.arange(count)).astype(np.uint64))
+        return cls(loads, g, blocked @ _bits(count))
 
     def excludes(self, masks: np.ndarray) -> np.ndarray:
         """Whether a direction excludes each set of loads (bit masks)."""
@@ -430,7 +430,8 @@ class _Exclusions:
 
     def every_load(self) -> bool:
         """Whether a direction excludes every load at once: no forces at all balance the load."""
-        return bool(self.excludes(np.array([2 ** self.loads.shape[1] - 1], dtype=np.uint64))[0])
+        every = np.uint64(2 ** self.loads.shape[1] - 1)
+        return bool(((every & ~self.blocked) == 0).any())
 
     def equilibrium(self) -> bool | None:
         """With every load: False when excluded, True when a non-negative fit balances the load to the margin, None
@@ -439,6 +440,12 @@ class _Exclusions:
             return False
         _, residual = nnls(self.loads, -self.g)
         return True if residual <= _margin(self.g) else None
+
+
+@functools.cache
+def _bits(count: int) -> np.ndarray:
+    """``2^k`` for each of ``count`` loads, as 64-bit integers (a mask of booleans in one product)."""
+    return np.uint64(1) << np.arange(count, dtype=np.uint64)
 
 
 @functools.cache
@@ -519,7 +526,7 @@ def _edges_excluded(planes: _Planes, vertices: _Vertices, held: np.ndarray, excl
     signs = vertices.signs[held]
     masks = []
     for key, sign in _by_sign(signs):
-        near = np.flatnonzero(sign == 0)
+        near = (sign == 0).nonzero()[0]
         i, j = _pairs(near.size)
         pair = near[i] * P + near[j]
         lines = planes.flat_crosses[pair]
@@ -534,7 +541,7 @@ def _edges_excluded(planes: _Planes, vertices: _Vertices, held: np.ndarray, excl
         along[np.abs(along) <= zero] = 0.0
         rays = np.concatenate((along, -along))
         rays = rays[(rays[:, near < m] >= 0.0).all(axis=1)]  # no near gap row falls along it
-        ray_signs = np.repeat(sign[None, :], rays.shape[0], axis=0)
+        ray_signs = sign[None, :].repeat(rays.shape[0], axis=0)
         ray_signs[:, near] = np.sign(rays)
         masks.append(_load_masks(planes, ray_signs))
     return bool(excluded.excludes(np.concatenate(masks)).all())

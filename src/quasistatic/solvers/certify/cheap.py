@@ -95,18 +95,21 @@ def _form_point(form: LCPForm, z: np.ndarray, frictional: np.ndarray) -> np.ndar
     frictionless[frictional] = False
     if frictionless.any():  # (a mask, not np.setdiff1d, and no np.r_: each costs more than the arithmetic here)
         slip_along = (form.W[m : m + m * K, :n] @ q - form.r[m : m + m * K]).reshape(m, K)
-        lam[frictionless] = np.maximum(0.0, np.max(-slip_along[frictionless], axis=1, initial=0.0))
+        lam[frictionless] = np.maximum(0.0, (-slip_along[frictionless]).max(axis=1, initial=0.0))
     return np.concatenate([q, z[2 * n : 2 * n + m], beta.ravel(), lam])
 
 
 def satisfies_form(form: LCPForm, x: np.ndarray) -> bool:
     """Equilibrium, signs and complementarity of ``x`` hold to ``ZERO`` (scene-relative)."""
+    # (array methods, not np.max and np.min: their dispatch costs more than these few-entry reductions)
+    equilibrium = np.abs(form.E_eq @ x - form.e_eq).max(initial=0.0)
+    if not equilibrium <= ZERO:
+        return False
     w = form.W @ x - form.r
     pairs = x[form.pair_cols]
-    equilibrium = np.max(np.abs(form.E_eq @ x - form.e_eq), initial=0.0)
-    signs = min(np.min(pairs, initial=0.0), np.min(w, initial=0.0))
-    complementarity = np.max(np.minimum(np.abs(pairs), np.abs(w)), initial=0.0)
-    return bool(equilibrium <= ZERO and signs >= -ZERO and complementarity <= ZERO)
+    signs = min(pairs.min(initial=0.0), w.min(initial=0.0))
+    complementarity = np.minimum(np.abs(pairs), np.abs(w)).max(initial=0.0)
+    return bool(signs >= -ZERO and complementarity <= ZERO)
 
 
 def kinematically_unique(problem: Problem, q: np.ndarray) -> bool:
