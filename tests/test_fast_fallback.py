@@ -228,3 +228,20 @@ def test_fast_never_fails_or_contradicts_scip_3d_sweep(chunk: int) -> None:
     relaxation's motions were found needed."""
     for k in range(20):
         _agrees_with_scip(random_scene(3, 7000 + 20 * chunk + k))
+
+
+@pytest.mark.parametrize("chunk", range(2))
+def test_frictionless_3d_no_motion_is_proven_without_a_search(chunk: int) -> None:
+    """40 random frictionless 3-D scenes (20 a chunk): the laws are an LP's optimality conditions, so where Lemke
+    ends on a ray the kinematic or equilibrium certificate alone proves that no motion exists (no SCIP search);
+    every verdict equals the frictionless LP's."""
+    proven_alone = 0
+    for k in range(20):
+        problem = qs.assemble(random_scene(3, 6100 + 20 * chunk + k, friction="none"))
+        fast, lp = qs.solve(problem, method="fast"), qs.solve(problem, method="lp")
+        if fast.status == "solved":
+            assert lp.status in ("solved", "ambiguous") and fast.motion is not None and fast.motion.audit.passed
+            continue
+        assert fast.status == lp.status and fast.certified, f"fast: {fast.message}; lp: {lp.message}"
+        proven_alone += "without friction either proves" in str(dict(fast.notes).get("certificate"))
+    assert proven_alone > 0

@@ -79,6 +79,7 @@ _EXACT_STAGES = (  # how an exact 3-D answer was reached, by the kernel's stage
 FALLBACK_EDGES = (8, 32)
 _EXACT_FROM_RELAXATION = "exact laws solved by Newton's method from a point of the exact cones' sector relaxation"
 _NOT_EXACT = "no motion of the 8- or 32-edge pyramid converged to the exact cones by Newton's method"
+_FRICTIONLESS_PROOF = "no admissible twist, or no equilibrium: without friction either proves that no motion exists"
 _EXACT_FROM_PYRAMID = "exact laws solved by Newton's method with the contact modes of the branch and bound's pyramid motion"
 
 
@@ -117,6 +118,10 @@ def _complete_fallback(problem: Problem, options: Options, lemke: str) -> Backen
     the exact cones admit an equilibrium is too close to call, the 32-edge pyramid (as the certified search).
     """
     options = options.start_clock()
+    if problem.friction.kind == "none" and problem.dimension == 3:  # in the plane the vertex proof is cheaper still
+        verdict = _frictionless_no_motion(problem, lemke)
+        if verdict is not None:
+            return verdict
     if problem.dimension == 2 or problem.friction.is_polyhedral(3):
         return _on_pyramid(problem, options, lemke, problem.friction.edges, exact=False) or _failed(lemke)
     for count in FALLBACK_EDGES:
@@ -124,6 +129,17 @@ def _complete_fallback(problem: Problem, options: Options, lemke: str) -> Backen
         if result is not None:
             return result
     return _failed(f"{lemke}; {_NOT_EXACT}, or whether the exact cones admit an equilibrium was too close to call")
+
+
+def _frictionless_no_motion(problem: Problem, lemke: str) -> BackendResult | None:
+    """Without friction the laws are the optimality conditions of an LP (twists meeting the gap rows, forces
+    balancing the load), so a motion exists wherever an admissible twist and an equilibrium both do: a kinematic
+    Farkas certificate, or a certificate of no equilibrium, proves by itself that none exists, and no search is
+    needed. None where both exist (a motion Lemke's path missed: the search finds it)."""
+    verdict = diagnose(problem, aligned_edges(problem, problem.friction.edges))
+    if verdict.diagnosis in (Diagnosis.KINEMATIC, Diagnosis.NO_EQUILIBRIUM):
+        return verdict.with_notes(certificate=_FRICTIONLESS_PROOF, lemke=lemke)
+    return None
 
 
 def _on_pyramid(problem: Problem, options: Options, lemke: str, count: int, exact: bool) -> BackendResult | None:
