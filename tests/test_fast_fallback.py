@@ -200,17 +200,26 @@ def test_a_hint_only_orders_the_branch_and_bound() -> None:
 
 def test_past_the_node_budget_scips_search_finds_the_motion(monkeypatch: pytest.MonkeyPatch) -> None:
     """grasp-3d 8 #1 with the branch and bound held to 10 nodes: SCIP's search, stopped at its first motion,
-    gives the pyramid motion Newton's method carries to the exact cones, SCIP's own."""
+    gives the pyramid motion Newton's method carries to the exact cones: the scene's only motion, which the
+    unhindered fallback finds too (and SCIP, in the bench-scene test above)."""
     from quasistatic.solvers.certify import patterns
 
-    monkeypatch.setattr(patterns, "PYRAMID_PATTERN_NODES", 10)
     scene = FAMILIES["grasp-3d"].make(8, 1)
+    unhindered = qs.solve(scene, method="fast")
+    monkeypatch.setattr(patterns, "PYRAMID_PATTERN_NODES", 10)
     answer = qs.solve(scene, method="fast")
     assert answer.status == "solved" and dict(answer.notes)["method"] == "SCIP search (8 edges)", answer.message
-    assert _agrees_with_scip(scene) == ("solved", "solved")
+    assert dict(unhindered.notes)["method"] != "SCIP search (8 edges)"
+    assert answer.motion is not None and answer.motion.audit.passed and unhindered.motion is not None
+    problem = qs.assemble(scene)
+    twists = [_twist(problem, motion.twists) for motion in (answer.motion, unhindered.motion)]
+    assert np.allclose(twists[0], twists[1], rtol=0.0, atol=10 * TWIST_RTOL * np.abs(twists[1]).max())
 
 
-@pytest.mark.parametrize(("seed", "method"), [(7128, "sector relaxation"), (7040, "(32 edges)"), (7339, "(32 edges)")])
+@pytest.mark.parametrize(
+    ("seed", "method"),
+    [pytest.param(7128, "sector relaxation", marks=pytest.mark.slow), (7040, "(32 edges)"), (7339, "(32 edges)")],  # 7128: 18 s
+)
 def test_exact_motions_the_8_edge_pyramid_misses(seed: int, method: str) -> None:
     """Random 3-D scenes where the 8-edge pyramid has no motion that Newton's method carries to the exact cones
     (7339), or none at all (7128: a wedge of the pyramid, not of the circles; 7040: no equilibrium in it): a point
