@@ -36,7 +36,7 @@ def _uniform(problem: qs.Problem, count: int) -> list[np.ndarray]:
     return [2.0 * np.pi * np.arange(count + 1) / count for _ in range(problem.n_contacts)]
 
 
-@pytest.mark.parametrize(("count", "frictionless_every"), [(8, 0), (16, 0), (8, 2)])
+@pytest.mark.parametrize(("count", "frictionless_every"), [(8, 0), pytest.param(16, 0, marks=pytest.mark.slow), (8, 2)])  # 16: 5.5 s
 def test_the_branch_and_bound_excludes_the_relaxation_only_where_scip_proves_it_infeasible(count: int, frictionless_every: int) -> None:
     infeasible = excluded = 0
     for seed in range(30):
