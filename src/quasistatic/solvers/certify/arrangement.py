@@ -226,12 +226,10 @@ def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None, max_solutions: i
     """Whether the only motion of the planar laws ``form`` is the twist of ``seed_x`` (a point ``[q, cn, beta, lam]``
     every law of the form holds at, checked by the caller), or no motion exists, or the motions are isolated twists
     (at most ``max_solutions`` of them), each listed; see the module docstring."""
-    problem = form.problem
-    m = problem.n_contacts
-    if problem.dimension != 2 or form.n_q != 3 or form.n_edges != 2 or not 0 < m <= ARRANGEMENT_CONTACTS:
+    arrangement = _arrangement(form)
+    if arrangement is None:
         return _UNDECIDED
-    planes = _planes(problem.J, problem.b, problem.mu)
-    excluded = _Exclusions.of(planes.loads, problem.g)
+    planes, excluded = arrangement
     vertices = _vertices(planes)
     if excluded.every_load():  # no forces balance the load at all, whatever the twist
         return _UNDECIDED if seed_x is not None else VertexProof(VertexVerdict.NONE, False, admissible=_admissible(planes, vertices))
@@ -265,12 +263,10 @@ def motion_vertex(form: LCPForm) -> np.ndarray | None:
     For the fast path, which wants any motion: the vertices not excluded are tried best computed first (least
     ``|N_T^-1|_1``). No uniqueness is claimed; when the normals span R^3 every motion face has a motion vertex.
     """
-    problem = form.problem
-    m = problem.n_contacts
-    if problem.dimension != 2 or form.n_q != 3 or form.n_edges != 2 or not 0 < m <= ARRANGEMENT_CONTACTS:
+    arrangement = _arrangement(form)
+    if arrangement is None:
         return None
-    planes = _planes(problem.J, problem.b, problem.mu)
-    excluded = _Exclusions.of(planes.loads, problem.g)
+    planes, excluded = arrangement
     vertices = None if excluded.every_load() else _vertices(planes)
     if vertices is None:
         return None
@@ -280,6 +276,16 @@ def motion_vertex(form: LCPForm) -> np.ndarray | None:
         if point is not None:
             return point
     return None
+
+
+def _arrangement(form: LCPForm) -> tuple[_Planes, _Exclusions] | None:
+    """The planes of ``form`` and the Farkas directions that exclude loads, or None where the vertex certificate does
+    not apply: anything but one planar body with two edges a contact and 1 to ``ARRANGEMENT_CONTACTS`` contacts."""
+    problem = form.problem
+    if problem.dimension != 2 or form.n_q != 3 or form.n_edges != 2 or not 0 < problem.n_contacts <= ARRANGEMENT_CONTACTS:
+        return None
+    planes = _planes(problem.J, problem.b, problem.mu)
+    return planes, _Exclusions.of(planes.loads, problem.g)
 
 
 def _planes(J: np.ndarray, b: np.ndarray, mu: np.ndarray) -> _Planes:
