@@ -154,11 +154,11 @@ def _run(backend: Backend, problem: Problem, options: Options) -> BackendResult:
 
 def _recalled_or_run(reuse: Reuse, backend: Backend, problem: Problem, options: Options) -> BackendResult:
     """The answer ``reuse`` kept for these very laws, else the backend's (kept in turn when certified and complete)."""
-    kept = reuse.recalled(backend.name, problem, options)
+    kept, key = reuse.recalled(backend.name, problem, options)
     if kept is not None:
         return kept
     result = _run(backend, problem, options)
-    reuse.keep(backend.name, problem, options, result)
+    reuse.keep(key, result)
     return result
 
 

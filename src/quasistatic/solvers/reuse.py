@@ -33,17 +33,20 @@ class Reuse:
     result: BackendResult | None = None
     hits: int = 0
 
-    def recalled(self, method: str, problem: Problem, options: Options) -> BackendResult | None:
-        """The kept answer when ``problem`` and ``options`` equal those it answered, else None."""
-        if self.result is None or self.key != _key(method, problem, options):
-            return None
+    def recalled(self, method: str, problem: Problem, options: Options) -> tuple[BackendResult | None, tuple[Any, ...]]:
+        """The kept answer when ``problem`` and ``options`` equal those it answered (else None), and their key, for
+        :meth:`keep` after a solve."""
+        key = _key(method, problem, options)
+        if self.result is None or self.key != key:
+            return None, key
         self.hits += 1
-        return self.result
+        return self.result, key
 
-    def keep(self, method: str, problem: Problem, options: Options, result: BackendResult) -> None:
-        """Keep ``result`` when it is certified and complete; anything else clears the memory."""
+    def keep(self, key: tuple[Any, ...], result: BackendResult) -> None:
+        """Keep ``result`` for the laws of ``key`` (from :meth:`recalled`) when it is certified and complete; anything
+        else clears the memory."""
         if result.certified and result.search_complete and result.status in ("solved", "ambiguous"):
-            self.key, self.result = _key(method, problem, options), result.with_notes(reused=REUSED_NOTE)
+            self.key, self.result = key, result.with_notes(reused=REUSED_NOTE)
         else:
             self.key, self.result = None, None
 
