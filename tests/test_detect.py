@@ -495,8 +495,10 @@ def test_bad_input_is_a_scene_error_naming_the_field(build, field: str) -> None:
 
 
 def test_a_malformed_mesh_file_is_a_scene_error_naming_the_file(tmp_path: Path) -> None:
+    folder = tmp_path / ("a-folder-deep-enough-that-the-whole-path-is-longer-than-the-message-shows" * 2)
+    folder.mkdir()
     for name, text in [("junk.obj", "this is no mesh\n"), ("empty.stl", ""), ("flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")]:
-        path = tmp_path / name
+        path = folder / name
         path.write_text(text, encoding="utf-8")
         with pytest.raises(SceneError) as caught:
             Mesh(path, field="bodies.cube.shape.mesh")

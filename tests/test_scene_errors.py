@@ -556,3 +556,12 @@ def test_mutated_scene_raises_only_library_errors(data: dict[str, Any]) -> None:
     assert isinstance(solution, qs.Solution)
     event(f"solved: {solution.status}")
     assert solution.status in ("solved", "ambiguous", "jammed", "unstable", "failed")
+
+
+def test_a_missing_scene_file_in_a_deep_folder_is_named_by_its_end(tmp_path: Any) -> None:
+    """The value is cut to 80 characters; for a path the cut is at the start, so the file's name still shows."""
+    path = tmp_path.joinpath(*["deep-folder"] * 12, "my_scene.yaml")
+    with pytest.raises(qs.SceneError) as info:
+        qs.load_scene(path)
+    message = str(info.value)
+    assert "my_scene.yaml'" in message and "'..." in message and len(message) < 200, message

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterator
+from pathlib import PurePath
 from typing import Any
 
 __all__ = [
@@ -30,7 +31,8 @@ class SceneError(QuasistaticError, ValueError):
         What is wrong with it, in words.
 
     The message shows at most 80 characters of the value and 120 of the field,
-    however large or deeply nested the value is.
+    however large or deeply nested the value is; a long file path (a ``Path``
+    value) keeps its end, where the file's name is.
     """
 
     def __init__(self, field: str, value: Any, reason: str) -> None:
@@ -101,6 +103,8 @@ def _pieces(value: Any, limit: int) -> Iterator[str]:
 
 def _leaf_repr(value: Any, limit: int) -> str:
     """``repr`` of one value, never longer than needed: long text is cut first, huge integers are described."""
+    if isinstance(value, PurePath):
+        return repr(_path_tail(str(value), limit))
     if isinstance(value, (str, bytes, bytearray)) and len(value) > limit:
         return repr(value[:limit])
     if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 4 * limit:
@@ -112,6 +116,11 @@ def _leaf_repr(value: Any, limit: int) -> str:
         return repr(value)
     except Exception:  # a broken __repr__ must not hide the error being reported
         return f"<{type(value).__name__}>"
+
+
+def _path_tail(text: str, limit: int) -> str:
+    """A path cut at its start, not its end: in a deep folder the file's name must still show."""
+    return text if len(text) <= limit - 2 else "..." + text[-(limit - 5) :]
 
 
 def _short_text(text: str, limit: int) -> str:

@@ -124,7 +124,7 @@ class _Kinematics:
             try:
                 self.model = pinocchio.buildModelFromXML(text)
             except (ValueError, RuntimeError) as exc:
-                raise SceneError(field, str(urdf), f"not a valid URDF: {first_lines(errors()) or exc}") from None
+                raise SceneError(field, Path(urdf), f"not a valid URDF: {first_lines(errors()) or exc}") from None
             try:
                 # From the file, not the text: mesh paths relative to the URDF resolve from its folder.
                 self.geometry = pinocchio.buildGeomFromUrdf(
@@ -132,7 +132,7 @@ class _Kinematics:
                 )
             except (ValueError, RuntimeError) as exc:
                 reason = f"its collision geometry cannot be loaded: {first_lines(errors()) or exc}"
-                raise SceneError(field, str(urdf), f"{reason} (package:// paths are resolved in package_dirs)") from None
+                raise SceneError(field, Path(urdf), f"{reason} (package:// paths are resolved in package_dirs)") from None
         self.data = self.model.createData()
         self.geometry_data = pinocchio.GeometryData(self.geometry)
         self.urdf, self.package_dirs = urdf, tuple(package_dirs)
@@ -169,7 +169,7 @@ class _Kinematics:
         for joint_id in range(1, self.model.njoints):
             joint, name = self.model.joints[joint_id], self.model.names[joint_id]
             if joint.nv != 1:
-                raise SceneError(field, str(urdf), f"joint {name!r} has {joint.nv} degrees of freedom; only 1-DOF joints are supported")
+                raise SceneError(field, Path(urdf), f"joint {name!r} has {joint.nv} degrees of freedom; only 1-DOF joints are supported")
             names.append(name)
         return tuple(names)
 

@@ -16,6 +16,7 @@ import math
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import PurePath
 from typing import Any, TypeVar, cast
 
 import numpy as np
@@ -394,12 +395,12 @@ class Mesh(_Derived):
         factors = _positive_vector([scale] * 3 if is_number else scale, f"{field}.scale")
         if not os.path.isfile(text):
             reason = "not a regular file (a folder, device or pipe)" if os.path.exists(text) else "no such file"
-            raise SceneError(f"{field}.path", text, reason)
+            raise SceneError(f"{field}.path", PurePath(text), reason)
         vertices = _mesh_vertices(text, factors, f"{field}.path")
         try:
             convex = Convex(vertices, field)
         except SceneError as error:
-            raise SceneError(f"{field}.path", text, f"{error.reason} (the mesh's vertices)") from None
+            raise SceneError(f"{field}.path", PurePath(text), f"{error.reason} (the mesh's vertices)") from None
         _assign(self, path=text, scale=factors, convex=convex)
 
     @property
@@ -416,7 +417,7 @@ def _mesh_vertices(path: str, scale: FloatArray, field: str) -> FloatArray:
     except (ValueError, RuntimeError) as error:
         # coal's message starts with its own source location; the last line says what is wrong.
         reason = str(error).strip().splitlines()[-1] if str(error).strip() else type(error).__name__
-        raise SceneError(field, path, f"could not read the mesh: {reason}") from None
+        raise SceneError(field, PurePath(path), f"could not read the mesh: {reason}") from None
     vertices: FloatArray = np.array(model.vertices(), dtype=float).reshape(-1, 3)
     return vertices
 

@@ -415,13 +415,13 @@ def _read(path: str | Path) -> Any:
     except SceneError:
         raise
     except json.JSONDecodeError as exc:
-        raise SceneError("", str(path), f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}") from None
+        raise SceneError("", path, f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}") from None
     except yaml.YAMLError as exc:
         raise _yaml_error(path, text, exc) from None
     except RecursionError:  # a parser's own recursion (e.g. a YAML merge chain); nesting is limited before it
-        raise SceneError("", str(path), f"nested deeper than {MAX_DEPTH} levels") from None
+        raise SceneError("", path, f"nested deeper than {MAX_DEPTH} levels") from None
     except (ValueError, TypeError, OverflowError) as exc:  # a YAML tag's constructor, e.g. !!timestamp 2001-13-45
-        raise SceneError("", str(path), f"not valid {'JSON' if path.suffix.lower() == '.json' else 'YAML'}: {exc}") from None
+        raise SceneError("", path, f"not valid {'JSON' if path.suffix.lower() == '.json' else 'YAML'}: {exc}") from None
 
 
 def _yaml_error(path: Path, text: str, exc: yaml.YAMLError) -> SceneError:
@@ -438,7 +438,7 @@ def _yaml_error(path: Path, text: str, exc: yaml.YAMLError) -> SceneError:
             pass
     mark = getattr(exc, "problem_mark", None)
     where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-    return SceneError("", str(path), f"not valid YAML{where}: {problem}")
+    return SceneError("", path, f"not valid YAML{where}: {problem}")
 
 
 def read_text(path: Path, field: str = "", what: str = "the scene file") -> str:
@@ -450,13 +450,13 @@ def read_text(path: Path, field: str = "", what: str = "the scene file") -> str:
         with path.open("rb") as stream:
             raw = stream.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
-        raise SceneError(field, str(path), f"cannot read {what}: {exc.strerror or exc}") from None
+        raise SceneError(field, path, f"cannot read {what}: {exc.strerror or exc}") from None
     if len(raw) > MAX_FILE_BYTES:
-        raise SceneError(field, str(path), f"{what} is larger than {MAX_FILE_BYTES // 2**20} MiB")
+        raise SceneError(field, path, f"{what} is larger than {MAX_FILE_BYTES // 2**20} MiB")
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError:
-        raise SceneError(field, str(path), f"{what} is not UTF-8 text") from None
+        raise SceneError(field, path, f"{what} is not UTF-8 text") from None
 
 
 def _huge_integer(text: str) -> float | None:

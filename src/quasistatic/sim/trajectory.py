@@ -112,7 +112,7 @@ class Trajectory:
             ]
             path.write_text("\n".join(lines) + "\n", encoding="utf-8")
         else:
-            raise SceneError("out", str(path), "a trajectory is saved as .npz or .jsonl")
+            raise SceneError("out", Path(path), "a trajectory is saved as .npz or .jsonl")
         return path
 
     @classmethod
@@ -128,7 +128,7 @@ class Trajectory:
             raise SceneError(
                 "trajectory", str(path), f"is not a trajectory written by quasistatic ({type(error).__name__}: {error})"
             ) from None
-        raise SceneError("trajectory", str(path), "a trajectory file ends in .npz or .jsonl")
+        raise SceneError("trajectory", Path(path), "a trajectory file ends in .npz or .jsonl")
 
     def _header(self) -> dict[str, Any]:
         return {
