@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -72,9 +73,12 @@ def _above_the_legend(pixels: np.ndarray) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def pictures(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Path, subprocess.CompletedProcess[str]]]:
-    """Every case drawn once by the console script (they are slow to start)."""
+    """Every case drawn once by the console script, two processes at a time (each takes ~3 s, mostly imports)."""
     folder = tmp_path_factory.mktemp("pictures")
-    return {scene: (folder / f"{Path(scene).stem}.png", _plot(scene, folder / f"{Path(scene).stem}.png")) for scene in CASES}
+    outputs = {scene: folder / f"{Path(scene).stem}.png" for scene in CASES}
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        runs = dict(zip(outputs, pool.map(lambda scene: _plot(scene, outputs[scene]), outputs), strict=True))
+    return {scene: (outputs[scene], runs[scene]) for scene in CASES}
 
 
 @pytest.mark.parametrize("scene", sorted(CASES))
@@ -193,7 +197,7 @@ def test_a_solution_shows_itself_in_a_notebook(box_push: tuple[qs.Scene, qs.Solu
     assert solution._repr_png_() is None
 
 
-def test_robot_links_are_drawn_behind_the_scene(tmp_path: Path) -> None:
+def test_robot_links_are_drawn_behind_the_scene(tmp_path: Path, pictures: dict) -> None:
     """A URDF robot's collision shapes appear (translucent robot fill over white); a scene without one has none."""
     pytest.importorskip("pinocchio")
     from matplotlib.colors import to_hex, to_rgb
@@ -201,8 +205,7 @@ def test_robot_links_are_drawn_behind_the_scene(tmp_path: Path) -> None:
     from quasistatic.viz.style import ROBOT_FILL
 
     over_white = to_hex(0.6 * np.array(to_rgb(ROBOT_FILL)) + 0.4)  # alpha 0.6 on the white page
-    robot, plain = tmp_path / "allegro.png", tmp_path / "box.png"
+    robot, (plain, _) = tmp_path / "allegro.png", pictures["box_push_shapes.yaml"]
     assert _plot(EXAMPLES / "robots" / "allegro_ball.yaml", robot).returncode == 0
-    assert _plot("box_push_shapes.yaml", plain).returncode == 0
     drawn, stray = _count(_above_the_legend(_pixels(robot)), over_white), _count(_above_the_legend(_pixels(plain)), over_white)
     assert drawn > 100 * _PRESENT and stray < _PRESENT, (drawn, stray)  # whole links, against antialiased edges
