@@ -16,6 +16,7 @@ import re
 import subprocess
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -198,21 +199,24 @@ def test_a_long_run_is_exported_at_even_times(run: qs.Trajectory, world: qs.Worl
 
 def test_the_command_exports_a_run_and_needs_its_scene(tmp_path: Path) -> None:
     pytest.importorskip("viser")
-    target = tmp_path / "run.html"
-    done = subprocess.run(
-        [str(COMMAND), "view", str(RUN), "--scene", str(TIP), "--export", str(target)], capture_output=True, text=True, timeout=300
-    )
+    target, refused = tmp_path / "run.html", tmp_path / "refused.html"
+    commands = [
+        ["view", str(RUN), "--scene", str(TIP), "--export", str(target)],
+        ["view", str(RUN), "--export", str(refused)],
+        ["view", str(RUN), "--method", "fast"],
+        ["view", str(TIP), "--scene", str(TIP), "--export", str(refused)],
+    ]
+    with ThreadPoolExecutor(max_workers=2) as pool:  # four processes, mostly imports: two at a time
+        done, orphan, solved, scene_only = pool.map(
+            lambda args: subprocess.run([str(COMMAND), *args], capture_output=True, text=True, timeout=300), commands
+        )
     assert done.returncode == 0 and done.stdout.strip() == f"wrote {target}: 6 states, completed", (done.stdout, done.stderr)
     assert _recording(target.read_text())["durationSeconds"] == pytest.approx(1.1)
-    orphan = subprocess.run([str(COMMAND), "view", str(RUN), "--export", str(target)], capture_output=True, text=True, timeout=300)
     lines = orphan.stderr.strip().splitlines()
     assert orphan.returncode == 2 and len(lines) == 1 and lines[0].startswith("error: ") and "give --scene" in lines[0]
-    solved = subprocess.run([str(COMMAND), "view", str(RUN), "--method", "fast"], capture_output=True, text=True, timeout=300)
     assert solved.returncode == 2 and solved.stderr.startswith("error: --method 'fast': a trajectory is drawn")
-    scene_only = subprocess.run(
-        [str(COMMAND), "view", str(TIP), "--scene", str(TIP), "--export", str(target)], capture_output=True, text=True, timeout=300
-    )
     assert scene_only.returncode == 2 and "--scene" in scene_only.stderr and len(scene_only.stderr.strip().splitlines()) == 1
+    assert not refused.exists()
 
 
 # --------------------------------------------------------------------------- in a notebook
