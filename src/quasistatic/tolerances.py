@@ -29,6 +29,9 @@ __all__ = [
     "COMPLIANCE_RANK",
     "MOTION_RANK",
     "LP_FEASIBILITY",
+    "LINE_RANK",
+    "LINE_NULL_SPACE",
+    "LINE_PARALLEL_ROW",
     "FORCE_CEILING",
     "FORCE_INTERIOR",
     "PATTERN_NODES",
@@ -130,6 +133,16 @@ MOTION_RANK = 1e-9
 
 LP_FEASIBILITY = 1e-7
 """What HiGHS and SCIP meet constraints to; a certificate or range checked with their output uses the same [-]."""
+
+LINE_RANK = 1e-9
+"""Equality rows whose second-smallest singular value (of n) is above this fraction of their largest leave at most
+a line of twists: a leaf's extent is then read off in closed form (``numerics/line_extent.py``) [-]."""
+
+LINE_NULL_SPACE = 1e-12
+"""... and whose smallest singular value is below this fraction of their largest leave exactly a line [-]."""
+
+LINE_PARALLEL_ROW = 1e-12
+"""A row whose rate along a line's unit direction is below this fraction of its norm is parallel to the line [-]."""
 
 KINEMATIC_MULTIPLIERS = 1e10
 """Largest ``|y|_1`` of Farkas multipliers (``y >= 0``, ``Jn^T y = 0``, ``bn.y = 1``) accepted as proof that no twist keeps

@@ -150,6 +150,7 @@ from ...tolerances import (
     ZERO,
 )
 from ..numerics.highs import WarmLP, solve_lp
+from ..numerics.line_extent import AxisExtents, line_axis_extents
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
@@ -869,30 +870,22 @@ def _known_point(rows: _Rows, q: np.ndarray, columns: np.ndarray) -> bool:
 
 
 def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
-    """A leaf whose rows leave a polyhedron of twists: HiGHS measures its extent along each twist entry (2 n LPs
-    on one warm model). Empty, or every extreme within ``SAME_TWIST / 2`` of the seed: nothing new. One
-    extreme: a single motion there. Else a continuum: its extremes, its free directions, and a point inside it
-    (every inequality as slack as it can be), each with the leaf's forces and checked on every law of the form.
-    False when a check or an LP fails (too close to call) or there are too many motions."""
+    """A leaf whose rows leave a polyhedron of twists: its extent along each twist entry, by 2 n LPs on one warm
+    HiGHS model (in 3-D, where the equalities leave a line, its ends in closed form). Empty, or every extreme
+    within ``SAME_TWIST / 2`` of the seed: nothing new. One extreme: a single motion there. Else a continuum: its
+    extremes, its free directions, and a point inside it (every inequality as slack as it can be), each with the
+    leaf's forces and checked on every law of the form. False when a check or an LP fails (too close to call) or
+    there are too many motions."""
     equal, at_least = rows.row_mask(node.equal), rows.row_mask(node.at_least)
     E, e = rows.bank[equal], rows.rhs[equal]
     A, a = rows.bank[at_least], rows.rhs[at_least]
-    n = rows.g.size
-    model = WarmLP(np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
-    extremes: list[np.ndarray] = []
-    free: list[int] = []
-    for j in range(n):
-        for maximize in (False, True):
-            rows.proof.lps += 1
-            lp = model.optimise(np.eye(1, n, j)[0], maximize)
-            if lp.status == "infeasible":
-                return True
-            if lp.status == "unbounded":
-                free.append((j + 1) if maximize else -(j + 1))
-            elif lp.status != "optimal":
-                return False
-            elif not any(np.max(np.abs(lp.x - p)) <= SAME_TWIST for p in extremes):
-                extremes.append(lp.x)
+    # In 3-D the extremes' order never matters below, so a line's ends are read off without the LPs.
+    extents = line_axis_extents(E, e, A, a) if rows.width > 2 else None
+    if extents is None:
+        extents = _axis_extents_by_lps(rows, (E, e, A, a))
+    if extents is None or extents.empty:
+        return extents is not None
+    extremes, free = list(extents.extremes), list(extents.free)
     seed = rows.seed
     if not free and seed is not None and all(np.max(np.abs(p - seed)) <= 0.5 * SAME_TWIST for p in extremes):
         return True  # the seed's twist alone
@@ -906,6 +899,29 @@ def _record_polyhedron(rows: _Rows, node: _Node, fit: np.ndarray) -> bool:
         # polyhedron), this search would list each face. Until faces are merged, SCIP lists them.
         return False
     return _record_continuum(rows, (E, e, A, a), extremes, tuple(free), fit, rows.columns(node.columns))
+
+
+def _axis_extents_by_lps(rows: _Rows, region: _Region) -> AxisExtents | None:
+    """The least and largest value of each twist entry over a leaf's polyhedron: 2 n LPs on one warm HiGHS model
+    (None where one ends without an answer)."""
+    E, e, A, a = region
+    n = rows.g.size
+    model = WarmLP(np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
+    extremes: list[np.ndarray] = []
+    free: list[int] = []
+    for j in range(n):
+        for maximize in (False, True):
+            rows.proof.lps += 1
+            lp = model.optimise(np.eye(1, n, j)[0], maximize)
+            if lp.status == "infeasible":
+                return AxisExtents(empty=True)
+            if lp.status == "unbounded":
+                free.append((j + 1) if maximize else -(j + 1))
+            elif lp.status != "optimal":
+                return None
+            elif not any(np.max(np.abs(lp.x - p)) <= SAME_TWIST for p in extremes):
+                extremes.append(lp.x)
+    return AxisExtents(empty=False, extremes=tuple(extremes), free=tuple(free))
 
 
 def _record_continuum(
