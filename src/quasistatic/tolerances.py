@@ -35,6 +35,7 @@ __all__ = [
     "PYRAMID_PATTERN_NODES",
     "ARRANGEMENT_CONTACTS",
     "ARRANGEMENT_ROUNDOFF",
+    "BATCH_CONTACTS",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
     "BASIS_FEASIBILITY",
@@ -181,6 +182,12 @@ have lengths 1 to 2), a ray's rate along a plane below it is zero, and a compute
 fraction of ``|n| |w|_1 + |r|``. A zero rate or a near plane only adds force generators (it can keep a vertex from
 being excluded, never exclude one); dependent normals are the one round-off assumption, as for the branch and bound's
 parallel lines: computed to 1e-16, normals this close to dependent meet 1e12 times farther than their offsets."""
+
+BATCH_CONTACTS = 8
+"""Most contacts of a sweep's planar points decided together (:mod:`quasistatic.solvers.certify.batched`) [-]: its
+ray test holds, per vertex left, every pair of near planes against every candidate Farkas direction, an array that
+grows as the fourth power of the contacts (about 20 MB for a chunk's held vertices at 8); past it each point is
+solved alone."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""

@@ -17,6 +17,7 @@ from typing import Any
 from ..errors import BackendUnavailableError, QuasistaticError
 from ..solution import Solution
 from ..solve import solve
+from .batched import batched_points
 from .params import SweepParam
 from .result import SWEEPS_INSTALL_HINT, SweepPoint, point_from_solution
 from .scenes import PointScenes, scene_at
@@ -59,7 +60,11 @@ def solve_chunk(chunk: Chunk) -> tuple[str, list[SweepPoint]]:
     fails is recorded as ``failed`` with the reason, so one bad corner does not lose the sweep."""
     points = []
     scenes = PointScenes(chunk.data, chunk.folder, chunk.params)  # the file validated once per chunk
-    for index, values, refinement in chunk.points:
+    decided = batched_points(scenes, chunk.points, chunk.options)  # the points proven together, by position
+    for position, (index, values, refinement) in enumerate(chunk.points):
+        if position in decided:
+            points.append(decided[position])
+            continue
         start = time.perf_counter()
         try:
             solution = solve(scenes.at(values), **chunk.options)

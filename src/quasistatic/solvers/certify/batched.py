@@ -1,0 +1,318 @@
+"""The certified decision of many planar one-body problems of one shape at once (a sweep's chunk).
+
+Why batched: on a small planar scene the certified solve is ~100 numpy calls on arrays of a few entries, so its
+time is Python's per-call overhead, not arithmetic. A sweep's points share their shape (one body, the same
+contacts, the same frictional ones), so every array of :mod:`.arrangement`'s vertex certificate gains a leading
+point axis and one numpy call serves the whole chunk.
+
+What is decided here, per point, is only the certified solve's usual answer on such scenes, and only by the same
+proof: Lemke's point (the same compiled kernel on the same numbers as :func:`~.cheap.seed_point`, then checked on
+every law of the form to ``ZERO``), not kinematically unique (at most three closed contacts, so
+:func:`~.cheap.kinematically_unique` has no bound), and the vertex certificate's claim 2 (:mod:`.arrangement`: every
+vertex not excluded is the seed's, and every ray leaving them has its loads excluded by a checked Farkas
+direction), with the same tolerances. Then the motion's forces are unique by the plane's rank test
+(:func:`~..numerics.forces.indeterminate_forces` first test). Anything else (no seed, a kinematic bound to try,
+vertices near another twist, a ray not excluded, forces that may vary, a value within a factor of two of a
+threshold of those tests, whose rounding here may differ from the per-point code's) leaves the point
+undecided, and the caller solves it alone: the batch never decides what the per-point solve would not.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...laws.stacked import StackedLaws
+from ...tolerances import (
+    ARRANGEMENT_ROUNDOFF,
+    DISTINCT_TWIST,
+    FORCE_CEILING,
+    FORCE_RANK,
+    LP_FEASIBILITY,
+    MODE_SPEED,
+    PIVOT,
+    SAME_TWIST,
+    ZERO,
+)
+from ..numerics.lcp import PIVOTS_PER_ROW, split_lcp_point
+from ..numerics.lemke import SOLUTION
+
+__all__ = ["BatchedMotions", "certify_batch"]
+
+_PLANAR_EDGES = np.array([1.0, -1.0])  # the 2-D cone's edges along the tangent, as the kernel builds them
+_MOVING = ZERO * 10  # open or sliding beyond this (as numerics.forces measures a motion's modes)
+_LOOSENESS = np.array([0.0, ZERO, LP_FEASIBILITY])[:, None, None, None]  # the tau of each claim on the twist
+_WITHIN = np.array([0.5 * SAME_TWIST, 0.5 * DISTINCT_TWIST, DISTINCT_TWIST])[:, None, None]  # how near the seed
+_EDGE_BITS = np.array([1, 3, 2], dtype=np.uint64)  # by slip sign -1, 0, +1: the edge n + mu t, both, n - mu t
+
+
+@dataclass(frozen=True)
+class BatchedMotions:
+    """Per point: ``decided`` (N,) the proof went through; there ``q`` (N, 3) is the only motion's scene-relative
+    twist (Lemke's, bit for bit) and ``c`` (N, m, 2) its contact-frame forces (tangent, normal), unique."""
+
+    decided: np.ndarray
+    q: np.ndarray
+    c: np.ndarray
+
+
+def certify_batch(laws: StackedLaws) -> BatchedMotions:
+    """Decide what can be decided of every point of ``laws`` (every point with the same frictional contacts)."""
+    q, cn, beta, lam, seeded = _seeds(laws)
+    decided = seeded & _form_holds(laws, q, cn, beta, lam) & _few_closed(laws, q)
+    if decided.any():
+        decided &= _vertex_proof(laws, q, decided)
+    if decided.any():
+        decided &= _forces_unique(laws, q)
+    c = np.stack([beta[..., 0] - beta[..., 1], cn], axis=-1)  # as LCPForm.forces: the edges +1 and -1
+    return BatchedMotions(decided, q, c)
+
+
+def _seeds(laws: StackedLaws) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Lemke's point of each problem by the kernel :func:`~.cheap.seed_point` runs, on the same contiguous numbers."""
+    N, m = laws.mu.shape
+    q, cn, beta, lam = np.zeros((N, 3)), np.zeros((N, m)), np.zeros((N, m, 2)), np.zeros((N, m))
+    seeded = np.zeros(N, dtype=bool)
+    J, b, mu, g = (np.ascontiguousarray(a, dtype=float) for a in (laws.J, laws.b, laws.mu, laws.g))
+    frictional = np.flatnonzero(mu[0] > 0.0)
+    f = frictional.size
+    for k in range(N):
+        status, z = split_lcp_point(J[k], b[k], mu[k], g[k], frictional, _PLANAR_EDGES, PIVOT, PIVOTS_PER_ROW)
+        if status != SOLUTION:
+            continue
+        seeded[k] = True
+        q[k] = z[:3] - z[3:6]
+        cn[k] = z[6 : 6 + m]
+        beta[k, frictional] = z[6 + m : 6 + m + 2 * f].reshape(f, 2)
+        lam[k, frictional] = z[6 + m + 2 * f :]
+    slip = _rows(laws.J[..., 0, :], q) - laws.b[..., 0]
+    frictionless = mu[0] <= 0.0
+    lam[:, frictionless] = np.abs(slip[:, frictionless])  # the least slip speed its edges accept (cheap._form_point)
+    return q, cn, beta, lam, seeded
+
+
+def _rows(A: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """``A q`` for rows ``A`` (N, m, 3) and twists ``q`` (N, 3)."""
+    return A[..., 0] * q[:, None, 0] + A[..., 1] * q[:, None, 1] + A[..., 2] * q[:, None, 2]
+
+
+def _clear(values: np.ndarray, threshold: float) -> np.ndarray:
+    """Whether ``values`` are far from ``threshold`` (outside a factor of two): their side of it cannot depend on
+    rounding. Per point (the last axes reduced)."""
+    near = (np.abs(values) > 0.5 * threshold) & (np.abs(values) <= 2.0 * threshold)
+    return ~near.reshape(near.shape[0], -1).any(axis=1)
+
+
+def _form_holds(laws: StackedLaws, q: np.ndarray, cn: np.ndarray, beta: np.ndarray, lam: np.ndarray) -> np.ndarray:
+    """:func:`~.cheap.satisfies_form` per point: equilibrium, signs and complementarity to ``ZERO``, clear of it."""
+    Jt, Jn = laws.J[..., 0, :], laws.J[..., 1, :]
+    tangential = beta[..., 0] - beta[..., 1]
+    equilibrium = (cn[..., None] * Jn + tangential[..., None] * Jt).sum(axis=1) + laws.g
+    slip = _rows(Jt, q) - laws.b[..., 0]
+    w = np.concatenate(
+        (
+            _rows(Jn, q) - laws.b[..., 1],
+            (np.stack([slip, -slip], axis=-1) + lam[..., None]).reshape(q.shape[0], -1),
+            laws.mu * cn - beta.sum(axis=2),
+        ),
+        axis=1,
+    )
+    pairs = np.concatenate((cn, beta.reshape(q.shape[0], -1), lam), axis=1)
+    signs = np.minimum(pairs.min(axis=1, initial=0.0), w.min(axis=1, initial=0.0))
+    complementarity = np.minimum(np.abs(pairs), np.abs(w))
+    holds = (np.abs(equilibrium).max(axis=1) <= ZERO) & (signs >= -ZERO) & (complementarity.max(axis=1) <= ZERO)
+    clear = _clear(equilibrium, ZERO) & _clear(np.minimum(pairs, 0.0), ZERO) & _clear(np.minimum(w, 0.0), ZERO)
+    return holds & clear & _clear(complementarity, ZERO)
+
+
+def _few_closed(laws: StackedLaws, q: np.ndarray) -> np.ndarray:
+    """At most three contacts closed at ``q`` (to ``MODE_SPEED``): then no Gordan bound exists (more rows than the
+    twist's three are needed) and the certified solve goes on to the vertex certificate, as here."""
+    gap = _rows(laws.J[..., 1, :], q) - laws.b[..., 1]
+    return ((np.abs(gap) <= MODE_SPEED).sum(axis=1) <= 3) & _clear(gap, MODE_SPEED)
+
+
+@functools.cache
+def _triples(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every triple ``i < j < k`` (T, 3) and the flat pair columns of its adjugate's rows (3, T), as arrangement.py."""
+    triples = np.array(list(itertools.combinations(range(count), 3)), dtype=np.intp).reshape(-1, 3)
+    i, j, k = triples.T
+    return triples, np.stack([j * count + k, k * count + i, i * count + j])
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
+@dataclass(frozen=True)
+class _Planes:
+    """Every point's arrangement (:mod:`.arrangement`'s ``_Planes`` with a leading axis): ``normals`` (N, P, 3),
+    ``rhs`` (N, P), ``crosses`` (N, P * P, 3), ``triple`` (N, P, P * P), ``loads`` (N, 3, 2 m), ``longest``,
+    ``offset``, ``dependent`` (N,), ``m`` contacts and ``frictional`` (f,)."""
+
+    normals: np.ndarray
+    rhs: np.ndarray
+    crosses: np.ndarray
+    triple: np.ndarray
+    loads: np.ndarray
+    longest: np.ndarray
+    offset: np.ndarray
+    dependent: np.ndarray
+    m: int
+    frictional: np.ndarray
+
+
+def _planes(laws: StackedLaws) -> _Planes:
+    frictional = np.flatnonzero(laws.mu[0] > 0.0)
+    Jt, Jn = laws.J[..., 0, :], laws.J[..., 1, :]
+    normals = np.concatenate((Jn, Jt[:, frictional]), axis=1)
+    N, P = normals.shape[:2]
+    crosses = _cross(normals[:, :, None, :], normals[:, None, :, :]).reshape(N, P * P, 3)
+    triple = np.einsum("npj,nqj->npq", normals, crosses)
+    longest = np.sqrt((normals * normals).sum(axis=2).max(axis=1))
+    rhs = np.concatenate((laws.b[..., 1], laws.b[:, frictional, 0]), axis=1)
+    friction = laws.mu[..., None] * Jt
+    loads = np.empty((N, 3, 2 * Jn.shape[1]))
+    loads[:, :, 0::2] = (Jn + friction).transpose(0, 2, 1)
+    loads[:, :, 1::2] = (Jn - friction).transpose(0, 2, 1)
+    dependent = ARRANGEMENT_ROUNDOFF * longest**3
+    return _Planes(normals, rhs, crosses, triple, loads, longest, np.abs(rhs).max(axis=1), dependent, Jn.shape[1], frictional)
+
+
+@dataclass(frozen=True)
+class _Exclusions:
+    """Candidate Farkas directions per point and the loads each excludes (``blocked``, (N, D) bit masks; a direction
+    that is no Farkas direction for that point, ``useful`` False, excludes nothing)."""
+
+    blocked: np.ndarray
+    useful: np.ndarray
+    count: int
+
+    @classmethod
+    def of(cls, loads: np.ndarray, g: np.ndarray) -> _Exclusions:
+        N, _, count = loads.shape
+        columns = loads.transpose(0, 2, 1)  # (N, 2m, 3)
+        i, j = np.triu_indices(count, 1)
+        normals = _cross(columns[:, i], columns[:, j])
+        square = (columns * columns).sum(axis=2)
+        toward = (columns * -g[:, None, :]).sum(axis=2) / np.maximum(square, 1e-300)
+        along = -g[:, None, :] - toward[..., None] * columns
+        directions = np.concatenate((-g[:, None, :], along, normals, -normals), axis=1)
+        margin = math.sqrt(3.0) * LP_FEASIBILITY
+        reserve = (directions * -g[:, None, :]).sum(axis=2) - margin * np.sqrt((directions * directions).sum(axis=2))
+        useful = reserve > 0.0
+        blocked = np.einsum("ndj,njk->ndk", directions, loads) * FORCE_CEILING < reserve[..., None]
+        bits = np.uint64(1) << np.arange(count, dtype=np.uint64)
+        masks = (blocked.astype(np.uint64) * bits).sum(axis=2, dtype=np.uint64)
+        return cls(np.where(useful, masks, np.uint64(0)), useful, count)
+
+    def excludes(self, masks: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """Whether a direction of point ``points[k]`` excludes ``masks[k, ...]`` (bit masks)."""
+        blocked, useful = self.blocked[points], self.useful[points]
+        shape = (blocked.shape[0],) + (1,) * (masks.ndim - 1) + (blocked.shape[1],)
+        free = masks[..., None] & ~blocked.reshape(shape)
+        return ((free == 0) & useful.reshape(shape)).any(axis=-1)
+
+    def every_load(self) -> np.ndarray:
+        every = np.uint64(2**self.count - 1)
+        return (((every & ~self.blocked) == 0) & self.useful).any(axis=1)
+
+
+def _load_masks(signs: np.ndarray, m: int, frictional: np.ndarray) -> np.ndarray:
+    """Bit masks of the loads each sign vector's contacts may use (``signs`` (..., P), 0 on near planes)."""
+    slip = np.zeros((*signs.shape[:-1], m), dtype=np.int8)
+    slip[..., frictional] = signs[..., m:]
+    bits = _EDGE_BITS[slip + 1] * (signs[..., :m] == 0)
+    weights = np.uint64(4) ** np.arange(m, dtype=np.uint64)
+    return (bits * weights).sum(axis=-1, dtype=np.uint64)
+
+
+def _vertex_proof(laws: StackedLaws, q: np.ndarray, todo: np.ndarray) -> np.ndarray:
+    """The vertex certificate's claim 2 per point: the seed's twist the only motion (see :mod:`.arrangement`)."""
+    planes = _planes(laws)
+    excluded = _Exclusions.of(planes.loads, laws.g)
+    N, P = planes.rhs.shape
+    if P < 3:
+        return np.zeros(N, dtype=bool)
+    triples, columns = _triples(P)
+    det = planes.triple[:, triples[:, 0], columns[0]]  # (N, T)
+    independent = np.abs(det) > planes.dependent[:, None]
+    det = np.where(independent, det, 1.0)
+    products = planes.triple[:, :, columns] / det[:, None, None, :]  # (N, P, 3, T)
+    r = planes.rhs[:, triples].transpose(0, 2, 1)  # (N, 3, T)
+    rows = np.einsum("npkt,nkt->npt", products, r) - planes.rhs[:, :, None]
+    adjugate = planes.crosses[:, columns]  # (N, 3, T, 3)
+    w = np.einsum("nkt,nktj->ntj", r, adjugate) / det[..., None]
+    slack = ARRANGEMENT_ROUNDOFF * (planes.longest[:, None] * np.abs(w).sum(axis=2) + planes.offset[:, None])
+    near = (LP_FEASIBILITY + slack[:, None, :]) * (1.0 + np.abs(products).sum(axis=2)) + slack[:, None, :]
+    signs = ((rows > near).view(np.int8) - (rows < -near).view(np.int8)).transpose(0, 2, 1)  # (N, T, P)
+    kept = independent & (signs[..., : planes.m] >= 0).all(axis=2)
+    spread = np.abs(adjugate).sum(axis=1) / np.abs(det)[..., None]  # (N, T, 3)
+    masks = _load_masks(signs, planes.m, planes.frictional)
+    held = kept & ~excluded.excludes(masks, np.arange(N)) & todo[:, None]
+    reach = np.abs(w - q[:, None, :]) + (_LOOSENESS + slack[None, :, :, None]) * spread[None]  # (3, N, T, 3)
+    near_seed = ((reach.max(axis=3) <= _WITHIN) | ~held[None]).all(axis=(0, 2))
+    proven = todo & independent.any(axis=1) & held.any(axis=1) & near_seed & ~excluded.every_load() & excluded.useful.any(axis=1)
+    return proven & _rays_excluded(planes, excluded, signs, held & proven[:, None])
+
+
+def _rays_excluded(planes: _Planes, excluded: _Exclusions, signs: np.ndarray, held: np.ndarray) -> np.ndarray:
+    """Per point, whether every ray leaving a held vertex, along a line where two of its near planes meet and
+    kept in loose ``Q0``, has its loads excluded (:mod:`.arrangement`'s ``_edges_excluded`` without ``apart``)."""
+    N, P = planes.rhs.shape
+    points, vertex = held.nonzero()
+    sign = signs[points, vertex]  # (H, P)
+    a, b = np.triu_indices(P, 1)
+    lines = planes.crosses[:, a * P + b]  # (N, Q, 3)
+    squares = (lines * lines).sum(axis=2)
+    parallel = ~(squares > (planes.dependent**2 / planes.longest**2)[:, None])
+    zero = sign == 0
+    valid = zero[:, a] & zero[:, b] & ~parallel[points]  # (H, Q)
+    along = planes.triple[points][:, :, a * P + b].transpose(0, 2, 1).copy()  # (H, Q, P)
+    along[np.abs(along) <= planes.dependent[points, None, None]] = 0.0
+    gap_near = zero[:, None, : planes.m]
+    ok = np.ones(points.size, dtype=bool)
+    for direction in (along, -along):
+        opening = ((direction[..., : planes.m] >= 0.0) | ~gap_near).all(axis=2)
+        ray_signs = np.where(zero[:, None, :], np.sign(direction).astype(np.int8), sign[:, None, :])
+        masks = _load_masks(ray_signs, planes.m, planes.frictional)
+        ok &= (excluded.excludes(masks, points) | ~(valid & opening)).all(axis=1)
+    proven = np.ones(N, dtype=bool)
+    proven[points[~ok]] = False
+    return proven
+
+
+def _forces_unique(laws: StackedLaws, q: np.ndarray) -> np.ndarray:
+    """The plane's rank test of :func:`~..numerics.forces.indeterminate_forces` per point: the closed contacts' force
+    coordinates (a cone's tangent and normal; a frictionless or sliding contact's one tilted normal) have a wrench
+    map of full column rank (every singular value above ``FORCE_RANK``), clear of every threshold."""
+    Jt, Jn = laws.J[..., 0, :], laws.J[..., 1, :]
+    u_n = _rows(Jn, q) - laws.b[..., 1]
+    u_t = _rows(Jt, q) - laws.b[..., 0]
+    closed = ~(u_n > _MOVING)
+    frictional = laws.mu > 0.0
+    sliding = closed & (np.abs(u_t) > _MOVING) & frictional
+    single = ~frictional | sliding
+    tilt = np.where(sliding, -laws.mu * np.sign(u_t), 0.0)
+    one = Jn + tilt[..., None] * Jt  # (N, m, 3)
+    unique = _clear(u_n, _MOVING) & _clear(u_t, _MOVING)
+    counts = np.where(closed, np.where(single, 1, 2), 0).sum(axis=1)
+    unique &= counts <= 3
+    patterns = np.concatenate((closed, single), axis=1)
+    for pattern in np.unique(patterns[unique], axis=0):
+        members = np.flatnonzero(unique & (patterns == pattern).all(axis=1))
+        shut, alone = pattern[: Jn.shape[1]], pattern[Jn.shape[1] :]
+        columns = [one[members, i] for i in np.flatnonzero(shut & alone)]
+        columns += [x for i in np.flatnonzero(shut & ~alone) for x in (Jt[members, i], Jn[members, i])]
+        if not columns:
+            continue
+        wrenches = np.stack(columns, axis=2)  # (k, 3, f)
+        smallest = np.linalg.svd(wrenches, compute_uv=False)[:, -1]
+        unique[members] &= (smallest > FORCE_RANK) & _clear(smallest[:, None], FORCE_RANK)
+    return unique

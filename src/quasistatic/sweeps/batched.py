@@ -1,0 +1,165 @@
+"""A chunk's points solved together, where they share one planar shape and the default certified method runs.
+
+Why: a small planar certified solve is ~1 ms of Python calls on arrays of a few entries (the scene at the point,
+assembly, Lemke, the vertex certificate, the audit, the Solution). The points of a sweep's chunk differ only in
+the swept numbers, so here those numbers are written into stacked arrays (:class:`~quasistatic.model.stacked.PlanarStack`,
+no Scene per point), assembled together (:func:`~quasistatic.laws.stacked.assemble_stack`, bit for bit as
+``assemble``), decided together (:func:`~quasistatic.solvers.batched.certify_stack`: Lemke's kernel per point,
+then the vertex certificate and the force rank test for all points at once), and audited together on each point's
+own numbers (:func:`~quasistatic.check.stacked.audit_stack`). A point the batch does not decide (another swept
+path, a value a Scene might reject, an answer other than one proven motion with unique forces, a value near a
+threshold, a failed audit) is left to the per-point :func:`~quasistatic.solve`, so the batch never changes an
+answer: it decides faster what it can decide exactly. Its records equal the per-point ones (status, message,
+twists, forces, modes; tested on random grids).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..check import DEFAULT_TOLERANCE
+from ..check.stacked import MODE_CODES, audit_stack
+from ..laws.stacked import assemble_stack
+from ..model.stacked import PlanarStack, stackable
+from ..solvers.batched import SOLVED_UNIQUE, certify_stack
+from ..tolerances import BATCH_CONTACTS, MAX_FRICTION, MAX_MAGNITUDE, ROUNDOFF
+from .result import SweepPoint
+from .scenes import PointScenes
+
+__all__ = ["batched_points"]
+
+Task = tuple[int, tuple[float, ...], bool]
+
+
+def batched_points(scenes: PointScenes, tasks: Sequence[Task], options: Mapping[str, Any]) -> dict[int, SweepPoint]:
+    """The points of ``tasks`` the batch decides, by position in ``tasks``; the others are not in the result."""
+    started = time.perf_counter()
+    setters = _setters(scenes, options)
+    if setters is None or len(tasks) < 2:
+        return {}
+    assert scenes.base is not None
+    values = np.array([task[1] for task in tasks], dtype=float).reshape(len(tasks), len(setters))
+    valid = _valid(values, setters)
+    stack = PlanarStack.tiled(scenes.base, len(tasks))
+    for column, setter in enumerate(setters):
+        setter.apply(stack, values[:, column])
+    decided: dict[int, SweepPoint] = {}
+    frictional = stack.mu > 0.0
+    for mask in np.unique(frictional[valid & frictional.any(axis=1)], axis=0):
+        members = np.flatnonzero(valid & (frictional == mask).all(axis=1))
+        tolerance = float(options.get("tolerance", DEFAULT_TOLERANCE))
+        decided.update(_decided(_taken(stack, members), [tasks[k] for k in members.tolist()], members, tolerance))
+    seconds = (time.perf_counter() - started) / max(len(decided), 1)  # a batched point's share of the batch's time
+    for point in decided.values():
+        object.__setattr__(point, "seconds", seconds)  # known only now; the points are new and not yet shared
+    return decided
+
+
+class _Setter:
+    """Where one parameter's value goes in a stack: its paths as (array name, index) pairs, and what it must be."""
+
+    def __init__(self, places: list[tuple[str, tuple[Any, ...]]], kind: str) -> None:
+        self.places, self.kind = places, kind
+
+    def apply(self, stack: PlanarStack, values: np.ndarray) -> None:
+        for name, index in self.places:
+            array = getattr(stack, name)
+            where = (slice(None), *index)
+            array[where] = values.reshape(-1, *([1] * (array[where].ndim - 1)))
+
+
+def _setters(scenes: PointScenes, options: Mapping[str, Any]) -> list[_Setter] | None:
+    """One setter per parameter, or None when the batch does not apply (method, scene shape or a swept path)."""
+    method = options.get("method", "auto")
+    certify = options.get("certify", True) if options.get("all_solutions") is None else options.get("all_solutions")
+    if method not in ("auto", "certified") or (method == "auto" and not certify):
+        return None
+    base = scenes.base
+    if base is None or scenes.parts is None or not stackable(base) or len(base.contacts) > BATCH_CONTACTS:
+        return None
+    setters = []
+    for paths in scenes.steps:
+        places = [_place(base, path) for path in paths]
+        if any(place is None for place in places):
+            return None
+        kinds = {place[2] for place in places if place is not None}
+        setters.append(_Setter([(p[0], p[1]) for p in places if p is not None], kinds.pop() if len(kinds) == 1 else "number"))
+    return setters
+
+
+def _place(base: Any, path: tuple[str | int, ...]) -> tuple[str, tuple[Any, ...], str] | None:
+    """The stack array and index a file path sets, and the kind of number it is; None where the batch cannot set it."""
+    if path[0] == "contacts" and len(path) == 3 and path[2] == "mu":
+        return ("mu", (path[1],), "mu")
+    if path[0] == "contacts" and len(path) == 4 and path[2] == "point" and path[3] in (0, 1):
+        return ("point", (path[1], path[3]), "number")
+    body = base.bodies[0].name
+    if path[:3] == ("bodies", body, "mass") and len(path) == 3:
+        return ("mass", (), "mass")
+    if path[:3] == ("bodies", body, "com") and len(path) == 4 and path[3] in (0, 1):
+        return ("com", (path[3],), "number")
+    if path[:3] == ("bodies", body, "wrench") and len(path) == 4 and path[3] in (0, 1, 2):
+        return ("wrench", (path[3],), "number")
+    if path[0] == "movers" and len(path) == 4 and path[2] == "twist" and path[3] in (0, 1, 2):
+        rows = tuple(i for i, c in enumerate(base.contacts) if c.other == path[1])
+        return ("twist", (list(rows), path[3]), "number") if rows else None
+    return None
+
+
+def _valid(values: np.ndarray, setters: list[_Setter]) -> np.ndarray:
+    """Points whose every value a Scene accepts (finite, within ``MAX_MAGNITUDE``; mu and mass as ``Contact`` and
+    ``Body`` check them): any other is solved alone, which reports its error as a fresh read does."""
+    valid = np.isfinite(values).all(axis=1) & (np.abs(values) <= MAX_MAGNITUDE).all(axis=1)
+    for column, setter in enumerate(setters):
+        if setter.kind == "mu":
+            valid &= (values[:, column] >= 0.0) & (values[:, column] <= MAX_FRICTION)
+        elif setter.kind == "mass":
+            valid &= values[:, column] >= 0.0
+    return valid
+
+
+def _taken(stack: PlanarStack, members: np.ndarray) -> PlanarStack:
+    arrays = (stack.point, stack.normal, stack.mu, stack.mass, stack.com, stack.wrench, stack.gravity, stack.twist, stack.origin)
+    return PlanarStack(stack.scene, *(a[members] for a in arrays))
+
+
+def _decided(stack: PlanarStack, tasks: list[Task], positions: np.ndarray, tolerance: float) -> dict[int, SweepPoint]:
+    laws = assemble_stack(stack)
+    if laws is None:
+        return {}
+    motions = certify_stack(laws)
+    if not motions.decided.any():
+        return {}
+    units = laws.twist_units()
+    twists = motions.q * units
+    frames, c = laws.frames, motions.c
+    forces = ((0.0 + c[..., 0, None] * frames[..., 0, :]) + c[..., 1, None] * frames[..., 1, :]) * laws.force[:, None, None]  # as to_world
+    audit = audit_stack(stack, twists, forces, (laws.length, laws.force, laws.velocity), tolerance)
+    kept = motions.decided & audit.passed
+    twists = np.where(np.abs(twists) <= ROUNDOFF * units, 0.0, twists)  # round-off shown as 0, as the report does
+    forces = np.where(np.abs(forces) <= ROUNDOFF * laws.force[:, None, None], 0.0, forces)
+    body = stack.scene.bodies[0].name
+    out = {}
+    for k in np.flatnonzero(kept).tolist():
+        index, values, refinement = tasks[k]
+        out[int(positions[k])] = SweepPoint(
+            index=index,
+            values=tuple(float(v) for v in values),
+            refinement=refinement,
+            status="solved",
+            certified=True,
+            message=SOLVED_UNIQUE,
+            motions=1,
+            twists=((body, _floats(twists[k])),),
+            forces=tuple(_floats(f) for f in forces[k]),
+            modes=tuple(MODE_CODES[code] for code in audit.modes[k].tolist()),
+        )
+    return out
+
+
+def _floats(array: np.ndarray) -> tuple[float, ...]:
+    return tuple(x + 0.0 for x in array.tolist())
