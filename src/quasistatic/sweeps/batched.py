@@ -143,6 +143,8 @@ def _decided(stack: PlanarStack, tasks: list[Task], positions: np.ndarray, toler
     twists = np.where(np.abs(twists) <= ROUNDOFF * units, 0.0, twists)  # round-off shown as 0, as the report does
     forces = np.where(np.abs(forces) <= ROUNDOFF * laws.force[:, None, None], 0.0, forces)
     body = stack.scene.bodies[0].name
+    # Whole arrays to Python floats at once (adding 0.0 turns -0.0 into 0.0, as the per-point record does).
+    twist_rows, force_rows, mode_rows = (twists + 0.0).tolist(), (forces + 0.0).tolist(), audit.modes.tolist()
     out = {}
     for k in np.flatnonzero(kept).tolist():
         index, values, refinement = tasks[k]
@@ -154,12 +156,8 @@ def _decided(stack: PlanarStack, tasks: list[Task], positions: np.ndarray, toler
             certified=True,
             message=SOLVED_UNIQUE,
             motions=1,
-            twists=((body, _floats(twists[k])),),
-            forces=tuple(_floats(f) for f in forces[k]),
-            modes=tuple(MODE_CODES[code] for code in audit.modes[k].tolist()),
+            twists=((body, tuple(twist_rows[k])),),
+            forces=tuple(map(tuple, force_rows[k])),
+            modes=tuple(MODE_CODES[code] for code in mode_rows[k]),
         )
     return out
-
-
-def _floats(array: np.ndarray) -> tuple[float, ...]:
-    return tuple(x + 0.0 for x in array.tolist())

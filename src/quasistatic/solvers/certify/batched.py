@@ -38,7 +38,7 @@ from ...tolerances import (
     SAME_TWIST,
     ZERO,
 )
-from ..numerics.lcp import PIVOTS_PER_ROW, split_lcp_point
+from ..numerics.lcp import PIVOTS_PER_ROW, split_lcp_points
 from ..numerics.lemke import SOLUTION
 
 __all__ = ["BatchedMotions", "certify_batch"]
@@ -75,20 +75,16 @@ def certify_batch(laws: StackedLaws) -> BatchedMotions:
 def _seeds(laws: StackedLaws) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Lemke's point of each problem by the kernel :func:`~.cheap.seed_point` runs, on the same contiguous numbers."""
     N, m = laws.mu.shape
-    q, cn, beta, lam = np.zeros((N, 3)), np.zeros((N, m)), np.zeros((N, m, 2)), np.zeros((N, m))
-    seeded = np.zeros(N, dtype=bool)
     J, b, mu, g = (np.ascontiguousarray(a, dtype=float) for a in (laws.J, laws.b, laws.mu, laws.g))
     frictional = np.flatnonzero(mu[0] > 0.0)
     f = frictional.size
-    for k in range(N):
-        status, z = split_lcp_point(J[k], b[k], mu[k], g[k], frictional, _PLANAR_EDGES, PIVOT, PIVOTS_PER_ROW)
-        if status != SOLUTION:
-            continue
-        seeded[k] = True
-        q[k] = z[:3] - z[3:6]
-        cn[k] = z[6 : 6 + m]
-        beta[k, frictional] = z[6 + m : 6 + m + 2 * f].reshape(f, 2)
-        lam[k, frictional] = z[6 + m + 2 * f :]
+    statuses, z = split_lcp_points(J, b, mu, g, frictional, _PLANAR_EDGES, PIVOT, PIVOTS_PER_ROW)
+    seeded = statuses == SOLUTION
+    q = z[:, :3] - z[:, 3:6]
+    cn = z[:, 6 : 6 + m].copy()
+    beta, lam = np.zeros((N, m, 2)), np.zeros((N, m))
+    beta[:, frictional] = z[:, 6 + m : 6 + m + 2 * f].reshape(N, f, 2)
+    lam[:, frictional] = z[:, 6 + m + 2 * f :]
     slip = _rows(laws.J[..., 0, :], q) - laws.b[..., 0]
     frictionless = mu[0] <= 0.0
     lam[:, frictionless] = np.abs(slip[:, frictionless])  # the least slip speed its edges accept (cheap._form_point)
@@ -168,16 +164,18 @@ class _Planes:
     frictional: np.ndarray
 
 
-def _planes(laws: StackedLaws) -> _Planes:
+def _planes(laws: StackedLaws, points: np.ndarray) -> _Planes:
+    """The arrangement of each of ``points`` (indices into the stack)."""
     frictional = np.flatnonzero(laws.mu[0] > 0.0)
-    Jt, Jn = laws.J[..., 0, :], laws.J[..., 1, :]
+    J, b, mu = laws.J[points], laws.b[points], laws.mu[points]
+    Jt, Jn = J[..., 0, :], J[..., 1, :]
     normals = np.concatenate((Jn, Jt[:, frictional]), axis=1)
     N, P = normals.shape[:2]
     crosses = _cross(normals[:, :, None, :], normals[:, None, :, :]).reshape(N, P * P, 3)
-    triple = np.einsum("npj,nqj->npq", normals, crosses)
+    triple = np.matmul(normals, crosses.transpose(0, 2, 1))
     longest = np.sqrt((normals * normals).sum(axis=2).max(axis=1))
-    rhs = np.concatenate((laws.b[..., 1], laws.b[:, frictional, 0]), axis=1)
-    friction = laws.mu[..., None] * Jt
+    rhs = np.concatenate((b[..., 1], b[:, frictional, 0]), axis=1)
+    friction = mu[..., None] * Jt
     loads = np.empty((N, 3, 2 * Jn.shape[1]))
     loads[:, :, 0::2] = (Jn + friction).transpose(0, 2, 1)
     loads[:, :, 1::2] = (Jn - friction).transpose(0, 2, 1)
@@ -196,7 +194,7 @@ class _Exclusions:
 
     @classmethod
     def of(cls, loads: np.ndarray, g: np.ndarray) -> _Exclusions:
-        N, _, count = loads.shape
+        count = loads.shape[2]
         columns = loads.transpose(0, 2, 1)  # (N, 2m, 3)
         i, j = np.triu_indices(count, 1)
         normals = _cross(columns[:, i], columns[:, j])
@@ -207,84 +205,92 @@ class _Exclusions:
         margin = math.sqrt(3.0) * LP_FEASIBILITY
         reserve = (directions * -g[:, None, :]).sum(axis=2) - margin * np.sqrt((directions * directions).sum(axis=2))
         useful = reserve > 0.0
-        blocked = np.einsum("ndj,njk->ndk", directions, loads) * FORCE_CEILING < reserve[..., None]
-        bits = np.uint64(1) << np.arange(count, dtype=np.uint64)
-        masks = (blocked.astype(np.uint64) * bits).sum(axis=2, dtype=np.uint64)
+        blocked = np.matmul(directions, loads) * FORCE_CEILING < reserve[..., None]
+        masks = _bit_masks(blocked, 2.0)
         return cls(np.where(useful, masks, np.uint64(0)), useful, count)
 
     def excludes(self, masks: np.ndarray, points: np.ndarray) -> np.ndarray:
-        """Whether a direction of point ``points[k]`` excludes ``masks[k, ...]`` (bit masks)."""
-        blocked, useful = self.blocked[points], self.useful[points]
-        shape = (blocked.shape[0],) + (1,) * (masks.ndim - 1) + (blocked.shape[1],)
-        free = masks[..., None] & ~blocked.reshape(shape)
-        return ((free == 0) & useful.reshape(shape)).any(axis=-1)
+        """Whether a direction of point ``points[k]`` excludes the set of loads ``masks[k]`` (bit masks, (K,))."""
+        free = masks[:, None] & ~self.blocked[points]
+        return ((free == 0) & self.useful[points]).any(axis=1)
 
     def every_load(self) -> np.ndarray:
         every = np.uint64(2**self.count - 1)
         return (((every & ~self.blocked) == 0) & self.useful).any(axis=1)
 
 
+def _bit_masks(flags: np.ndarray, base: float) -> np.ndarray:
+    """``sum_k flags[..., k] base^k`` as 64-bit integers (exact in floats: at most 2^16 here)."""
+    return np.matmul(flags.astype(float), base ** np.arange(flags.shape[-1], dtype=float)).astype(np.uint64)
+
+
 def _load_masks(signs: np.ndarray, m: int, frictional: np.ndarray) -> np.ndarray:
-    """Bit masks of the loads each sign vector's contacts may use (``signs`` (..., P), 0 on near planes)."""
-    slip = np.zeros((*signs.shape[:-1], m), dtype=np.int8)
-    slip[..., frictional] = signs[..., m:]
-    bits = _EDGE_BITS[slip + 1] * (signs[..., :m] == 0)
-    weights = np.uint64(4) ** np.arange(m, dtype=np.uint64)
-    return (bits * weights).sum(axis=-1, dtype=np.uint64)
+    """Bit masks of the loads each sign vector's contacts may use (``signs`` (K, P), 0 on near planes): a closed
+    contact's two bits 1 (``+t``, sliding +), 2 (``-t``) or 3 (both), contact ``i`` at ``4^i``."""
+    slip = np.zeros((signs.shape[0], m), dtype=np.int8)
+    slip[:, frictional] = signs[:, m:]
+    return _bit_masks(_EDGE_BITS[slip + 1] * (signs[:, :m] == 0), 4.0)
 
 
 def _vertex_proof(laws: StackedLaws, q: np.ndarray, todo: np.ndarray) -> np.ndarray:
     """The vertex certificate's claim 2 per point: the seed's twist the only motion (see :mod:`.arrangement`)."""
-    planes = _planes(laws)
-    excluded = _Exclusions.of(planes.loads, laws.g)
+    proven = np.zeros(todo.size, dtype=bool)
+    points = np.flatnonzero(todo)
+    planes = _planes(laws, points)
+    excluded = _Exclusions.of(planes.loads, laws.g[points])
     N, P = planes.rhs.shape
     if P < 3:
-        return np.zeros(N, dtype=bool)
+        return proven
     triples, columns = _triples(P)
     det = planes.triple[:, triples[:, 0], columns[0]]  # (N, T)
     independent = np.abs(det) > planes.dependent[:, None]
     det = np.where(independent, det, 1.0)
     products = planes.triple[:, :, columns] / det[:, None, None, :]  # (N, P, 3, T)
-    r = planes.rhs[:, triples].transpose(0, 2, 1)  # (N, 3, T)
-    rows = np.einsum("npkt,nkt->npt", products, r) - planes.rhs[:, :, None]
+    r = planes.rhs[:, triples]  # (N, T, 3)
+    rows = products[:, :, 0] * r[:, None, :, 0] + products[:, :, 1] * r[:, None, :, 1] + products[:, :, 2] * r[:, None, :, 2]
+    rows -= planes.rhs[:, :, None]
     adjugate = planes.crosses[:, columns]  # (N, 3, T, 3)
-    w = np.einsum("nkt,nktj->ntj", r, adjugate) / det[..., None]
+    w = (r[..., 0, None] * adjugate[:, 0] + r[..., 1, None] * adjugate[:, 1] + r[..., 2, None] * adjugate[:, 2]) / det[..., None]
     slack = ARRANGEMENT_ROUNDOFF * (planes.longest[:, None] * np.abs(w).sum(axis=2) + planes.offset[:, None])
     near = (LP_FEASIBILITY + slack[:, None, :]) * (1.0 + np.abs(products).sum(axis=2)) + slack[:, None, :]
     signs = ((rows > near).view(np.int8) - (rows < -near).view(np.int8)).transpose(0, 2, 1)  # (N, T, P)
     kept = independent & (signs[..., : planes.m] >= 0).all(axis=2)
-    spread = np.abs(adjugate).sum(axis=1) / np.abs(det)[..., None]  # (N, T, 3)
-    masks = _load_masks(signs, planes.m, planes.frictional)
-    held = kept & ~excluded.excludes(masks, np.arange(N)) & todo[:, None]
-    reach = np.abs(w - q[:, None, :]) + (_LOOSENESS + slack[None, :, :, None]) * spread[None]  # (3, N, T, 3)
-    near_seed = ((reach.max(axis=3) <= _WITHIN) | ~held[None]).all(axis=(0, 2))
-    proven = todo & independent.any(axis=1) & held.any(axis=1) & near_seed & ~excluded.every_load() & excluded.useful.any(axis=1)
-    return proven & _rays_excluded(planes, excluded, signs, held & proven[:, None])
+    at, vertex = kept.nonzero()
+    loose = ~excluded.excludes(_load_masks(signs[at, vertex], planes.m, planes.frictional), at)
+    at, vertex = at[loose], vertex[loose]  # the held vertices (not excluded)
+    spread = np.abs(adjugate[at, :, vertex]).sum(axis=1) / np.abs(det[at, vertex])[:, None]  # (H, 3)
+    reach = np.abs(w[at, vertex] - q[points[at]]) + (_LOOSENESS[:, :, 0] + slack[at, vertex, None]) * spread  # (3, H, 3)
+    far = ~(reach.max(axis=2) <= _WITHIN[:, :, 0]).all(axis=0)
+    held = np.zeros(N, dtype=bool)
+    held[at] = True
+    decided = held & independent.any(axis=1) & ~excluded.every_load() & excluded.useful.any(axis=1)
+    decided[at[far]] = False
+    decided &= _rays_excluded(planes, excluded, signs[at, vertex], at)
+    proven[points] = decided
+    return proven
 
 
-def _rays_excluded(planes: _Planes, excluded: _Exclusions, signs: np.ndarray, held: np.ndarray) -> np.ndarray:
-    """Per point, whether every ray leaving a held vertex, along a line where two of its near planes meet and
-    kept in loose ``Q0``, has its loads excluded (:mod:`.arrangement`'s ``_edges_excluded`` without ``apart``)."""
+def _rays_excluded(planes: _Planes, excluded: _Exclusions, sign: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Per point, whether every ray leaving a held vertex (its signs ``sign`` (H, P), of point ``at``), along a line
+    where two of its near planes meet and kept in loose ``Q0``, has its loads excluded (:mod:`.arrangement`'s
+    ``_edges_excluded`` without ``apart``)."""
     N, P = planes.rhs.shape
-    points, vertex = held.nonzero()
-    sign = signs[points, vertex]  # (H, P)
     a, b = np.triu_indices(P, 1)
     lines = planes.crosses[:, a * P + b]  # (N, Q, 3)
-    squares = (lines * lines).sum(axis=2)
-    parallel = ~(squares > (planes.dependent**2 / planes.longest**2)[:, None])
+    parallel = ~((lines * lines).sum(axis=2) > (planes.dependent**2 / planes.longest**2)[:, None])
     zero = sign == 0
-    valid = zero[:, a] & zero[:, b] & ~parallel[points]  # (H, Q)
-    along = planes.triple[points][:, :, a * P + b].transpose(0, 2, 1).copy()  # (H, Q, P)
-    along[np.abs(along) <= planes.dependent[points, None, None]] = 0.0
-    gap_near = zero[:, None, : planes.m]
-    ok = np.ones(points.size, dtype=bool)
-    for direction in (along, -along):
-        opening = ((direction[..., : planes.m] >= 0.0) | ~gap_near).all(axis=2)
-        ray_signs = np.where(zero[:, None, :], np.sign(direction).astype(np.int8), sign[:, None, :])
-        masks = _load_masks(ray_signs, planes.m, planes.frictional)
-        ok &= (excluded.excludes(masks, points) | ~(valid & opening)).all(axis=1)
+    valid = zero[:, a] & zero[:, b] & ~parallel[at]  # (H, Q)
+    held, line = valid.nonzero()
+    along = planes.triple[at[held], :, a[line] * P + b[line]]  # (R, P): each plane's rate along the line
+    along[np.abs(along) <= planes.dependent[at[held], None]] = 0.0
+    gap_near = zero[held, : planes.m]
     proven = np.ones(N, dtype=bool)
-    proven[points[~ok]] = False
+    for direction in (along, -along):
+        opening = ((direction[:, : planes.m] >= 0.0) | ~gap_near).all(axis=1)
+        ray, vertex = direction[opening], held[opening]
+        ray_signs = np.where(zero[vertex], np.sign(ray).astype(np.int8), sign[vertex])
+        masks = _load_masks(ray_signs, planes.m, planes.frictional)
+        proven[at[vertex[~excluded.excludes(masks, at[vertex])]]] = False
     return proven
 
 
