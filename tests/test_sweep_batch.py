@@ -82,12 +82,12 @@ def _scene(data: dict[str, Any]) -> Any:
     return scene_from_file(read_scene_file(data)[0])
 
 
-def _alone(scenes: PointScenes, tasks: tuple[tuple[int, tuple[float, ...], bool], ...]) -> list[SweepPoint]:
+def _alone(scenes: PointScenes, tasks: tuple[tuple[int, tuple[float, ...], bool], ...], **options: Any) -> list[SweepPoint]:
     """Each point solved by itself, as solve_chunk solved every point before batches."""
     points = []
     for index, values, refinement in tasks:
         try:
-            solution = solve(scenes.at(values), **OPTIONS)
+            solution = solve(scenes.at(values), **{**OPTIONS, **options})
         except QuasistaticError as exc:
             solution = Solution("failed", f"not solved at this point: {exc}", "auto", "")
         points.append(point_from_solution(index, values, refinement, solution))
@@ -193,6 +193,19 @@ def test_points_the_batch_cannot_take_are_solved_alone() -> None:
     assert [p.status for p in points[:2]] == ["failed", "failed"] and "must be >= 0" in points[0].message
     normal = sweep_params(SWEEP_SCENE, {"contacts[2].normal[0]": [1.0, 0.99]})
     assert batched_points(PointScenes(SWEEP_SCENE, ".", normal), ((0, (1.0,), False), (1, (0.99,), False)), OPTIONS) == {}
+
+
+def test_a_motion_the_stacked_audit_turns_down_is_left_to_the_per_point_solve() -> None:
+    """With an audit threshold below round-off every proven motion fails its audit: the batch reports none of them,
+    and the per-point solve's verdict (its audit failing too) is what the chunk records."""
+    axes = sweep_params(SWEEP_SCENE, {"contacts[2].point[1]": [0.1, 0.3], "contacts[0].mu,contacts[1].mu": [0.5]})
+    tasks = ((0, (0.1, 0.5), False), (1, (0.3, 0.5), False))
+    scenes = PointScenes(SWEEP_SCENE, ".", axes)
+    strict = {**OPTIONS, "tolerance": 1e-30}
+    assert batched_points(scenes, tasks, strict) == {} and len(batched_points(scenes, tasks, OPTIONS)) == 2
+    _, points = solve_chunk(Chunk("grid-00000", SWEEP_SCENE, ".", axes, tasks, strict))
+    assert points == _alone(scenes, tasks, tolerance=1e-30)
+    assert all(p.status != "solved" or not p.certified for p in points)
 
 
 @pytest.mark.slow

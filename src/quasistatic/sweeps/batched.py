@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -47,16 +48,42 @@ def batched_points(scenes: PointScenes, tasks: Sequence[Task], options: Mapping[
     stack = PlanarStack.tiled(scenes.base, len(tasks))
     for column, setter in enumerate(setters):
         setter.apply(stack, values[:, column])
-    decided: dict[int, SweepPoint] = {}
+    answers: list[_Answer] = []
     frictional = stack.mu > 0.0
-    for mask in np.unique(frictional[valid & frictional.any(axis=1)], axis=0):
+    tolerance = float(options.get("tolerance", DEFAULT_TOLERANCE))
+    for mask in np.unique(frictional[valid & frictional.any(axis=1)], axis=0):  # one shape of the laws per group
         members = np.flatnonzero(valid & (frictional == mask).all(axis=1))
-        tolerance = float(options.get("tolerance", DEFAULT_TOLERANCE))
-        decided.update(_decided(_taken(stack, members), [tasks[k] for k in members.tolist()], members, tolerance))
-    seconds = (time.perf_counter() - started) / max(len(decided), 1)  # a batched point's share of the batch's time
-    for point in decided.values():
-        object.__setattr__(point, "seconds", seconds)  # known only now; the points are new and not yet shared
-    return decided
+        answers += _decided(_taken(stack, members), members, tolerance)
+    seconds = (time.perf_counter() - started) / max(len(answers), 1)  # a batched point's share of the batch's time
+    body = scenes.base.bodies[0].name
+    return {answer.position: answer.record(tasks[answer.position], body, seconds) for answer in answers}
+
+
+@dataclass(frozen=True)
+class _Answer:
+    """A decided point: its position in the chunk, twist, world forces (round-off shown as 0) and mode names."""
+
+    position: int
+    twist: tuple[float, ...]
+    forces: tuple[tuple[float, ...], ...]
+    modes: tuple[str, ...]
+
+    def record(self, task: Task, body: str, seconds: float) -> SweepPoint:
+        """The sweep's record, as :func:`~.result.point_from_solution` makes it of the per-point Solution."""
+        index, values, refinement = task
+        return SweepPoint(
+            index=index,
+            values=tuple(float(v) for v in values),
+            refinement=refinement,
+            status="solved",
+            certified=True,
+            message=SOLVED_UNIQUE,
+            motions=1,
+            twists=((body, self.twist),),
+            forces=self.forces,
+            modes=self.modes,
+            seconds=seconds,
+        )
 
 
 class _Setter:
@@ -127,37 +154,24 @@ def _taken(stack: PlanarStack, members: np.ndarray) -> PlanarStack:
     return PlanarStack(stack.scene, *(a[members] for a in arrays))
 
 
-def _decided(stack: PlanarStack, tasks: list[Task], positions: np.ndarray, tolerance: float) -> dict[int, SweepPoint]:
+def _decided(stack: PlanarStack, positions: np.ndarray, tolerance: float) -> list[_Answer]:
+    """The points of ``stack`` proven and audited here (``positions``: theirs in the chunk)."""
     laws = assemble_stack(stack)
     if laws is None:
-        return {}
+        return []
     motions = certify_stack(laws)
     if not motions.decided.any():
-        return {}
+        return []
     units = laws.twist_units()
     twists = motions.q * units
-    frames, c = laws.frames, motions.c
-    forces = ((0.0 + c[..., 0, None] * frames[..., 0, :]) + c[..., 1, None] * frames[..., 1, :]) * laws.force[:, None, None]  # as to_world
+    frames, c, force = laws.frames, motions.c, laws.force[:, None, None]
+    forces = ((0.0 + c[..., 0, None] * frames[..., 0, :]) + c[..., 1, None] * frames[..., 1, :]) * force  # as to_world
     audit = audit_stack(stack, twists, forces, (laws.length, laws.force, laws.velocity), tolerance)
-    kept = motions.decided & audit.passed
     twists = np.where(np.abs(twists) <= ROUNDOFF * units, 0.0, twists)  # round-off shown as 0, as the report does
-    forces = np.where(np.abs(forces) <= ROUNDOFF * laws.force[:, None, None], 0.0, forces)
-    body = stack.scene.bodies[0].name
+    forces = np.where(np.abs(forces) <= ROUNDOFF * force, 0.0, forces)
     # Whole arrays to Python floats at once (adding 0.0 turns -0.0 into 0.0, as the per-point record does).
     twist_rows, force_rows, mode_rows = (twists + 0.0).tolist(), (forces + 0.0).tolist(), audit.modes.tolist()
-    out = {}
-    for k in np.flatnonzero(kept).tolist():
-        index, values, refinement = tasks[k]
-        out[int(positions[k])] = SweepPoint(
-            index=index,
-            values=tuple(float(v) for v in values),
-            refinement=refinement,
-            status="solved",
-            certified=True,
-            message=SOLVED_UNIQUE,
-            motions=1,
-            twists=((body, tuple(twist_rows[k])),),
-            forces=tuple(map(tuple, force_rows[k])),
-            modes=tuple(MODE_CODES[code] for code in mode_rows[k]),
-        )
-    return out
+    return [
+        _Answer(int(positions[k]), tuple(twist_rows[k]), tuple(map(tuple, force_rows[k])), tuple(MODE_CODES[c] for c in mode_rows[k]))
+        for k in np.flatnonzero(motions.decided & audit.passed).tolist()
+    ]
