@@ -131,6 +131,8 @@ def _place(base: Any, path: tuple[str | int, ...]) -> tuple[str, tuple[Any, ...]
         return ("com", (path[3],), "number")
     if path[:3] == ("bodies", body, "wrench") and len(path) == 4 and path[3] in (0, 1, 2):
         return ("wrench", (path[3],), "number")
+    if path[0] == "gravity" and len(path) == 2 and path[1] in (0, 1):
+        return ("gravity", (path[1],), "number")
     if path[0] == "movers" and len(path) == 4 and path[2] == "twist" and path[3] in (0, 1, 2):
         rows = tuple(i for i, c in enumerate(base.contacts) if c.other == path[1])
         return ("twist", (list(rows), path[3]), "number") if rows else None

@@ -52,7 +52,8 @@ class SweepPoint:
     modes : tuple of str
         Each contact's mode in the reported motion.
     seconds : float
-        Wall time of the solve [s] (not compared: it differs between runs).
+        Wall time of the solve [s] (not compared: it differs between runs); a point decided in a batch
+        (:mod:`.batched`) has its share of the batch's time.
     """
 
     index: int
