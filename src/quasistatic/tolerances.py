@@ -36,6 +36,7 @@ __all__ = [
     "ARRANGEMENT_CONTACTS",
     "ARRANGEMENT_ROUNDOFF",
     "BATCH_CONTACTS",
+    "BATCH_TIE",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
     "BASIS_FEASIBILITY",
@@ -188,6 +189,12 @@ BATCH_CONTACTS = 8
 ray test holds, per vertex left, every pair of near planes against every candidate Farkas direction, an array that
 grows as the fourth power of the contacts (about 20 MB for a chunk's held vertices at 8); past it each point is
 solved alone."""
+
+BATCH_TIE = 2.0
+"""A batched test's value within this factor of its threshold, either side, leaves the point to the per-point solve
+(:mod:`quasistatic.solvers.certify.batched`) [-]: the batch sums the same products in another order, so the two can
+differ in the last bits; far from the threshold they fall on the same side. A factor, not a margin in the laws: the
+point is then only solved alone, as before."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""

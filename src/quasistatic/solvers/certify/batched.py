@@ -10,11 +10,17 @@ proof: Lemke's point (the same compiled kernel on the same numbers as :func:`~.c
 every law of the form to ``ZERO``), not kinematically unique (at most three closed contacts, so
 :func:`~.cheap.kinematically_unique` has no bound), and the vertex certificate's claim 2 (:mod:`.arrangement`: every
 vertex not excluded is the seed's, and every ray leaving them has its loads excluded by a checked Farkas
-direction), with the same tolerances. Then the motion's forces are unique by the plane's rank test
-(:func:`~..numerics.forces.indeterminate_forces` first test). Anything else (no seed, a kinematic bound to try,
-vertices near another twist, a ray not excluded, forces that may vary, a value within a factor of two of a
-threshold of those tests, whose rounding here may differ from the per-point code's) leaves the point
-undecided, and the caller solves it alone: the batch never decides what the per-point solve would not.
+direction), with the same tolerances. Then the motion's forces are unique by the plane's rank test (the first test
+of :func:`~..numerics.forces.indeterminate_forces`). Anything else (no seed, a kinematic bound to try, vertices near
+another twist, a ray not excluded, forces that may vary) leaves the point undecided, and the caller solves it alone.
+
+Rounding. The twist and forces are Lemke's, bit for bit. The seed's check, the closed count and the rank test sum
+their products in another order than the per-point code, so a value within ``BATCH_TIE`` of one of their thresholds
+(either side) leaves the point undecided: its side could differ there. The vertex certificate's comparisons are not
+guarded: its margins are a proof under any rounding of its 3x3 solves within ``ARRANGEMENT_ROUNDOFF``, so a point it
+proves here has Lemke's twist as its only motion; were one of the per-point certificate's own comparisons to land
+the other way at a tie, that solve goes on to the branch and bound, which proves the same answer (a sweep's record
+does not say which certificate proved it). The cross-checks of ``tests/test_sweep_batch.py`` compare the records.
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ import numpy as np
 from ...laws.stacked import StackedLaws
 from ...tolerances import (
     ARRANGEMENT_ROUNDOFF,
+    BATCH_TIE,
     DISTINCT_TWIST,
     FORCE_CEILING,
     FORCE_RANK,
@@ -44,7 +51,7 @@ from ..numerics.lemke import SOLUTION
 __all__ = ["BatchedMotions", "certify_batch"]
 
 _PLANAR_EDGES = np.array([1.0, -1.0])  # the 2-D cone's edges along the tangent, as the kernel builds them
-_MOVING = ZERO * 10  # open or sliding beyond this (as numerics.forces measures a motion's modes)
+_MOVING = ZERO * 10  # open or sliding beyond this: numerics.forces's (a test checks these copies stay equal)
 _LOOSENESS = np.array([0.0, ZERO, LP_FEASIBILITY])[:, None, None, None]  # the tau of each claim on the twist
 _WITHIN = np.array([0.5 * SAME_TWIST, 0.5 * DISTINCT_TWIST, DISTINCT_TWIST])[:, None, None]  # how near the seed
 _EDGE_BITS = np.array([1, 3, 2], dtype=np.uint64)  # by slip sign -1, 0, +1: the edge n + mu t, both, n - mu t
@@ -97,9 +104,10 @@ def _rows(A: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 
 def _clear(values: np.ndarray, threshold: float) -> np.ndarray:
-    """Whether ``values`` are far from ``threshold`` (outside a factor of two): their side of it cannot depend on
-    rounding. Per point (the last axes reduced)."""
-    near = (np.abs(values) > 0.5 * threshold) & (np.abs(values) <= 2.0 * threshold)
+    """Whether ``values`` are clear of ``threshold`` (outside a factor ``BATCH_TIE`` of it): their side of it cannot
+    depend on rounding. Per point (the last axes reduced)."""
+    size = np.abs(values)
+    near = (size > threshold / BATCH_TIE) & (size <= threshold * BATCH_TIE)
     return ~near.reshape(near.shape[0], -1).any(axis=1)
 
 
