@@ -10,13 +10,15 @@ from ..laws.stacked import StackedLaws
 from .certify.batched import BatchedMotions, certify_batch
 from .result import force_claim
 
-__all__ = ["BatchedMotions", "certify_stack", "SOLVED_UNIQUE"]
+__all__ = ["BatchedMotions", "certify_stack", "solved_message"]
 
-SOLVED_UNIQUE = "solved: one motion" + force_claim(False)
-"""The message of a decided point: the certified method's for one motion with unique forces."""
+
+def solved_message(indeterminate: bool) -> str:
+    """The message of a decided point: the certified method's for one motion, with what is known of its forces."""
+    return "solved: one motion" + force_claim(indeterminate)
 
 
 def certify_stack(laws: StackedLaws) -> BatchedMotions:
-    """Each point's only motion (scene-relative twist and contact-frame forces) where it is proven, with unique
-    forces; ``decided`` False elsewhere. Every point must have the same contacts with friction."""
+    """Each point's only motion (scene-relative twist and contact-frame forces) where it is proven, and whether its
+    forces are indeterminate; ``decided`` False elsewhere. Every point must have the same contacts with friction."""
     return certify_batch(laws)

@@ -26,7 +26,7 @@ from ..check import DEFAULT_TOLERANCE
 from ..check.stacked import MODE_CODES, audit_stack
 from ..laws.stacked import assemble_stack
 from ..model.stacked import PlanarStack, stackable
-from ..solvers.batched import SOLVED_UNIQUE, certify_stack
+from ..solvers.batched import certify_stack, solved_message
 from ..tolerances import BATCH_CONTACTS, MAX_FRICTION, MAX_MAGNITUDE, ROUNDOFF
 from .result import SweepPoint
 from .scenes import PointScenes
@@ -61,12 +61,13 @@ def batched_points(scenes: PointScenes, tasks: Sequence[Task], options: Mapping[
 
 @dataclass(frozen=True)
 class _Answer:
-    """A decided point: its position in the chunk, twist, world forces (round-off shown as 0) and mode names."""
+    """A decided point: its position in the chunk, twist, world forces (round-off shown as 0), mode names and message."""
 
     position: int
     twist: tuple[float, ...]
     forces: tuple[tuple[float, ...], ...]
     modes: tuple[str, ...]
+    message: str
 
     def record(self, task: Task, body: str, seconds: float) -> SweepPoint:
         """The sweep's record, as :func:`~.result.point_from_solution` makes it of the per-point Solution."""
@@ -77,7 +78,7 @@ class _Answer:
             refinement=refinement,
             status="solved",
             certified=True,
-            message=SOLVED_UNIQUE,
+            message=self.message,
             motions=1,
             twists=((body, self.twist),),
             forces=self.forces,
@@ -173,7 +174,14 @@ def _decided(stack: PlanarStack, positions: np.ndarray, tolerance: float) -> lis
     forces = np.where(np.abs(forces) <= ROUNDOFF * force, 0.0, forces)
     # Whole arrays to Python floats at once (adding 0.0 turns -0.0 into 0.0, as the per-point record does).
     twist_rows, force_rows, mode_rows = (twists + 0.0).tolist(), (forces + 0.0).tolist(), audit.modes.tolist()
+    messages = (solved_message(False), solved_message(True))
     return [
-        _Answer(int(positions[k]), tuple(twist_rows[k]), tuple(map(tuple, force_rows[k])), tuple(MODE_CODES[c] for c in mode_rows[k]))
+        _Answer(
+            int(positions[k]),
+            tuple(twist_rows[k]),
+            tuple(map(tuple, force_rows[k])),
+            tuple(MODE_CODES[c] for c in mode_rows[k]),
+            messages[int(motions.indeterminate[k])],
+        )
         for k in np.flatnonzero(motions.decided & audit.passed).tolist()
     ]

@@ -60,11 +60,13 @@ _EDGE_BITS = np.array([1, 3, 2], dtype=np.uint64)  # by slip sign -1, 0, +1: the
 @dataclass(frozen=True)
 class BatchedMotions:
     """Per point: ``decided`` (N,) the proof went through; there ``q`` (N, 3) is the only motion's scene-relative
-    twist (Lemke's, bit for bit) and ``c`` (N, m, 2) its contact-frame forces (tangent, normal), unique."""
+    twist (Lemke's, bit for bit), ``c`` (N, m, 2) its contact-frame forces (tangent, normal) and ``indeterminate``
+    (N,) whether other forces balance it too (then ``c`` is one of them, as the per-point solve reports)."""
 
     decided: np.ndarray
     q: np.ndarray
     c: np.ndarray
+    indeterminate: np.ndarray
 
 
 def certify_batch(laws: StackedLaws) -> BatchedMotions:
@@ -73,10 +75,12 @@ def certify_batch(laws: StackedLaws) -> BatchedMotions:
     decided = seeded & _form_holds(laws, q, cn, beta, lam) & _few_closed(laws, q)
     if decided.any():
         decided &= _vertex_proof(laws, q, decided)
-    if decided.any():
-        decided &= _forces_unique(laws, q)
+    unique = indeterminate = np.zeros(decided.size, dtype=bool)
     c = np.stack([beta[..., 0] - beta[..., 1], cn], axis=-1)  # as LCPForm.forces: the edges +1 and -1
-    return BatchedMotions(decided, q, c)
+    if decided.any():
+        unique, indeterminate = _force_claims(laws, q, c)
+        unique, indeterminate = _force_claims(laws, q, c)
+    return BatchedMotions(decided & (unique | indeterminate), q, c, indeterminate)
 
 
 def _seeds(laws: StackedLaws) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -302,10 +306,16 @@ def _rays_excluded(planes: _Planes, excluded: _Exclusions, sign: np.ndarray, at:
     return proven
 
 
-def _forces_unique(laws: StackedLaws, q: np.ndarray) -> np.ndarray:
-    """The plane's rank test of :func:`~..numerics.forces.indeterminate_forces` per point: the closed contacts' force
-    coordinates (a cone's tangent and normal; a frictionless or sliding contact's one tilted normal) have a wrench
-    map of full column rank (every singular value above ``FORCE_RANK``), clear of every threshold."""
+def _force_claims(laws: StackedLaws, q: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per point, whether the forces at ``q`` are known unique, and whether known indeterminate (neither: undecided).
+
+    Unique as :func:`~..numerics.forces.indeterminate_forces` first decides it in the plane: the closed contacts'
+    force coordinates (a cone's tangent and normal; a frictionless or sliding contact's one tilted normal) with a
+    wrench map of full column rank (every singular value above ``FORCE_RANK``). Indeterminate when that test fails and
+    a step from Lemke's forces ``c`` (m, 2 per point) along the map's null space, kept in every cone, moves some force
+    coordinate by more than ``BATCH_TIE`` times ``LP_FEASIBILITY``: the per-point decision (its segment through a
+    balanced point, else an LP or the ranges of every component against ``LP_FEASIBILITY``) then says so too, since
+    the set of consistent forces is that wide. Anything else is left undecided."""
     Jt, Jn = laws.J[..., 0, :], laws.J[..., 1, :]
     u_n = _rows(Jn, q) - laws.b[..., 1]
     u_t = _rows(Jt, q) - laws.b[..., 0]
@@ -315,18 +325,98 @@ def _forces_unique(laws: StackedLaws, q: np.ndarray) -> np.ndarray:
     single = ~frictional | sliding
     tilt = np.where(sliding, -laws.mu * np.sign(u_t), 0.0)
     one = Jn + tilt[..., None] * Jt  # (N, m, 3)
-    unique = _clear(u_n, _MOVING) & _clear(u_t, _MOVING)
-    counts = np.where(closed, np.where(single, 1, 2), 0).sum(axis=1)
-    unique &= counts <= 3
+    clear = _clear(u_n, _MOVING) & _clear(u_t, _MOVING)
+    unique, indeterminate = np.zeros(clear.size, dtype=bool), np.zeros(clear.size, dtype=bool)
+    m = Jn.shape[1]
     patterns = np.concatenate((closed, single), axis=1)
-    for pattern in np.unique(patterns[unique], axis=0):
-        members = np.flatnonzero(unique & (patterns == pattern).all(axis=1))
-        shut, alone = pattern[: Jn.shape[1]], pattern[Jn.shape[1] :]
-        columns = [one[members, i] for i in np.flatnonzero(shut & alone)]
-        columns += [x for i in np.flatnonzero(shut & ~alone) for x in (Jt[members, i], Jn[members, i])]
-        if not columns:
+    for pattern in np.unique(patterns[clear], axis=0):
+        members = np.flatnonzero(clear & (patterns == pattern).all(axis=1))
+        shut, alone = pattern[:m], pattern[m:]
+        contacts = np.flatnonzero(shut)
+        if not contacts.size:
+            unique[members] = True  # no closed contact: no force at all
             continue
+        columns: list[np.ndarray] = []
+        normal_at: list[int] = []
+        tangent_at: list[int] = []
+        for i in contacts.tolist():  # in contact order, as the per-point columns
+            if alone[i]:
+                normal_at.append(len(columns))
+                tangent_at.append(-1)
+                columns.append(one[members, i])
+            else:
+                tangent_at.append(len(columns))
+                normal_at.append(len(columns) + 1)
+                columns += [Jt[members, i], Jn[members, i]]
         wrenches = np.stack(columns, axis=2)  # (k, 3, f)
-        smallest = np.linalg.svd(wrenches, compute_uv=False)[:, -1]
-        unique[members] &= (smallest > FORCE_RANK) & _clear(smallest[:, None], FORCE_RANK)
-    return unique
+        _, sigma, vt = np.linalg.svd(wrenches)
+        settled = _clear(sigma, FORCE_RANK)
+        full = (sigma > FORCE_RANK).all(axis=1) & (wrenches.shape[2] <= 3)
+        unique[members] = full & settled
+        cone = _cones(contacts, alone, laws.mu[members], normal_at, tangent_at)
+        x = _coordinates(c[members], contacts, normal_at, tangent_at, wrenches.shape[2])
+        wide = _wide(wrenches, laws.g[members], sigma, vt, x, cone)
+        indeterminate[members] = ~full & settled & wide
+    return unique, indeterminate
+
+
+def _wide(wrenches: np.ndarray, g: np.ndarray, sigma: np.ndarray, vt: np.ndarray, x: np.ndarray, cone: _Cones) -> np.ndarray:
+    """Whether the forces ``x`` (k, f: each closed contact's coordinates, Lemke's) balance the load, lie in the cones,
+    and a step from them along the null space of ``wrenches`` (k, 3, f), kept in every cone, moves some coordinate by
+    more than ``BATCH_TIE * LP_FEASIBILITY``: then other forces balance the load too (indeterminate)."""
+    k, _, f = wrenches.shape
+    balanced = np.abs(np.matmul(wrenches, x[..., None])[..., 0] + g).max(axis=1) <= ZERO / BATCH_TIE
+    room = cone.values(x)  # (k, C): each cone side's distance, >= 0 inside
+    inside = (room >= -ZERO / BATCH_TIE).all(axis=1)
+    room = np.maximum(room, 0.0)
+    rank = (sigma > FORCE_RANK).sum(axis=1)
+    basis = vt * (np.arange(f)[None, :] >= rank[:, None])[..., None]  # (k, f, f): the rows spanning the null space
+    projection = np.matmul(basis.transpose(0, 2, 1), basis)  # (k, f, f): onto the null space
+    wide = np.zeros(k, dtype=bool)
+    for j in range(f):
+        for side in (1.0, -1.0):
+            step = side * projection[:, :, j]  # along which coordinate j moves by |projection[j, j]| per unit
+            rate = cone.values(step)
+            drift = np.abs(np.matmul(wrenches, step[..., None])[..., 0]).max(axis=1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                reach = np.where(rate < 0.0, room / -rate, np.inf).min(axis=1)
+                reach = np.minimum(reach, np.where(drift > 0.0, ZERO / drift, np.inf))
+                width = np.where(projection[:, j, j] > 0.0, reach * projection[:, j, j], 0.0)  # inf: nothing limits it
+            wide |= width > BATCH_TIE * LP_FEASIBILITY
+    return balanced & inside & wide
+
+
+@dataclass(frozen=True)
+class _Cones:
+    """The sides of the closed contacts' cones in force coordinates: side ``s`` is ``rho_s x[normal_s] + sign_s
+    x[tangent_s] >= 0`` (a single coordinate's ``x >= 0``: ``sign`` 0; a cone's two edges: ``mu x_n -+ x_t``)."""
+
+    normal: np.ndarray
+    tangent: np.ndarray
+    rho: np.ndarray  # (k, C)
+    sign: np.ndarray
+
+    def values(self, x: np.ndarray) -> np.ndarray:
+        return self.rho * x[:, self.normal] + self.sign * x[:, self.tangent]
+
+
+def _cones(contacts: np.ndarray, alone: np.ndarray, mu: np.ndarray, normal_at: list[int], tangent_at: list[int]) -> _Cones:
+    """The cone sides of the closed ``contacts`` (a single coordinate: one side; a 2-D cone: its two edges)."""
+    sides: list[tuple[int, int, np.ndarray, float]] = []  # (normal coordinate, tangent coordinate, rho, sign)
+    for position, i in enumerate(contacts.tolist()):
+        if alone[i]:
+            sides.append((normal_at[position], 0, np.ones(mu.shape[0]), 0.0))
+        else:
+            sides += [(normal_at[position], tangent_at[position], mu[:, i], edge) for edge in (-1.0, 1.0)]
+    normal, tangent, rho, sign = zip(*sides, strict=True)
+    return _Cones(np.array(normal), np.array(tangent), np.stack(rho, axis=1), np.array(sign))
+
+
+def _coordinates(c: np.ndarray, contacts: np.ndarray, normal_at: list[int], tangent_at: list[int], size: int) -> np.ndarray:
+    """Contact-frame forces ``c`` (k, m, 2) as the closed contacts' force coordinates (k, f)."""
+    x = np.zeros((c.shape[0], size))
+    for position, i in enumerate(contacts.tolist()):
+        x[:, normal_at[position]] = c[:, i, 1]
+        if tangent_at[position] >= 0:
+            x[:, tangent_at[position]] = c[:, i, 0]
+    return x
