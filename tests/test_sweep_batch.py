@@ -208,6 +208,9 @@ def test_points_the_batch_cannot_take_are_solved_alone() -> None:
     _, points = solve_chunk(Chunk("grid-00000", SWEEP_SCENE, ".", axes, tasks, OPTIONS))
     assert points == _alone(scenes, tasks)
     assert [p.status for p in points[:2]] == ["failed", "failed"] and "must be >= 0" in points[0].message
+    joined = sweep_params(SWEEP_SCENE, {"contacts[0].mu,bodies.box.mass": [1.0]})  # one value, two kinds of number
+    joined_tasks = ((0, (-0.5,), False), (1, (0.5,), False), (2, (1.5,), False))
+    assert sorted(batched_points(PointScenes(SWEEP_SCENE, ".", joined), joined_tasks, OPTIONS)) == [1, 2]
     normal = sweep_params(SWEEP_SCENE, {"contacts[2].normal[0]": [1.0, 0.99]})
     assert batched_points(PointScenes(SWEEP_SCENE, ".", normal), ((0, (1.0,), False), (1, (0.99,), False)), OPTIONS) == {}
 
@@ -228,7 +231,7 @@ def test_a_motion_the_stacked_audit_turns_down_is_left_to_the_per_point_solve() 
 @pytest.mark.slow
 def test_many_random_grids_equal_each_point_alone() -> None:
     """Cross-check on 40 random boxes and 20 random scenes of 1 to 8 contacts (about 10 s): the batch decides every
-    point whose per-point answer is one motion with unique forces proven by the vertex certificate (244 here)."""
+    point whose per-point answer is one motion proven by the vertex certificate (550 of 644 solved here)."""
     rng = np.random.default_rng(2024)
     decided = 0
     for trial in range(60):
@@ -239,4 +242,4 @@ def test_many_random_grids_equal_each_point_alone() -> None:
         if "movers.pusher.twist[0]" in grid and not any(c["other"] == "pusher" for c in data["contacts"]):
             continue
         decided += _batched_equals_alone(data, grid)
-    assert decided > 200
+    assert decided > 500

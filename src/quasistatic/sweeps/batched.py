@@ -4,11 +4,11 @@ Why: a small planar certified solve is ~1 ms of Python calls on arrays of a few 
 assembly, Lemke, the vertex certificate, the audit, the Solution). The points of a sweep's chunk differ only in
 the swept numbers, so here those numbers are written into stacked arrays (:class:`~quasistatic.model.stacked.PlanarStack`,
 no Scene per point), assembled together (:func:`~quasistatic.laws.stacked.assemble_stack`, bit for bit as
-``assemble``), decided together (:func:`~quasistatic.solvers.batched.certify_stack`: Lemke's kernel per point,
-then the vertex certificate and the force rank test for all points at once), and audited together on each point's
+``assemble``), decided together (:func:`~quasistatic.solvers.batched.certify_stack`: Lemke's kernel over the stack, then the
+vertex certificate and what is known of the forces for all points at once), and audited together on each point's
 own numbers (:func:`~quasistatic.check.stacked.audit_stack`). A point the batch does not decide (another swept
-path, a value a Scene might reject, an answer other than one proven motion with unique forces, a value near a
-threshold, a failed audit) is left to the per-point :func:`~quasistatic.solve`, so the batch never changes an
+path, a value a Scene might reject, an answer other than one proven motion, forces neither test settles, a value
+near a threshold, a failed audit) is left to the per-point :func:`~quasistatic.solve`, so the batch never changes an
 answer: it decides faster what it can decide exactly. Its records equal the per-point ones (status, message,
 twists, forces, modes; tested on random grids).
 """
@@ -25,6 +25,7 @@ import numpy as np
 from ..check import DEFAULT_TOLERANCE
 from ..check.stacked import MODE_CODES, audit_stack
 from ..laws.stacked import assemble_stack
+from ..model import Scene
 from ..model.stacked import PlanarStack, stackable
 from ..solvers.batched import certify_stack, solved_message
 from ..tolerances import BATCH_CONTACTS, MAX_FRICTION, MAX_MAGNITUDE, ROUNDOFF
@@ -87,14 +88,19 @@ class _Answer:
         )
 
 
-class _Setter:
-    """Where one parameter's value goes in a stack: its paths as (array name, index) pairs, and what it must be."""
+Place = tuple[str, tuple[Any, ...], str]
+"""Where a path's number goes in a stack: the array's name, the index after the point axis, and the kind of number
+(``mu``, ``mass`` or any other ``number``) that says which values a Scene accepts."""
 
-    def __init__(self, places: list[tuple[str, tuple[Any, ...]]], kind: str) -> None:
-        self.places, self.kind = places, kind
+
+class _Setter:
+    """Where one parameter's value goes in a stack: each of its paths' place."""
+
+    def __init__(self, places: list[Place]) -> None:
+        self.places = places
 
     def apply(self, stack: PlanarStack, values: np.ndarray) -> None:
-        for name, index in self.places:
+        for name, index, _ in self.places:
             array = getattr(stack, name)
             where = (slice(None), *index)
             array[where] = values.reshape(-1, *([1] * (array[where].ndim - 1)))
@@ -112,14 +118,14 @@ def _setters(scenes: PointScenes, options: Mapping[str, Any]) -> list[_Setter] |
     setters = []
     for paths in scenes.steps:
         places = [_place(base, path) for path in paths]
-        if any(place is None for place in places):
+        known = [place for place in places if place is not None]
+        if len(known) < len(places):
             return None
-        kinds = {place[2] for place in places if place is not None}
-        setters.append(_Setter([(p[0], p[1]) for p in places if p is not None], kinds.pop() if len(kinds) == 1 else "number"))
+        setters.append(_Setter(known))
     return setters
 
 
-def _place(base: Any, path: tuple[str | int, ...]) -> tuple[str, tuple[Any, ...], str] | None:
+def _place(base: Scene, path: tuple[str | int, ...]) -> Place | None:
     """The stack array and index a file path sets, and the kind of number it is; None where the batch cannot set it."""
     if path[0] == "contacts" and len(path) == 3 and path[2] == "mu":
         return ("mu", (path[1],), "mu")
@@ -142,12 +148,13 @@ def _place(base: Any, path: tuple[str | int, ...]) -> tuple[str, tuple[Any, ...]
 
 def _valid(values: np.ndarray, setters: list[_Setter]) -> np.ndarray:
     """Points whose every value a Scene accepts (finite, within ``MAX_MAGNITUDE``; mu and mass as ``Contact`` and
-    ``Body`` check them): any other is solved alone, which reports its error as a fresh read does."""
+    ``Body`` check them), wherever each goes: any other is solved alone, which reports its error as a fresh read does."""
     valid = np.isfinite(values).all(axis=1) & (np.abs(values) <= MAX_MAGNITUDE).all(axis=1)
     for column, setter in enumerate(setters):
-        if setter.kind == "mu":
+        kinds = {kind for _, _, kind in setter.places}
+        if "mu" in kinds:
             valid &= (values[:, column] >= 0.0) & (values[:, column] <= MAX_FRICTION)
-        elif setter.kind == "mass":
+        if "mass" in kinds:
             valid &= values[:, column] >= 0.0
     return valid
 
