@@ -182,13 +182,9 @@ def _decided(stack: PlanarStack, positions: np.ndarray, tolerance: float) -> lis
     # Whole arrays to Python floats at once (adding 0.0 turns -0.0 into 0.0, as the per-point record does).
     twist_rows, force_rows, mode_rows = (twists + 0.0).tolist(), (forces + 0.0).tolist(), audit.modes.tolist()
     messages = (solved_message(False), solved_message(True))
+    places, indeterminate = positions.tolist(), motions.indeterminate.tolist()
+    names = {row: tuple(MODE_CODES[code] for code in row) for row in set(map(tuple, mode_rows))}
     return [
-        _Answer(
-            int(positions[k]),
-            tuple(twist_rows[k]),
-            tuple(map(tuple, force_rows[k])),
-            tuple(MODE_CODES[c] for c in mode_rows[k]),
-            messages[int(motions.indeterminate[k])],
-        )
+        _Answer(places[k], tuple(twist_rows[k]), tuple(map(tuple, force_rows[k])), names[tuple(mode_rows[k])], messages[indeterminate[k]])
         for k in np.flatnonzero(motions.decided & audit.passed).tolist()
     ]

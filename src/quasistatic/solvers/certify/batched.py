@@ -349,14 +349,17 @@ def _force_claims(laws: StackedLaws, q: np.ndarray, c: np.ndarray) -> tuple[np.n
                 normal_at.append(len(columns) + 1)
                 columns += [Jt[members, i], Jn[members, i]]
         wrenches = np.stack(columns, axis=2)  # (k, 3, f)
-        _, sigma, vt = np.linalg.svd(wrenches)
+        sigma = np.linalg.svd(wrenches, compute_uv=False)
         settled = _clear(sigma, FORCE_RANK)
         full = (sigma > FORCE_RANK).all(axis=1) & (wrenches.shape[2] <= 3)
         unique[members] = full & settled
-        cone = _cones(contacts, alone, laws.mu[members], normal_at, tangent_at)
-        x = _coordinates(c[members], contacts, normal_at, tangent_at, wrenches.shape[2])
-        wide = _wide(wrenches, laws.g[members], sigma, vt, x, cone)
-        indeterminate[members] = ~full & settled & wide
+        loose = np.flatnonzero(~full & settled)  # forces that may vary: is a step along them wide?
+        if loose.size:
+            picked = members[loose]
+            _, sigma, vt = np.linalg.svd(wrenches[loose])
+            cone = _cones(contacts, alone, laws.mu[picked], normal_at, tangent_at)
+            x = _coordinates(c[picked], contacts, normal_at, tangent_at, wrenches.shape[2])
+            indeterminate[picked] = _wide(wrenches[loose], laws.g[picked], sigma, vt, x, cone)
     return unique, indeterminate
 
 
