@@ -19,6 +19,7 @@ from quasistatic.model.io import read_scene_data, read_scene_file, scene_from_fi
 from quasistatic.model.stacked import PlanarStack, stackable
 from quasistatic.solution import Solution
 from quasistatic.solve import solve
+from quasistatic.sweeps import sweep
 from quasistatic.sweeps.backends import Chunk, solve_chunk
 from quasistatic.sweeps.batched import batched_points
 from quasistatic.sweeps.params import sweep_params
@@ -142,7 +143,7 @@ def test_stacked_audit_passes_and_fails_with_the_audit() -> None:
     modes equal the audit's."""
     rng = np.random.default_rng(11)
     checked = failed = 0
-    for _ in range(20):
+    for _ in range(12):
         scene = _scene(_pushed_box(rng))
         solution = solve(scene)
         if solution.motion is None:
@@ -161,7 +162,7 @@ def test_stacked_audit_passes_and_fails_with_the_audit() -> None:
             assert tuple(MODE_CODES[c] for c in stacked.modes[0]) == modes
             checked += 1
             failed += not audit.passed
-    assert checked > 30 and failed > 10  # both verdicts were compared
+    assert checked >= 30 and failed >= 20  # both verdicts were compared
 
 
 def test_the_bench_grid_is_decided_in_one_batch_equal_to_each_point_alone() -> None:
@@ -226,6 +227,17 @@ def test_a_motion_the_stacked_audit_turns_down_is_left_to_the_per_point_solve() 
     _, points = solve_chunk(Chunk("grid-00000", SWEEP_SCENE, ".", axes, tasks, strict))
     assert points == _alone(scenes, tasks, tolerance=1e-30)
     assert all(p.status != "solved" or not p.certified for p in points)
+
+
+def test_a_sweeps_records_do_not_depend_on_how_its_points_are_grouped(monkeypatch: pytest.MonkeyPatch) -> None:
+    """One chunk, stacks of at most 5 points, and chunks of one point (never batched): equal sweeps."""
+    import quasistatic.sweeps.batched as batched
+
+    grid = {"contacts[2].point[1]": np.linspace(0.02, 0.38, 6), "contacts[0].mu,contacts[1].mu": np.linspace(0.1, 1.0, 6)}
+    whole = sweep(SWEEP_SCENE, grid, chunk_size=36)
+    alone = sweep(SWEEP_SCENE, grid, chunk_size=1)
+    monkeypatch.setattr(batched, "BATCH_POINTS", 5)
+    assert sweep(SWEEP_SCENE, grid, chunk_size=36).points == whole.points == alone.points
 
 
 @pytest.mark.slow

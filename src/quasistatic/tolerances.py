@@ -36,6 +36,7 @@ __all__ = [
     "ARRANGEMENT_CONTACTS",
     "ARRANGEMENT_ROUNDOFF",
     "BATCH_CONTACTS",
+    "BATCH_POINTS",
     "BATCH_TIE",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
@@ -185,10 +186,14 @@ being excluded, never exclude one); dependent normals are the one round-off assu
 parallel lines: computed to 1e-16, normals this close to dependent meet 1e12 times farther than their offsets."""
 
 BATCH_CONTACTS = 8
-"""Most contacts of a sweep's planar points decided together (:mod:`quasistatic.solvers.certify.batched`) [-]: its
-ray test holds, per vertex left, every pair of near planes against every candidate Farkas direction, an array that
-grows as the fourth power of the contacts (about 20 MB for a chunk's held vertices at 8); past it each point is
-solved alone."""
+"""Most contacts of a sweep's planar points decided together (:mod:`quasistatic.solvers.certify.batched`) [-]: the
+vertex certificate's arrays hold every triple of the up to ``2 m`` twist planes against every plane, per point
+(C(16, 3) x 16 x 3 numbers, 215 KB a point at 8 contacts; 3.8 MB at the 16 of ``ARRANGEMENT_CONTACTS``); past it
+each point is solved alone."""
+
+BATCH_POINTS = 256
+"""Most points decided in one stack [-]: a sweep's chunks hold at most 256 by default, and a larger chunk
+(``chunk_size``) is decided 256 points at a time, so the arrays above stay below about 60 MB."""
 
 BATCH_TIE = 2.0
 """A batched test's value within this factor of its threshold, either side, leaves the point to the per-point solve

@@ -57,7 +57,9 @@ class Chunk:
 
 def solve_chunk(chunk: Chunk) -> tuple[str, list[SweepPoint]]:
     """Solve every point of a chunk (audited, as :func:`quasistatic.solve` does); a point whose scene or solve
-    fails is recorded as ``failed`` with the reason, so one bad corner does not lose the sweep."""
+    fails is recorded as ``failed`` with the reason, so one bad corner does not lose the sweep. Points of one planar
+    shape are first decided together where the batch proves them (:mod:`.batched`, the same records); the rest one
+    by one."""
     points = []
     scenes = PointScenes(chunk.data, chunk.folder, chunk.params)  # the file validated once per chunk
     decided = batched_points(scenes, chunk.points, chunk.options)  # the points proven together, by position

@@ -28,7 +28,7 @@ from ..laws.stacked import assemble_stack
 from ..model import Scene
 from ..model.stacked import PlanarStack, stackable
 from ..solvers.batched import certify_stack, solved_message
-from ..tolerances import BATCH_CONTACTS, MAX_FRICTION, MAX_MAGNITUDE, ROUNDOFF
+from ..tolerances import BATCH_CONTACTS, BATCH_POINTS, MAX_FRICTION, MAX_MAGNITUDE, ROUNDOFF
 from .result import SweepPoint
 from .scenes import PointScenes
 
@@ -54,7 +54,9 @@ def batched_points(scenes: PointScenes, tasks: Sequence[Task], options: Mapping[
     tolerance = float(options.get("tolerance", DEFAULT_TOLERANCE))
     for mask in np.unique(frictional[valid & frictional.any(axis=1)], axis=0):  # one shape of the laws per group
         members = np.flatnonzero(valid & (frictional == mask).all(axis=1))
-        answers += _decided(_taken(stack, members), members, tolerance)
+        for start in range(0, members.size, BATCH_POINTS):  # bounded arrays, whatever the chunk's size
+            part = members[start : start + BATCH_POINTS]
+            answers += _decided(_taken(stack, part), part, tolerance)
     seconds = (time.perf_counter() - started) / max(len(answers), 1)  # a batched point's share of the batch's time
     body = scenes.base.bodies[0].name
     return {answer.position: answer.record(tasks[answer.position], body, seconds) for answer in answers}
