@@ -4,6 +4,9 @@ the per-point solve's, field for field and bit for bit (status, message, twists,
 from __future__ import annotations
 
 import itertools
+import subprocess
+import sys
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -255,3 +258,23 @@ def test_many_random_grids_equal_each_point_alone() -> None:
             continue
         decided += _batched_equals_alone(data, grid)
     assert decided > 500
+
+
+@pytest.mark.slow
+def test_batched_sweeps_equal_point_by_point_without_numba() -> None:
+    """With numba made unimportable (the kernels as plain Python), a batched chunk still equals chunks of one point."""
+    code = textwrap.dedent(
+        """
+        import sys
+        sys.modules["numba"] = None  # import numba now raises ImportError
+        import numpy as np
+        from quasistatic import jit
+        from quasistatic.sweeps import sweep
+        from quasistatic.tools.bench.sweep_bench import SWEEP_SCENE
+        assert not jit.HAVE_NUMBA
+        grid = {"contacts[2].point[1]": np.linspace(0.02, 0.38, 3), "contacts[0].mu,contacts[1].mu": [0.1, 1.0]}
+        assert sweep(SWEEP_SCENE, grid, chunk_size=6).points == sweep(SWEEP_SCENE, grid, chunk_size=1).points
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert out.returncode == 0, out.stderr
