@@ -189,9 +189,11 @@ def test_a_rejected_point_gives_the_error_of_the_file_read_again(params: dict[st
 
 def test_a_sweep_equals_each_point_solved_from_the_file_and_leaves_messages_for_reading() -> None:
     grid = {"contacts[2].point[1]": [0.05, 0.15, 0.3], "contacts[0].mu,contacts[1].mu": [0.2, 0.8]}
-    result = qs.sweep(SWEEP_SCENE, grid)
+    result = qs.sweep(SWEEP_SCENE, grid, chunk_size=1)  # a point a chunk: solved alone (a batch decides its claims as it proves)
     point_message = SweepPoint.__dict__["message"]
     assert not any(point_message.decided(p) for p in result.points)
+    batched = qs.sweep(SWEEP_SCENE, grid)
+    assert all(point_message.decided(p) for p in batched.points) and batched.points == result.points
     axes = sweep_params(SWEEP_SCENE, grid)
     for point in result.points:
         fresh = qs.solve(scene_at(SWEEP_SCENE, ".", axes, point.values))

@@ -38,6 +38,9 @@ __all__ = [
     "PYRAMID_PATTERN_NODES",
     "ARRANGEMENT_CONTACTS",
     "ARRANGEMENT_ROUNDOFF",
+    "BATCH_CONTACTS",
+    "BATCH_POINTS",
+    "BATCH_TIE",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
     "BASIS_FEASIBILITY",
@@ -194,6 +197,22 @@ have lengths 1 to 2), a ray's rate along a plane below it is zero, and a compute
 fraction of ``|n| |w|_1 + |r|``. A zero rate or a near plane only adds force generators (it can keep a vertex from
 being excluded, never exclude one); dependent normals are the one round-off assumption, as for the branch and bound's
 parallel lines: computed to 1e-16, normals this close to dependent meet 1e12 times farther than their offsets."""
+
+BATCH_CONTACTS = 8
+"""Most contacts of a sweep's planar points decided together (:mod:`quasistatic.solvers.certify.batched`) [-]: the
+vertex certificate's arrays hold every triple of the up to ``2 m`` twist planes against every plane, per point
+(C(16, 3) x 16 x 3 numbers, 215 KB a point at 8 contacts; 3.8 MB at the 16 of ``ARRANGEMENT_CONTACTS``); past it
+each point is solved alone."""
+
+BATCH_POINTS = 256
+"""Most points decided in one stack [-]: a sweep's chunks hold at most 256 by default, and a larger chunk
+(``chunk_size``) is decided 256 points at a time, so the arrays above stay below about 60 MB."""
+
+BATCH_TIE = 2.0
+"""A batched test's value within this factor of its threshold, either side, leaves the point to the per-point solve
+(:mod:`quasistatic.solvers.certify.batched`) [-]: the batch sums the same products in another order, so the two can
+differ in the last bits; far from the threshold they fall on the same side. A factor, not a margin in the laws: the
+point is then only solved alone, as before."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""

@@ -17,6 +17,7 @@ from typing import Any
 from ..errors import BackendUnavailableError, QuasistaticError
 from ..solution import Solution
 from ..solve import solve
+from .batched import batched_points
 from .params import SweepParam
 from .result import SWEEPS_INSTALL_HINT, SweepPoint, point_from_solution
 from .scenes import PointScenes, scene_at
@@ -56,10 +57,16 @@ class Chunk:
 
 def solve_chunk(chunk: Chunk) -> tuple[str, list[SweepPoint]]:
     """Solve every point of a chunk (audited, as :func:`quasistatic.solve` does); a point whose scene or solve
-    fails is recorded as ``failed`` with the reason, so one bad corner does not lose the sweep."""
+    fails is recorded as ``failed`` with the reason, so one bad corner does not lose the sweep. Points of one planar
+    shape are first decided together where the batch proves them (:mod:`.batched`, the same records); the rest one
+    by one."""
     points = []
     scenes = PointScenes(chunk.data, chunk.folder, chunk.params)  # the file validated once per chunk
-    for index, values, refinement in chunk.points:
+    decided = batched_points(scenes, chunk.points, chunk.options)  # the points proven together, by position
+    for position, (index, values, refinement) in enumerate(chunk.points):
+        if position in decided:
+            points.append(decided[position])
+            continue
         start = time.perf_counter()
         try:
             solution = solve(scenes.at(values), **chunk.options)

@@ -42,7 +42,8 @@ class SweepPoint:
         The verdict is proven (``Solution.certified``); false marks it unproven.
     message : str
         The solution's message (or why the point could not be solved); its claim about the forces is worked out
-        when first read (the table, pickling, ``==``), so a sweep that reads only statuses does not pay for it.
+        when first read (the table, pickling, ``==``), so a sweep that reads only statuses does not pay for it (a point
+        decided in a batch, :mod:`.batched`, comes with it: the batch works it out as it proves the motion).
     motions : int
         Motions found: 1 for ``solved``, the listed ones for ``ambiguous``, 0 otherwise.
     twists : tuple of (str, tuple of float)
@@ -52,7 +53,8 @@ class SweepPoint:
     modes : tuple of str
         Each contact's mode in the reported motion.
     seconds : float
-        Wall time of the solve [s] (not compared: it differs between runs).
+        Wall time of the solve [s] (not compared: it differs between runs); a point decided in a batch
+        (:mod:`.batched`) has its share of the batch's time.
     """
 
     index: int

@@ -33,6 +33,7 @@ from .lemke import SOLUTION, lemke
 __all__ = [
     "solve_split_lcp",
     "split_lcp_point",
+    "split_lcp_points",
     "lemke_motion",
     "exact_newton",
     "LemkeInputs",
@@ -231,6 +232,33 @@ def split_lcp_point(
     M, qv = _assemble(Jn, Jt, bn, bt, mu_f, g, edges, frictional)
     status, z, _, _ = lemke(M, qv, np.ones(qv.shape[0]), pivots_per_row * qv.shape[0], pivot_tol)
     return status, z
+
+
+@njit
+def split_lcp_points(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    frictional: np.ndarray,
+    base: np.ndarray,
+    pivot_tol: float,
+    pivots_per_row: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`split_lcp_point` on each of a stack of problems of one shape (``J`` (N, m, d, n), ``b`` (N, m, d),
+    ``mu`` (N, m), ``g`` (N, n); the same ``frictional`` contacts): one compiled call instead of N (a call's
+    dispatch costs as much as a small problem's pivots). Returns each status (N,) and raw point (N, len z)."""
+    count = J.shape[0]
+    n = J.shape[3]
+    size = 2 * n + J.shape[1] + frictional.shape[0] * (base.shape[0] + 1)
+    statuses = np.empty(count, dtype=np.int64)
+    points = np.zeros((count, size))
+    for k in range(count):
+        status, z = split_lcp_point(J[k], b[k], mu[k], g[k], frictional, base, pivot_tol, pivots_per_row)
+        statuses[k] = status
+        if z.shape[0] == size:
+            points[k] = z
+    return statuses, points
 
 
 @njit

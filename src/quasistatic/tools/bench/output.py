@@ -312,8 +312,9 @@ _SWEEP_COLUMNS = (
 )
 _SWEEP_CAPTION = (
     "Sweep of the tip-or-slide box (push height x floor friction), every point certified and audited; warm workers. "
-    "one solve = median solver time of a point: workers / one solve is what the solves alone allow, the rest is "
-    "per-point overhead (scene read at each point, chunks shipped and collected); startup = the LocalCluster's start, not in wall"
+    "one solve = median solver time of a point (a point decided in a batch: its share of the batch's time): workers / one "
+    "solve is what the solves alone allow, the rest is per-point overhead (scene read at each point, chunks shipped and "
+    "collected); startup = the LocalCluster's start, not in wall"
 )
 
 

@@ -40,7 +40,8 @@ class SweepRow:
     """One backend's sweep of the same grid; times in seconds.
 
     ``per_second`` counts certified solves over the sweep's wall time (warm workers);
-    ``solve_seconds`` is the median time of one solve as the solver measured it, so
+    ``solve_seconds`` is the median time of one solve as the solver measured it (a point decided in a
+    batched chunk: its share of the batch's time, from stacking to audit), so
     ``workers / solve_seconds`` is what the solves alone would allow and the rest is overhead
     (reading the scene at each point, shipping chunks, collecting answers).
     """

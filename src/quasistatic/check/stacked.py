@@ -1,0 +1,99 @@
+"""The audit of many planar motions at once, each on its own scene's numbers (a :class:`~quasistatic.model.stacked.PlanarStack`).
+
+The same laws and residuals as :mod:`.audit`'s planar kernel, contact by contact in the same order, with the
+points as a leading array axis: velocities, loads and moments recomputed from the stacked scene data (world frame,
+physical units), never from assembled matrices, so this stays an independent judge of a batched solve. It also
+measures each contact's normal velocity and slip speed, from which a mode is named as the report names it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import FloatArray
+from ..model.stacked import PlanarStack
+from ..tolerances import AUDIT, MODE_SPEED
+
+__all__ = ["StackedAudit", "audit_stack", "MODE_CODES"]
+
+MODE_CODES = ("rolling", "sliding", "separating")
+"""The mode named by each code of :attr:`StackedAudit.modes`."""
+
+
+@dataclass(frozen=True)
+class StackedAudit:
+    """Per point: whether every residual is within the tolerance (``passed``, (N,)), each contact's mode as the audit
+    measured it (``modes``, (N, m), codes into :data:`MODE_CODES`), and the measured normal velocity and slip speed
+    (``normal_velocity``, ``slip_speed``, (N, m)) with the mode threshold (``threshold``, (N,))."""
+
+    passed: np.ndarray
+    modes: np.ndarray
+    normal_velocity: FloatArray
+    slip_speed: FloatArray
+    threshold: FloatArray
+
+
+def audit_stack(
+    stack: PlanarStack,
+    twists: FloatArray,
+    forces: FloatArray,
+    scales: tuple[FloatArray, FloatArray, FloatArray],
+    tolerance: float = AUDIT,
+) -> StackedAudit:
+    """Audit each point's motion: ``twists`` (N, 3) physical, ``forces`` (N, m, 2) world forces on the body;
+    ``scales`` the (length, force, velocity) of each point (N,) the residuals are divided by."""
+    length, force, velocity = scales
+    n, t = stack.normal, np.stack([stack.normal[..., 1], -stack.normal[..., 0]], axis=-1)
+    arm = stack.point - stack.com[:, None, :]
+    offset = stack.point - stack.origin
+    spin = stack.twist[..., 2]
+    mover = np.stack([stack.twist[..., 0] - spin * offset[..., 1], stack.twist[..., 1] + spin * offset[..., 0]], axis=-1)
+    loads = stack.wrench.copy()
+    loads[:, :2] += stack.mass[:, None] * stack.gravity
+    vx, vy, w = twists[:, 0], twists[:, 1], twists[:, 2]
+    size = stack.size
+    totals = [loads[:, 0].copy(), loads[:, 1].copy(), loads[:, 2].copy()]
+    cone, penetration, normal_power, shortfall = (np.zeros(size) for _ in range(4))
+    supplied, dissipated, check = np.zeros(size), np.zeros(size), np.zeros(size)
+    normal_velocity, slip_speed = np.empty(stack.mu.shape), np.empty(stack.mu.shape)
+    for i in range(stack.mu.shape[1]):  # in contact order, as the kernel adds them
+        nx, ny, tx, ty = n[:, i, 0], n[:, i, 1], t[:, i, 0], t[:, i, 1]
+        rx, ry, mx, my = arm[:, i, 0], arm[:, i, 1], mover[:, i, 0], mover[:, i, 1]
+        fx, fy = forces[:, i, 0], forces[:, i, 1]
+        ux, uy = (vx - w * ry) - mx, (vy + w * rx) - my
+        totals[0] += fx
+        totals[1] += fy
+        totals[2] += rx * fy - ry * fx
+        supplied += fx * mx + fy * my
+        f_n, f_t = fx * nx + fy * ny, fx * tx + fy * ty
+        u_n, u_t = ux * nx + uy * ny, ux * tx + uy * ty
+        radius = stack.mu[:, i] * np.maximum(f_n, 0.0)
+        cone = np.maximum(np.maximum(cone, -f_n), np.abs(f_t) - radius)
+        penetration = np.maximum(penetration, -u_n)
+        normal_power = np.maximum(normal_power, np.abs(f_n * u_n))
+        shortfall = np.maximum(shortfall, radius * np.abs(u_t) + f_t * u_t)
+        dissipated -= fx * ux + fy * uy - f_n * u_n
+        check += fx + fy + ux + uy
+        sx, sy = ux - u_n * nx, uy - u_n * ny
+        normal_velocity[:, i], slip_speed[:, i] = u_n, np.sqrt(sx * sx + sy * sy)
+    raised = np.zeros(size)
+    for j in range(3):
+        check += totals[j]
+        raised -= loads[:, j] * twists[:, j]
+    check += raised
+    F, L, V = force, length, velocity
+    equilibrium = np.maximum(np.maximum(np.abs(totals[0]), np.abs(totals[1])) / F, np.abs(totals[2]) / (F * L))
+    equilibrium[~np.isfinite(check)] = np.inf
+    residuals = (
+        equilibrium,
+        np.maximum(0.0, cone / F),
+        np.maximum(penetration / V, normal_power / (F * V)),
+        np.maximum(shortfall / (F * V), 0.0),
+        np.abs(supplied - raised - dissipated) / (F * V),
+    )
+    passed = np.logical_and.reduce([r <= tolerance for r in residuals])
+    threshold = MODE_SPEED * velocity
+    modes = np.where(normal_velocity > threshold[:, None], 2, np.where(slip_speed > threshold[:, None], 1, 0))
+    return StackedAudit(passed, modes.astype(np.int8), normal_velocity, slip_speed, threshold)
