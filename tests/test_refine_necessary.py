@@ -22,14 +22,15 @@ from random_scenes import random_scene
 
 
 def _answer(solution: qs.Solution) -> tuple[object, ...]:
-    """Status, message and every motion's twists, modes and forces, exactly."""
+    """Status, message and every motion's twists, modes and forces, exactly (not the force ranges: nothing here
+    changes them, and they are worked out only when read)."""
     motions = solution.solutions or ((solution.motion,) if solution.motion is not None else ())
     return (
         solution.status,
         solution.certified,
         solution.message,
         tuple(
-            (tuple(np.concatenate([np.ravel(t) for t in m.twists.values()]).tolist()), m.modes, tuple(c.force.tolist() for c in m.contacts))
+            (tuple(np.concatenate([np.ravel(t) for t in m.twists.values()]).tolist()), m.modes, m.forces_and_slips()[0].tolist())
             for m in motions
         ),
     )
