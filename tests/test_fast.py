@@ -587,7 +587,10 @@ def test_sparse_full_column_rank_matches_lapack() -> None:
         for tol in (1e-9, 1e-10):
             if not 0.5 < smallest / tol < 2.0:
                 assert full_column_rank(A, tol) is bool(smallest > tol), (trial, smallest, tol)
-    assert not full_column_rank(np.zeros((DENSE_MAX + 5, DENSE_MAX + 1)), 1e-9)  # exactly singular: the LU stops
+    assert not full_column_rank(np.zeros((DENSE_MAX + 5, DENSE_MAX + 1)), 1e-9)  # exactly singular, by its pattern
+    few_rows = np.zeros((140, DENSE_MAX + 70))
+    few_rows[:9] = rng.normal(size=(9, DENSE_MAX + 70))  # rank 9 at most (SuperLU could crash on its K)
+    assert not full_column_rank(few_rows, 1e-9)
 
 
 def test_plain_python_twins_equal_the_compiled_kernels() -> None:

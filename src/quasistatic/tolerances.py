@@ -181,7 +181,8 @@ most ~30 ms before SCIP."""
 PYRAMID_PATTERN_NODES = 8192
 """Most nodes of the 3-D pyramid's mode branch and bound (:mod:`quasistatic.solvers.certify.patterns`) before it
 gives the proof to the SCIP search [-]: measured on the 8-edge pyramid, the benchmark's 3-D grasps of 4-8 contacts
-need 208-4822 (0.03-0.6 s), where SCIP took 0.2-30 s; of 240 random scenes of 2-4 contacts, 235 were decided
+need 203-4023 (0.02-0.3 s; 208-4822 before the slip's four arcs and a proof's least loaded contacts first), where SCIP
+took 0.2-30 s; of 240 random scenes of 2-4 contacts, 235 were decided
 within it. A node costs 55-90 us (about 64 on those grasps), so the budget wastes at most about 0.6 s before SCIP.
 The same budget bounds the search of the exact cones' sector relaxation (``patterns.relaxation_excluded``)."""
 

@@ -35,7 +35,7 @@ import scipy.optimize
 
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes, slips
 from ...laws.fixed_modes import FixedModeLaws
-from ...laws.polyhedral import LCPForm, aligned_edges, polyhedral_form
+from ...laws.polyhedral import LCPForm, aligned_edges, edge_jacobian, polyhedral_form
 from ...solution import Certificate, CertificateKind, Diagnosis
 from ...tolerances import (
     CONE_ROUNDOFF,
@@ -44,10 +44,12 @@ from ...tolerances import (
     FRICTION_ALIGNMENT,
     JACOBIAN_RANK,
     LEAST_SQUARES_STEP,
+    LP_FEASIBILITY,
     MODE_SPEED,
     SAME_TWIST,
 )
 from ..numerics.forces import least_normal_forces
+from ..numerics.highs import solve_lp
 from ..result import BackendResult, Options
 from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
@@ -63,6 +65,7 @@ SEARCH_EDGES = 8  # pyramid edges of the first certified search
 VERDICT_EDGES = 256  # polygons tried when the searched ones cannot decide between unstable and at rest
 WIDER_SEARCH_EDGES = 32  # the most edges the mixed-integer search is run with (its size grows with them)
 RANGE_EDGES = 64  # polygon used for force ranges at rolling contacts (inner, within 0.12 %)
+BALANCE_EDGES = 16  # polygon around each circle when a changed mode pattern's closed contacts are tested for equilibrium
 
 
 def solve_exact_3d(problem: Problem, options: Options, by_patterns: bool = False) -> BackendResult:
@@ -207,7 +210,8 @@ def _refined_result(problem: Problem, motions: list[RawMotion], complete: bool, 
     Where some motion cannot be refined, two distinct exact motions (or a
     continuum) still prove ``ambiguous``, with a list that may be incomplete.
     """
-    refined = [_refine(problem, motion) for motion in motions]
+    necessary = _Necessary(problem)
+    refined = [_refine(problem, motion, necessary) for motion in motions]
     unique: list[RawMotion] = []
     for motion in refined:
         if motion is not None and _keeps_prescribed(problem, motion, options) and not any(_same_exact(problem, motion, o) for o in unique):
@@ -284,22 +288,74 @@ def _same_exact(problem: Problem, a: RawMotion, b: RawMotion) -> bool:
     )
 
 
-def _refine(problem: Problem, motion: RawMotion) -> RawMotion | None:
+def _refine(problem: Problem, motion: RawMotion, necessary: _Necessary) -> RawMotion | None:
     """The exact motion next to a pyramid motion: with the pyramid's modes, else with one or two of them changed.
 
     A pyramid's sliding contact may separate or roll under the circle (its
     slip runs between two edges, where the pyramid's friction is weaker), so
-    those changes are tried, nearest first, before giving up.
+    those changes are tried, nearest first, before giving up. A changed pattern
+    that an LP proves has no solution (``necessary``: no equilibrium on its
+    closed contacts, or no twist with its modes) is not tried.
     """
     if not motion.continuum and _max_dissipation_error(problem, motion) <= FRICTION_ALIGNMENT:
         return motion
     modes = np.array(contact_modes(problem, motion.q), dtype=object)
     for attempt, changed in enumerate(_mode_changes(modes)):
+        if attempt and not necessary.possible(changed):
+            continue  # proven to have no solution
         # Newton converges in a few dozen steps from a nearby start; a changed pattern that has not by then is wrong.
         refined = _refine_with_modes(problem, motion, changed, evaluations=200 if attempt == 0 else 20)
         if refined is not None:
             return refined
     return None
+
+
+class _Necessary:
+    """Two conditions every solution of the exact laws with a mode pattern meets, each one LP per pattern part,
+    remembered (a pattern's rolling and sliding variants share the first): forces on its closed contacts, each in
+    a polygon of :data:`BALANCE_EDGES` edges around its circle, balance the load; a twist closes the closed
+    contacts, stops the rolling ones and opens the separating ones.
+
+    A refined motion meets its closed and rolling rows to ``FIXED_MODE_RESIDUAL``, opens a separating contact by
+    more than ``MODE_SPEED``, and has forces in the exact cones (to ``CONE_ROUNDOFF``, inside the polygons) on its
+    closed contacts only that balance the load to ``FIXED_MODE_RESIDUAL`` (or an LP's, to ``LP_FEASIBILITY``). So
+    where HiGHS finds either LP infeasible (every row loosened by ``LP_FEASIBILITY``), no refinement with that
+    pattern can succeed: the test only skips work that would fail."""
+
+    def __init__(self, problem: Problem) -> None:
+        self.problem = problem
+        edges = aligned_edges(problem, BALANCE_EDGES) / np.cos(np.pi / BALANCE_EDGES)
+        m, n = problem.n_contacts, problem.n_dof
+        friction = problem.mu[:, None, None] * edge_jacobian(problem, edges).reshape(m, BALANCE_EDGES, n)
+        self.generators = problem.Jn[:, None, :] + friction  # (m, K, n): the polygon's edges as wrenches
+        self.known: dict[bytes, bool] = {}
+
+    def possible(self, modes: np.ndarray) -> bool:
+        """False when no solution of the exact laws has these contact modes (proven by an infeasible LP)."""
+        masks = ModeMasks.of(self.problem, modes)
+        return self._balances(masks.closed) and self._kinematic(masks)
+
+    def _balances(self, closed: np.ndarray) -> bool:
+        if not closed.any():
+            return True  # nothing to test (the attempt decides)
+        key = b"f" + np.packbits(closed).tobytes()
+        if key not in self.known:
+            G = self.generators[closed].reshape(-1, self.problem.n_dof).T
+            g = self.problem.g
+            self.known[key] = solve_lp(np.zeros(G.shape[1]), G, -g, -g, np.zeros(G.shape[1])).status != "infeasible"
+        return self.known[key]
+
+    def _kinematic(self, masks: ModeMasks) -> bool:
+        key = b"q" + np.packbits(np.concatenate([masks.closed, masks.rolling])).tobytes()
+        if key not in self.known:
+            p = self.problem
+            rolling = masks.rolling
+            A = np.vstack([p.Jn, p.Jt[rolling].reshape(-1, p.n_dof)])
+            rhs = np.concatenate([p.bn, p.bt[rolling].ravel()])
+            upper = np.concatenate([np.where(masks.closed, p.bn, np.inf), p.bt[rolling].ravel()])
+            lp = solve_lp(np.zeros(p.n_dof), A, rhs - LP_FEASIBILITY, upper + LP_FEASIBILITY)
+            self.known[key] = lp.status != "infeasible"
+        return self.known[key]
 
 
 def _mode_changes(modes: np.ndarray) -> Iterator[np.ndarray]:

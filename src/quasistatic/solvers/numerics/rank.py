@@ -49,7 +49,13 @@ def full_column_rank(A: np.ndarray | sp.spmatrix, tol: float) -> bool:
     if c <= DENSE_MAX:
         dense = np.asarray(A.toarray() if isinstance(A, sp.spmatrix | sp.sparray) else A, dtype=float)
         return bool(np.linalg.svd(dense, compute_uv=False)[-1] > tol)
-    return _augmented_norm(sp.csc_matrix(A), tol) < 1.0 / (_GOLDEN * tol)
+    sparse = sp.csc_matrix(A)
+    if np.count_nonzero(sparse.getnnz(axis=1)) < c:
+        # Fewer rows with entries than columns: rank-deficient by its pattern. SuperLU is not asked, as its pivoting
+        # can read uninitialised memory on the structurally singular K (xiaoyeli/superlu#33): a segfault, 1 run in
+        # 10, on the force ranges of a random 3-D scene's ambiguous answer (140 x 134, 9 rows with entries).
+        return False
+    return _augmented_norm(sparse, tol) < 1.0 / (_GOLDEN * tol)
 
 
 def _augmented_norm(A: sp.csc_matrix, a: float) -> float:
