@@ -35,6 +35,7 @@ __all__ = [
     "PYRAMID_PATTERN_NODES",
     "ARRANGEMENT_CONTACTS",
     "ARRANGEMENT_ROUNDOFF",
+    "FLOAT_ARRANGEMENT_PLANES",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
     "BASIS_FEASIBILITY",
@@ -181,6 +182,12 @@ have lengths 1 to 2), a ray's rate along a plane below it is zero, and a compute
 fraction of ``|n| |w|_1 + |r|``. A zero rate or a near plane only adds force generators (it can keep a vertex from
 being excluded, never exclude one); dependent normals are the one round-off assumption, as for the branch and bound's
 parallel lines: computed to 1e-16, normals this close to dependent meet 1e12 times farther than their offsets."""
+
+FLOAT_ARRANGEMENT_PLANES = 6
+"""Most twist planes (gap rows plus slip rows) on which the vertex certificate's claim "the seed is the only motion" is
+first tried in Python floats (:mod:`quasistatic.solvers.certify.arrangement_floats`) [-]: up to C(6, 3) = 20 triples
+the scalar loops beat the whole-array code's fixed cost of about a hundred numpy calls; past it the arrays are cheaper.
+Not a tolerance: the same claim, the same margins, either way."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""
