@@ -197,29 +197,35 @@ def _rays_excluded(planes: _Planes, held: list[_Vertex], blocked: list[int]) -> 
 
 def _blocked(loads: list[Vector], g: list[float]) -> list[int]:
     """Per useful candidate Farkas direction, the loads it excludes as a bit mask (as :meth:`.arrangement._Exclusions.of`):
-    ``-g``, ``-g`` less its part along each load, and both normals of the plane of each pair of loads."""
+    ``-g``, ``-g`` less its part along each load, and both normals of the plane of each pair of loads. A direction and
+    its negation share their products up to sign (rounding is symmetric), so each normal's are computed once."""
     gx, gy, gz = -g[0], -g[1], -g[2]
     margin = math.sqrt(len(g)) * LP_FEASIBILITY
     directions: list[Vector] = [(gx, gy, gz)]
     for x, y, z in loads:
         scale = (x * gx + y * gy + z * gz) / max(x * x + y * y + z * z, 1e-300)
         directions.append((gx - scale * x, gy - scale * y, gz - scale * z))
-    blocked = [_blocking(direction, 1.0, loads, gx, gy, gz, margin) for direction in directions]
+    blocked: list[int] = []
+    for x, y, z in directions:
+        reserve = (x * gx + y * gy + z * gz) - margin * math.sqrt(x * x + y * y + z * z)
+        if reserve > 0.0:
+            blocked.append(_bits([x * lx + y * ly + z * lz for lx, ly, lz in loads], reserve))
     for (ux, uy, uz), (vx, vy, vz) in itertools.combinations(loads, 2):
-        normal = (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx)
-        blocked += [_blocking(normal, 1.0, loads, gx, gy, gz, margin), _blocking(normal, -1.0, loads, gx, gy, gz, margin)]
-    return [bits for bits in blocked if bits >= 0]
+        x, y, z = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+        toward, length = x * gx + y * gy + z * gz, margin * math.sqrt(x * x + y * y + z * z)
+        rates = [x * lx + y * ly + z * lz for lx, ly, lz in loads]
+        if toward - length > 0.0:
+            blocked.append(_bits(rates, toward - length))
+        if -toward - length > 0.0:
+            blocked.append(_bits([-rate for rate in rates], -toward - length))
+    return blocked
 
 
-def _blocking(direction: Vector, sign: float, loads: list[Vector], gx: float, gy: float, gz: float, margin: float) -> int:
-    """The loads ``sign * direction`` excludes as a bit mask, or -1 where it is not useful (no reserve against ``-g``)."""
-    x, y, z = direction
-    reserve = sign * (x * gx + y * gy + z * gz) - margin * math.sqrt(x * x + y * y + z * z)
-    if not reserve > 0.0:
-        return -1
+def _bits(rates: list[float], reserve: float) -> int:
+    """The loads whose rate along a direction, times ``FORCE_CEILING``, stays below its reserve, as a bit mask."""
     bits = 0
-    for k, (lx, ly, lz) in enumerate(loads):
-        if sign * (x * lx + y * ly + z * lz) * FORCE_CEILING < reserve:
+    for k, rate in enumerate(rates):
+        if rate * FORCE_CEILING < reserve:
             bits |= 1 << k
     return bits
 
