@@ -285,6 +285,7 @@ class _Placed:
         self.centre = np.array(pose[:2])
         self.c, self.s = math.cos(pose[2]), math.sin(pose[2])
         self._faces: tuple[FloatArray, FloatArray, FloatArray] | None = None
+        self._line: tuple[FloatArray, float] | None = None
 
     @property
     def rotation_t(self) -> FloatArray:
@@ -308,10 +309,12 @@ class _Placed:
         return self._faces
 
     def line(self) -> tuple[FloatArray, float]:
-        """A halfplane's world normal and offset."""
-        plane = cast(HalfPlane, self.shape)
-        normal = self.to_world(plane.normal)
-        return normal, plane.offset + float(normal @ self.centre)
+        """A halfplane's world normal and offset (worked out once: the broad phase and the pair's kernel both ask)."""
+        if self._line is None:
+            plane = cast(HalfPlane, self.shape)
+            normal = self.to_world(plane.normal)
+            self._line = (normal, plane.offset + float(normal @ self.centre))
+        return self._line
 
 
 Kernel = Callable[[_Placed, _Placed, float, float], Witnesses]
