@@ -205,18 +205,18 @@ class PlanarLayout:
         self.first = np.array([i for i, _ in pairs], dtype=int)
         self.second = np.array([j for _, j in pairs], dtype=int)
         self.kernels = [_kernel(shapes[i], shapes[j]) for i, j in pairs]
-        self.planes = np.array([isinstance(shapes[i], HalfPlane) or isinstance(shapes[j], HalfPlane) for i, j in pairs], dtype=bool)
-        # each pair with a halfplane: its index, the halfplane's collider and the other's (the broad phase's scalar loop)
-        self.plane_pairs = [
-            (k, i, j) if isinstance(shapes[i], HalfPlane) else (k, j, i) for k, (i, j) in enumerate(pairs) if self.planes[k]
-        ]
+        self.planes = [isinstance(shapes[i], HalfPlane) or isinstance(shapes[j], HalfPlane) for i, j in pairs]
+        # the broad phase's Python floats: each pair's colliders, each reach, and for a pair with a halfplane, the
+        # halfplane's collider and the other's
+        self.pairs, self.reach_list = pairs, self.reach.tolist()
+        self.plane_of = {k: (i, j) if isinstance(shapes[i], HalfPlane) else (j, i) for k, (i, j) in enumerate(pairs) if self.planes[k]}
         self.tolerances = [DUPLICATE_POINT * min(self.sizes[i] or math.inf, self.sizes[j] or math.inf) for i, j in pairs]
 
     def detect(self, poses: FloatArray, margin: float) -> list[ContactPoint]:
         """Contact points of every pair within ``margin``; ``poses`` (n, 3): each collider's [x, y, angle]."""
         placed = self._placed(poses)
         found: list[ContactPoint] = []
-        for k in np.flatnonzero(self._near(poses, placed, margin)).tolist():
+        for k in self._near(poses.tolist(), placed, margin):
             i, j = int(self.first[k]), int(self.second[k])
             for point, normal, gap in self.kernels[k](placed[i], placed[j], margin, self.tolerances[k]):
                 found.append(ContactPoint(self.owners[i], self.owners[j], point, normal, gap))
@@ -237,15 +237,23 @@ class PlanarLayout:
     def _placed(self, poses: FloatArray) -> list[_Placed]:
         return [_Placed(shape, outline, pose) for shape, outline, pose in zip(self.shapes, self.outlines, poses.tolist(), strict=True)]
 
-    def _near(self, poses: FloatArray, placed: list[_Placed], margin: float) -> npt.NDArray[np.bool_]:
-        """Broad phase: bounding circles within ``margin``; against a halfplane, the circle's signed distance."""
-        i, j = self.first, self.second
-        centres = poses[:, :2]
-        reach = self.reach
-        near = np.hypot(*(centres[i] - centres[j]).T) <= reach[i] + reach[j] + margin
-        for k, plane, other in self.plane_pairs:
-            normal, offset = placed[plane].line()
-            near[k] = float(normal @ centres[other]) - offset <= reach[other] + margin
+    def _near(self, poses: list[list[float]], placed: list[_Placed], margin: float) -> list[int]:
+        """Broad phase, the pairs whose bounding circles are within ``margin``; against a halfplane, the circle's signed
+        distance. In Python floats: for a few pairs numpy's calls cost more than the arithmetic, and the test only
+        chooses which pairs the exact kernels look at (each applies the margin itself)."""
+        reach = self.reach_list
+        near = []
+        for k, (i, j) in enumerate(self.pairs):
+            if self.planes[k]:
+                plane, other = self.plane_of[k]
+                normal, offset = placed[plane].line()
+                nx, ny = normal.tolist()
+                x, y = poses[other][0], poses[other][1]
+                close = nx * x + ny * y - offset <= reach[other] + margin
+            else:
+                close = math.hypot(poses[i][0] - poses[j][0], poses[i][1] - poses[j][1]) <= reach[i] + reach[j] + margin
+            if close:
+                near.append(k)
         return near
 
 
