@@ -293,6 +293,7 @@ class _Placed:
         self.centre = np.array(pose[:2])
         self.c, self.s = math.cos(pose[2]), math.sin(pose[2])
         self._faces: tuple[FloatArray, FloatArray, FloatArray] | None = None
+        self._vertices: FloatArray | None = None
         self._line: tuple[FloatArray, float] | None = None
 
     @property
@@ -308,12 +309,18 @@ class _Placed:
         """A local direction in the world (no translation)."""
         return np.array([self.c * vector[0] - self.s * vector[1], self.s * vector[0] + self.c * vector[1]])
 
+    def vertices(self) -> FloatArray:
+        """World vertices (k, 2) of a polygon (all a halfplane's kernel needs of its faces)."""
+        if self._vertices is None:
+            self._vertices = cast(_Outline, self.outline).vertices @ self.rotation_t + self.centre
+        return self._vertices
+
     def faces(self) -> tuple[FloatArray, FloatArray, FloatArray]:
         """World vertices (k, 2), outward face normals (k, 2) and face offsets (k,) of a polygon."""
         if self._faces is None:
-            outline, turn = cast(_Outline, self.outline), self.rotation_t
-            normals = outline.normals @ turn
-            self._faces = (outline.vertices @ turn + self.centre, normals, outline.offsets + normals @ self.centre)
+            outline = cast(_Outline, self.outline)
+            normals = outline.normals @ self.rotation_t
+            self._faces = (self.vertices(), normals, outline.offsets + normals @ self.centre)
         return self._faces
 
     def line(self) -> tuple[FloatArray, float]:
@@ -394,7 +401,7 @@ def _polygon_plane(a: _Placed, b: _Placed, margin: float, tolerance: float) -> W
     one (a polygon standing on a corner whose neighbours are within the margin touches at that corner), each with its
     gap; of vertices at one place along the line, the deepest."""
     normal, offset = b.line()
-    vertices = a.faces()[0]
+    vertices = a.vertices()
     gaps = vertices @ normal - offset
     within = np.flatnonzero(gaps <= margin)
     if within.size == 0:
