@@ -5,7 +5,7 @@ only where that proves nothing. Its verdicts must be the array code's, verdict f
 triples solved, and the proofs it returns the same values (the seed itself, to the last bit): on the turning run's
 problems (the simulation's steps), on the benchmark's planar grasps of 1 to 3 contacts, with and without friction,
 and on random planar scenes. The float path must also decide where the arrays say "unique" with a seed (else the
-speed-up would be lost and these tests would pass on nothing). Measured on 4,000 grasps and 3,000 random scenes:
+speed-up would be lost and these tests would pass on nothing). Measured on 3,200 grasps and 3,000 random scenes:
 every verdict the same, and every seeded unique one of at most six planes proven in floats.
 """
 

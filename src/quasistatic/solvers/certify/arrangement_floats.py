@@ -15,7 +15,7 @@ product and each addition, where numpy's matrix products (BLAS) fuse a multiply 
 most x86-64 machines. A cross or triple product may so differ in its last bit or two; both are far inside the
 certificate's round-off allowance (``ARRANGEMENT_ROUNDOFF``, 1e-12 of the longest normal's cube, against 1e-16), so
 each computation is a proof on its own. ``tests/test_arrangement_floats.py`` holds the two verdict for verdict, with
-equal sign vectors and load masks, on the turning run's problems, the benchmark's planar grasps and random scenes.
+the same number of triples solved, on the turning run's problems, the benchmark's planar grasps and random scenes.
 """
 
 from __future__ import annotations
