@@ -41,6 +41,7 @@ __all__ = [
     "BATCH_CONTACTS",
     "BATCH_POINTS",
     "BATCH_TIE",
+    "FLOAT_ARRANGEMENT_PLANES",
     "HIGHS_SMALLEST_ENTRY",
     "PIVOT",
     "BASIS_FEASIBILITY",
@@ -214,6 +215,12 @@ BATCH_TIE = 2.0
 (:mod:`quasistatic.solvers.certify.batched`) [-]: the batch sums the same products in another order, so the two can
 differ in the last bits; far from the threshold they fall on the same side. A factor, not a margin in the laws: the
 point is then only solved alone, as before."""
+
+FLOAT_ARRANGEMENT_PLANES = 6
+"""Most twist planes (gap rows plus slip rows) on which the vertex certificate's claim "the seed is the only motion" is
+first tried in Python floats (:mod:`quasistatic.solvers.certify.arrangement_floats`) [-]: up to C(6, 3) = 20 triples
+the scalar loops beat the whole-array code's fixed cost of about a hundred numpy calls; past it the arrays are cheaper.
+Not a tolerance: the same claim, the same margins, either way."""
 
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""

@@ -205,18 +205,18 @@ class PlanarLayout:
         self.first = np.array([i for i, _ in pairs], dtype=int)
         self.second = np.array([j for _, j in pairs], dtype=int)
         self.kernels = [_kernel(shapes[i], shapes[j]) for i, j in pairs]
-        self.planes = np.array([isinstance(shapes[i], HalfPlane) or isinstance(shapes[j], HalfPlane) for i, j in pairs], dtype=bool)
-        # each pair with a halfplane: its index, the halfplane's collider and the other's (the broad phase's scalar loop)
-        self.plane_pairs = [
-            (k, i, j) if isinstance(shapes[i], HalfPlane) else (k, j, i) for k, (i, j) in enumerate(pairs) if self.planes[k]
-        ]
+        self.planes = [isinstance(shapes[i], HalfPlane) or isinstance(shapes[j], HalfPlane) for i, j in pairs]
+        # the broad phase's Python floats: each pair's colliders, each reach, and for a pair with a halfplane, the
+        # halfplane's collider and the other's
+        self.pairs, self.reach_list = pairs, self.reach.tolist()
+        self.plane_of = {k: (i, j) if isinstance(shapes[i], HalfPlane) else (j, i) for k, (i, j) in enumerate(pairs) if self.planes[k]}
         self.tolerances = [DUPLICATE_POINT * min(self.sizes[i] or math.inf, self.sizes[j] or math.inf) for i, j in pairs]
 
     def detect(self, poses: FloatArray, margin: float) -> list[ContactPoint]:
         """Contact points of every pair within ``margin``; ``poses`` (n, 3): each collider's [x, y, angle]."""
         placed = self._placed(poses)
         found: list[ContactPoint] = []
-        for k in np.flatnonzero(self._near(poses, placed, margin)).tolist():
+        for k in self._near(poses.tolist(), placed, margin):
             i, j = int(self.first[k]), int(self.second[k])
             for point, normal, gap in self.kernels[k](placed[i], placed[j], margin, self.tolerances[k]):
                 found.append(ContactPoint(self.owners[i], self.owners[j], point, normal, gap))
@@ -237,15 +237,23 @@ class PlanarLayout:
     def _placed(self, poses: FloatArray) -> list[_Placed]:
         return [_Placed(shape, outline, pose) for shape, outline, pose in zip(self.shapes, self.outlines, poses.tolist(), strict=True)]
 
-    def _near(self, poses: FloatArray, placed: list[_Placed], margin: float) -> npt.NDArray[np.bool_]:
-        """Broad phase: bounding circles within ``margin``; against a halfplane, the circle's signed distance."""
-        i, j = self.first, self.second
-        centres = poses[:, :2]
-        reach = self.reach
-        near = np.hypot(*(centres[i] - centres[j]).T) <= reach[i] + reach[j] + margin
-        for k, plane, other in self.plane_pairs:
-            normal, offset = placed[plane].line()
-            near[k] = float(normal @ centres[other]) - offset <= reach[other] + margin
+    def _near(self, poses: list[list[float]], placed: list[_Placed], margin: float) -> list[int]:
+        """Broad phase, the pairs whose bounding circles are within ``margin``; against a halfplane, the circle's signed
+        distance. In Python floats: for a few pairs numpy's calls cost more than the arithmetic, and the test only
+        chooses which pairs the exact kernels look at (each applies the margin itself)."""
+        reach = self.reach_list
+        near = []
+        for k, (i, j) in enumerate(self.pairs):
+            if self.planes[k]:
+                plane, other = self.plane_of[k]
+                normal, offset = placed[plane].line()
+                nx, ny = normal.tolist()
+                x, y = poses[other][0], poses[other][1]
+                close = nx * x + ny * y - offset <= reach[other] + margin
+            else:
+                close = math.hypot(poses[i][0] - poses[j][0], poses[i][1] - poses[j][1]) <= reach[i] + reach[j] + margin
+            if close:
+                near.append(k)
         return near
 
 
@@ -285,6 +293,8 @@ class _Placed:
         self.centre = np.array(pose[:2])
         self.c, self.s = math.cos(pose[2]), math.sin(pose[2])
         self._faces: tuple[FloatArray, FloatArray, FloatArray] | None = None
+        self._vertices: FloatArray | None = None
+        self._line: tuple[FloatArray, float] | None = None
 
     @property
     def rotation_t(self) -> FloatArray:
@@ -299,19 +309,27 @@ class _Placed:
         """A local direction in the world (no translation)."""
         return np.array([self.c * vector[0] - self.s * vector[1], self.s * vector[0] + self.c * vector[1]])
 
+    def vertices(self) -> FloatArray:
+        """World vertices (k, 2) of a polygon (all a halfplane's kernel needs of its faces)."""
+        if self._vertices is None:
+            self._vertices = cast(_Outline, self.outline).vertices @ self.rotation_t + self.centre
+        return self._vertices
+
     def faces(self) -> tuple[FloatArray, FloatArray, FloatArray]:
         """World vertices (k, 2), outward face normals (k, 2) and face offsets (k,) of a polygon."""
         if self._faces is None:
-            outline, turn = cast(_Outline, self.outline), self.rotation_t
-            normals = outline.normals @ turn
-            self._faces = (outline.vertices @ turn + self.centre, normals, outline.offsets + normals @ self.centre)
+            outline = cast(_Outline, self.outline)
+            normals = outline.normals @ self.rotation_t
+            self._faces = (self.vertices(), normals, outline.offsets + normals @ self.centre)
         return self._faces
 
     def line(self) -> tuple[FloatArray, float]:
-        """A halfplane's world normal and offset."""
-        plane = cast(HalfPlane, self.shape)
-        normal = self.to_world(plane.normal)
-        return normal, plane.offset + float(normal @ self.centre)
+        """A halfplane's world normal and offset (worked out once: the broad phase and the pair's kernel both ask)."""
+        if self._line is None:
+            plane = cast(HalfPlane, self.shape)
+            normal = self.to_world(plane.normal)
+            self._line = (normal, plane.offset + float(normal @ self.centre))
+        return self._line
 
 
 Kernel = Callable[[_Placed, _Placed, float, float], Witnesses]
@@ -383,7 +401,7 @@ def _polygon_plane(a: _Placed, b: _Placed, margin: float, tolerance: float) -> W
     one (a polygon standing on a corner whose neighbours are within the margin touches at that corner), each with its
     gap; of vertices at one place along the line, the deepest."""
     normal, offset = b.line()
-    vertices = a.faces()[0]
+    vertices = a.vertices()
     gaps = vertices @ normal - offset
     within = np.flatnonzero(gaps <= margin)
     if within.size == 0:

@@ -83,6 +83,17 @@ class SimModel:
         """The run's memory of its last certified answer (None when ``options.reuse`` is off)."""
         return Reuse() if self.options.reuse else None
 
+    def placed(self, state: State) -> AnyWorld:
+        """The look-ahead World at ``state``'s poses and joint positions, with the scene's own velocities: the step that
+        ended on ``state`` (looking for drifted contacts) and the next step, which starts on that very State and sets
+        its inputs on it, place it once. Kept for the last State asked, as :meth:`found_at` keeps its contacts."""
+        kept = self.__dict__.get("_placed")
+        if kept is not None and kept[0] is state:
+            return cast(AnyWorld, kept[1])
+        world = state.applied(self.detecting)
+        self.__dict__["_placed"] = (state, world)
+        return world
+
     def found_at(self, state: State, world: AnyWorld) -> Detection:
         """``world.detect()``, ``world`` being the look-ahead World placed at ``state``; the contacts found at the
         state a step ended on (:func:`advance` looks for drifted contacts there) serve the next step, which
@@ -225,7 +236,7 @@ class Event:
 def evaluate(model: SimModel, state: State, inputs: Inputs) -> Evaluation:
     """Contacts found at ``state`` (penetration corrected first), the certified answer, and the motion to follow."""
     inputs.check(model.world)
-    world = inputs.applied(state.applied(model.detecting))
+    world = inputs.applied(model.placed(state))
     margin = model.margin
     found = model.found_at(state, world)
     state, world, found, penetration = _corrected(model, state, inputs, world, found)
@@ -362,7 +373,7 @@ def _reclosed(evaluation: Evaluation, state: State) -> State:
     before = list(zip(evaluation.detection.contacts, evaluation.motion.modes, strict=True))
     if not any(mode in ("rolling", "sliding") for _, mode in before):
         return state
-    world = state.applied(evaluation.world)
+    world = evaluation.model.placed(state)  # poses only matter here: detection, and the bodies' centres of mass
     band = SIM_LOOKAHEAD * world.size
     found = evaluation.model.found_at(state, world)
     kept = [(c, gap) for c, gap in zip(found.contacts, found.gaps, strict=True) if _was_closed(before, c, band)]

@@ -40,13 +40,13 @@ class Reuse:
         if self.result is None or self.key != key:
             return None, key
         self.hits += 1
-        return self.result, key
+        return self.result.with_notes(reused=REUSED_NOTE), key  # noted here, not when kept: most kept answers never return
 
     def keep(self, key: tuple[Any, ...], result: BackendResult) -> None:
         """Keep ``result`` for the laws of ``key`` (from :meth:`recalled`) when it is certified and complete; anything
         else clears the memory."""
         if result.certified and result.search_complete and result.status in ("solved", "ambiguous"):
-            self.key, self.result = key, result.with_notes(reused=REUSED_NOTE)
+            self.key, self.result = key, result
         else:
             self.key, self.result = None, None
 

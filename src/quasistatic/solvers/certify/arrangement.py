@@ -145,6 +145,7 @@ from scipy.optimize import nnls
 
 from ...laws.polyhedral import LCPForm
 from ...tolerances import ARRANGEMENT_CONTACTS, ARRANGEMENT_ROUNDOFF, DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, SAME_TWIST, ZERO
+from .arrangement_floats import seed_is_only_motion
 from .cheap import satisfies_form
 from .diagnose import admits_no_multipliers
 
@@ -225,7 +226,11 @@ class _Planes:
 def prove_by_vertices(form: LCPForm, seed_x: np.ndarray | None, max_solutions: int | None = None) -> VertexProof:
     """Whether the only motion of the planar laws ``form`` is the twist of ``seed_x`` (a point ``[q, cn, beta, lam]``
     every law of the form holds at, checked by the caller), or no motion exists, or the motions are isolated twists
-    (at most ``max_solutions`` of them), each listed; see the module docstring."""
+    (at most ``max_solutions`` of them), each listed; see the module docstring. The seed's claim on a few planes is
+    tried in Python floats first (:mod:`.arrangement_floats`); anything it does not prove runs here from the start."""
+    triples = None if seed_x is None else seed_is_only_motion(form, seed_x[:3].tolist())
+    if triples is not None and seed_x is not None:
+        return VertexProof(VertexVerdict.UNIQUE, None, triples, seed_x)
     arrangement = _arrangement(form)
     if arrangement is None:
         return _UNDECIDED
