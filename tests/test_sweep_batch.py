@@ -112,20 +112,6 @@ def _batched_equals_alone(data: dict[str, Any], grid: dict[str, Any]) -> int:
     return len(decided)
 
 
-def test_the_batch_uses_the_per_point_certificates_constants() -> None:
-    """The batch keeps its own copies of a few private constants of the per-point code: they must stay equal."""
-    import quasistatic.solvers.certify.arrangement as arrangement
-    import quasistatic.solvers.certify.batched as batched
-    import quasistatic.solvers.numerics.forces as forces
-    import quasistatic.solvers.numerics.lcp as lcp
-
-    assert batched._MOVING == forces._MOVING
-    assert np.array_equal(batched._PLANAR_EDGES, lcp._PLANAR_EDGES)
-    assert np.array_equal(batched._EDGE_BITS, arrangement._EDGE_BITS)
-    assert np.array_equal(batched._LOOSENESS.ravel(), arrangement._LOOSENESS.ravel())
-    assert np.array_equal(batched._WITHIN.ravel(), arrangement._WITHIN.ravel())
-
-
 def test_stacked_laws_equal_assemble_bit_for_bit() -> None:
     rng = np.random.default_rng(5)
     for _ in range(40):

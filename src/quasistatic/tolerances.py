@@ -23,6 +23,7 @@ __all__ = [
     "DISPLAY_ZERO",
     "TORQUE_LIMIT",
     "ZERO",
+    "MOVING",
     "SAME_TWIST",
     "DISTINCT_TWIST",
     "FORCE_RANK",
@@ -117,6 +118,9 @@ largest lever arm (the largest Jacobian column entry at its contacts): the force
 
 ZERO = 1e-9
 """A residual, velocity or force below this is zero (a contact is closed, a force carries nothing) [-]."""
+
+MOVING = 10 * ZERO
+"""A contact's scene-relative opening or slip speed (or an edge's dissipation rate) above this opens or slides it [-]."""
 
 SAME_TWIST = 1e-7
 """Two twists closer than this (largest entry) are the same motion, and an extreme this close to a point is that point [-]."""

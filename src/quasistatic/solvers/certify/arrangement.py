@@ -144,8 +144,8 @@ import numpy as np
 from scipy.optimize import nnls
 
 from ...laws.polyhedral import LCPForm
-from ...tolerances import ARRANGEMENT_CONTACTS, ARRANGEMENT_ROUNDOFF, DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, SAME_TWIST, ZERO
-from .arrangement_floats import seed_is_only_motion
+from ...tolerances import ARRANGEMENT_CONTACTS, ARRANGEMENT_ROUNDOFF, DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, ZERO
+from .arrangement_floats import CLAIMS, EDGE_BIT_VALUES, seed_is_only_motion
 from .cheap import satisfies_form
 from .diagnose import admits_no_multipliers
 
@@ -157,6 +157,9 @@ __all__ = [
     "VERTEX_PROOF",
     "NO_VERTEX_PROOF",
     "VERTEX_LISTING_PROOF",
+    "EDGE_BITS",
+    "CLAIM_LOOSENESS",
+    "CLAIM_REACH",
 ]
 
 VERTEX_PROOF = (
@@ -398,11 +401,11 @@ def _load_masks(planes: _Planes, signs: np.ndarray) -> np.ndarray:
     else:
         slip = np.zeros((signs.shape[0], m), dtype=np.int8)
         slip[:, planes.frictional] = signs[:, m:]
-    bits = _EDGE_BITS[slip + 1] * (signs[:, :m] == 0)  # integers throughout: no float round trip
+    bits = EDGE_BITS[slip + 1] * (signs[:, :m] == 0)  # integers throughout: no float round trip
     return bits @ _weights(m)
 
 
-_EDGE_BITS = np.array([1, 3, 2], dtype=np.uint64)  # by slip sign -1, 0, +1: the edge n + mu t, both, the edge n - mu t
+EDGE_BITS = np.array(EDGE_BIT_VALUES, dtype=np.uint64)  # by slip sign -1, 0, +1: the edge n + mu t, both, the edge n - mu t
 
 
 @functools.cache
@@ -470,8 +473,9 @@ def _margin(g: np.ndarray) -> float:
     return math.sqrt(g.size) * LP_FEASIBILITY
 
 
-_LOOSENESS = np.array([0.0, ZERO, LP_FEASIBILITY])[:, None, None]  # the tau of each claim on the twist
-_WITHIN = np.array([0.5 * SAME_TWIST, 0.5 * DISTINCT_TWIST, DISTINCT_TWIST])  # and how near the seed it puts them
+CLAIM_LOOSENESS = np.array([tau for tau, _ in CLAIMS])  # the tau of each claim on the twist
+CLAIM_REACH = np.array([reach for _, reach in CLAIMS])  # and how near the seed it puts them
+_LOOSENESS = CLAIM_LOOSENESS[:, None, None]
 
 
 def _vertex_point(form: LCPForm, planes: _Planes, vertices: _Vertices, held: np.ndarray) -> np.ndarray | None:
@@ -520,7 +524,7 @@ def _near_seed(vertices: _Vertices, held: np.ndarray, q: np.ndarray) -> bool:
     ``SAME_TWIST / 2`` exactly, ``DISTINCT_TWIST / 2`` at ``tau = ZERO`` and ``DISTINCT_TWIST`` at ``LP_FEASIBILITY``."""
     offset = np.abs(vertices.w[held] - q)
     reach = offset + (_LOOSENESS + vertices.slack[held, None]) * vertices.spread[held]  # (3, H, 3)
-    return bool((reach.max(axis=(1, 2)) <= _WITHIN).all())
+    return bool((reach.max(axis=(1, 2)) <= CLAIM_REACH).all())
 
 
 def _edges_excluded(planes: _Planes, vertices: _Vertices, held: np.ndarray, excluded: _Exclusions, apart: float | None = None) -> bool:

@@ -37,12 +37,12 @@ from ...tolerances import (
     ZERO,
 )
 
-__all__ = ["seed_is_only_motion"]
+__all__ = ["seed_is_only_motion", "EDGE_BIT_VALUES", "CLAIMS"]
 
 Vector = tuple[float, float, float]
 
-_EDGE_BITS = (1, 3, 2)  # by slip sign -1, 0, +1: the edge n + mu t, both, the edge n - mu t (as arrangement.py)
-_LOOSE = ((0.0, 0.5 * SAME_TWIST), (ZERO, 0.5 * DISTINCT_TWIST), (LP_FEASIBILITY, DISTINCT_TWIST))  # tau, and how near
+EDGE_BIT_VALUES = (1, 3, 2)  # by slip sign -1, 0, +1: the edge n + mu t, both, the edge n - mu t
+CLAIMS = ((0.0, 0.5 * SAME_TWIST), (ZERO, 0.5 * DISTINCT_TWIST), (LP_FEASIBILITY, DISTINCT_TWIST))  # each claim's tau, how near
 
 
 def seed_is_only_motion(form: LCPForm, seed_q: Sequence[float]) -> int | None:
@@ -118,7 +118,7 @@ def _mask(slip_row: list[int], signs: Sequence[int]) -> int:
     mask = 0
     for i, row in enumerate(slip_row):
         if signs[i] == 0:
-            mask |= _EDGE_BITS[(signs[row] if row >= 0 else 0) + 1] << (2 * i)
+            mask |= EDGE_BIT_VALUES[(signs[row] if row >= 0 else 0) + 1] << (2 * i)
     return mask
 
 
@@ -167,7 +167,7 @@ def _near_seed(vertex: _Vertex, q: Sequence[float]) -> bool:
     """Whether the vertex, with its loose twists, is near the seed's twist (as :func:`.arrangement._near_seed`)."""
     w, spread, slack = vertex.w, vertex.spread, vertex.slack
     offset = (abs(w[0] - q[0]), abs(w[1] - q[1]), abs(w[2] - q[2]))
-    return all(offset[e] + (tau + slack) * spread[e] <= within for tau, within in _LOOSE for e in range(3))
+    return all(offset[e] + (tau + slack) * spread[e] <= within for tau, within in CLAIMS for e in range(3))
 
 
 def _rays_excluded(planes: _Planes, held: list[_Vertex], blocked: list[int]) -> bool:

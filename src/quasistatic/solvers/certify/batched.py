@@ -36,25 +36,22 @@ from ...laws.stacked import StackedLaws
 from ...tolerances import (
     ARRANGEMENT_ROUNDOFF,
     BATCH_TIE,
-    DISTINCT_TWIST,
     FORCE_CEILING,
     FORCE_RANK,
     LP_FEASIBILITY,
     MODE_SPEED,
+    MOVING,
     PIVOT,
-    SAME_TWIST,
     ZERO,
 )
-from ..numerics.lcp import PIVOTS_PER_ROW, split_lcp_points
+from ..numerics.lcp import PIVOTS_PER_ROW, PLANAR_EDGES, split_lcp_points
 from ..numerics.lemke import SOLUTION
+from .arrangement import CLAIM_LOOSENESS, CLAIM_REACH, EDGE_BITS
 
 __all__ = ["BatchedMotions", "certify_batch"]
 
-_PLANAR_EDGES = np.array([1.0, -1.0])  # the 2-D cone's edges along the tangent, as the kernel builds them
-_MOVING = ZERO * 10  # open or sliding beyond this: numerics.forces's (a test checks these copies stay equal)
-_LOOSENESS = np.array([0.0, ZERO, LP_FEASIBILITY])[:, None, None, None]  # the tau of each claim on the twist
-_WITHIN = np.array([0.5 * SAME_TWIST, 0.5 * DISTINCT_TWIST, DISTINCT_TWIST])[:, None, None]  # how near the seed
-_EDGE_BITS = np.array([1, 3, 2], dtype=np.uint64)  # by slip sign -1, 0, +1: the edge n + mu t, both, n - mu t
+_LOOSENESS = CLAIM_LOOSENESS[:, None, None, None]  # the vertex certificate's claims, with a point axis
+_WITHIN = CLAIM_REACH[:, None, None]
 
 
 @dataclass(frozen=True)
@@ -89,7 +86,7 @@ def _seeds(laws: StackedLaws) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nd
     J, b, mu, g = (np.ascontiguousarray(a, dtype=float) for a in (laws.J, laws.b, laws.mu, laws.g))
     frictional = np.flatnonzero(mu[0] > 0.0)
     f = frictional.size
-    statuses, z = split_lcp_points(J, b, mu, g, frictional, _PLANAR_EDGES, PIVOT, PIVOTS_PER_ROW)
+    statuses, z = split_lcp_points(J, b, mu, g, frictional, PLANAR_EDGES, PIVOT, PIVOTS_PER_ROW)
     seeded = statuses == SOLUTION
     q = z[:, :3] - z[:, 3:6]
     cn = z[:, 6 : 6 + m].copy()
@@ -241,7 +238,7 @@ def _load_masks(signs: np.ndarray, m: int, frictional: np.ndarray) -> np.ndarray
     contact's two bits 1 (``+t``, sliding +), 2 (``-t``) or 3 (both), contact ``i`` at ``4^i``."""
     slip = np.zeros((signs.shape[0], m), dtype=np.int8)
     slip[:, frictional] = signs[:, m:]
-    return _bit_masks(_EDGE_BITS[slip + 1] * (signs[:, :m] == 0), 4.0)
+    return _bit_masks(EDGE_BITS[slip + 1] * (signs[:, :m] == 0), 4.0)
 
 
 def _vertex_proof(laws: StackedLaws, q: np.ndarray, todo: np.ndarray) -> np.ndarray:
@@ -319,13 +316,13 @@ def _force_claims(laws: StackedLaws, q: np.ndarray, c: np.ndarray) -> tuple[np.n
     Jt, Jn = laws.J[..., 0, :], laws.J[..., 1, :]
     u_n = _rows(Jn, q) - laws.b[..., 1]
     u_t = _rows(Jt, q) - laws.b[..., 0]
-    closed = ~(u_n > _MOVING)
+    closed = ~(u_n > MOVING)
     frictional = laws.mu > 0.0
-    sliding = closed & (np.abs(u_t) > _MOVING) & frictional
+    sliding = closed & (np.abs(u_t) > MOVING) & frictional
     single = ~frictional | sliding
     tilt = np.where(sliding, -laws.mu * np.sign(u_t), 0.0)
     one = Jn + tilt[..., None] * Jt  # (N, m, 3)
-    clear = _clear(u_n, _MOVING) & _clear(u_t, _MOVING)
+    clear = _clear(u_n, MOVING) & _clear(u_t, MOVING)
     unique, indeterminate = np.zeros(clear.size, dtype=bool), np.zeros(clear.size, dtype=bool)
     m = Jn.shape[1]
     patterns = np.concatenate((closed, single), axis=1)

@@ -27,7 +27,7 @@ from scipy.optimize import nnls
 
 from ...laws import ForceSet, ModeMasks, Problem, slips
 from ...laws.polyhedral import ForcePolytope, aligned_edges, dense_force_matrix, force_polytope
-from ...tolerances import FORCE_INTERIOR, FORCE_RANK, LP_FEASIBILITY, ZERO
+from ...tolerances import FORCE_INTERIOR, FORCE_RANK, LP_FEASIBILITY, MOVING, ZERO
 from ..result import Range
 from .highs import solve_lp
 from .ranges import Bounds, linear_ranges, null_space, ranges_are_wide, rows_feasible, rows_in_row_space, value_ranges
@@ -45,8 +45,6 @@ __all__ = [
     "least_normal_forces",
     "measured_masks",
 ]
-
-_MOVING = ZERO * 10  # scene-relative speed or dissipation rate above which a contact opens or slides
 
 
 @dataclass(frozen=True)
@@ -171,7 +169,7 @@ def _held_columns(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: Mod
     m, K = edges.shape[:2]
     drive = -np.einsum("mkt,mt->mk", edges, slips(problem, q))  # dissipation rate per unit edge force
     best = drive.max(axis=1, initial=0.0)  # no edges (frictionless): nothing dissipates
-    weaker = drive < best[:, None] - _MOVING
+    weaker = drive < best[:, None] - MOVING
     normal = ~masks.closed
     # An open contact's edge forces and slack are zero too: ``mu cn = sum beta + slack`` with cn held at 0 and all
     # of them >= 0. Holding them says so as equations, which the rank tests read (a tipping box's lifted corner
@@ -181,11 +179,11 @@ def _held_columns(problem: Problem, edges: np.ndarray, q: np.ndarray, masks: Mod
 
 
 def measured_masks(problem: Problem, edges: np.ndarray, q: np.ndarray) -> ModeMasks:
-    """Modes as the velocities at ``q`` show them: open beyond ``_MOVING``, sliding where some edge dissipates."""
+    """Modes as the velocities at ``q`` show them: open beyond ``MOVING``, sliding where some edge dissipates."""
     u = problem.velocities(q)
     drive = -np.einsum("mkt,mt->mk", edges, u[:, :-1])
-    closed = ~(u[:, -1] > _MOVING)
-    sliding = drive.max(axis=1, initial=0.0) > _MOVING
+    closed = ~(u[:, -1] > MOVING)
+    sliding = drive.max(axis=1, initial=0.0) > MOVING
     return ModeMasks(closed, closed & ~sliding & (problem.mu > 0), sliding)
 
 

@@ -40,13 +40,14 @@ __all__ = [
     "NOT_CONVERGED",
     "PIVOTS_PER_ROW",
     "FAST_EDGES",
+    "PLANAR_EDGES",
 ]
 
 PIVOTS_PER_ROW = 20  # Lemke pivot cap per LCP row
 NOT_CONVERGED = 3  # kernel status beyond Lemke's: neither re-alignment nor Newton's method reached the exact cone
 FAST_EDGES = 6  # pyramid edges for exact 3-D cones (Newton then solves the circle; 6 was 2-3x faster than 8 on 3-D grasps, same successes)
 REALIGNMENTS = 20  # most edge re-alignments for exact 3-D cones
-_PLANAR_EDGES = np.array([1.0, -1.0])
+PLANAR_EDGES = np.array([1.0, -1.0])  # a 2-D cone's edges along the tangent, as the kernels build them
 
 
 class LemkeInputs:
@@ -63,7 +64,7 @@ class LemkeInputs:
     def __init__(self, problem: Problem) -> None:
         self.exact = problem.dimension == 3 and not problem.friction.is_polyhedral(3)
         if problem.dimension == 2:
-            self.base = _PLANAR_EDGES
+            self.base = PLANAR_EDGES
         else:
             count = FAST_EDGES if self.exact else problem.friction.edges
             self.base = 2.0 * np.pi * np.arange(count) / count
