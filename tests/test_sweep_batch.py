@@ -4,6 +4,7 @@ the per-point solve's, field for field and bit for bit (status, message, twists,
 from __future__ import annotations
 
 import itertools
+import json
 import subprocess
 import sys
 import textwrap
@@ -264,3 +265,39 @@ def test_batched_sweeps_equal_point_by_point_without_numba() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert out.returncode == 0, out.stderr
+
+
+def test_the_batchs_force_claims_agree_with_the_per_point_solve() -> None:
+    """Where the batch decides a point, its claim on the forces (unique, or indeterminate) is the per-point solve's:
+    random scenes of 1 to 8 contacts and pushed boxes, each a stack of one, cover maps of full rank and rank-deficient ones."""
+    from quasistatic.solvers.batched import certify_stack
+
+    rng = np.random.default_rng(11)
+    claims = {True: 0, False: 0}
+    for trial in range(80):
+        scene = _scene(_pushed_box(rng) if trial % 2 else _random_scene(rng, int(rng.integers(1, 9))))
+        if not stackable(scene):
+            continue
+        batch = certify_stack(assemble_stack(PlanarStack.tiled(scene, 1)))
+        if not batch.decided[0]:
+            continue
+        solution = solve(scene, **OPTIONS)
+        assert solution.status == "solved" and solution.certified
+        assert solution.forces_indeterminate == bool(batch.indeterminate[0])
+        claims[bool(batch.indeterminate[0])] += 1
+    assert claims[True] >= 2 and claims[False] >= 5, claims  # both claims were checked
+
+
+def test_forces_free_along_a_narrow_step_are_never_claimed_unique() -> None:
+    """Two rolling contacts give four force coordinates against three equations: the forces may vary, and the per-point
+    solve says they are indeterminate, but from Lemke's forces a step along the free direction is narrow (a cone edge
+    stops it), so the batch cannot show it: it must leave the point to the per-point solve, not call it unique
+    (found by the slow cross-check's random scene 45)."""
+    from quasistatic.solvers.batched import certify_stack
+
+    data = json.loads((ROOT / "tests" / "data" / "batch_narrow_free_forces.json").read_text())
+    scene = _scene(data)
+    solution = solve(scene, **OPTIONS)
+    assert solution.status == "solved" and solution.forces_indeterminate
+    batch = certify_stack(assemble_stack(PlanarStack.tiled(scene, 1)))
+    assert not batch.decided[0] or batch.indeterminate[0]

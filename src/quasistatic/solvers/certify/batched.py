@@ -76,7 +76,6 @@ def certify_batch(laws: StackedLaws) -> BatchedMotions:
     c = np.stack([beta[..., 0] - beta[..., 1], cn], axis=-1)  # as LCPForm.forces: the edges +1 and -1
     if decided.any():
         unique, indeterminate = _force_claims(laws, q, c)
-        unique, indeterminate = _force_claims(laws, q, c)
     return BatchedMotions(decided & (unique | indeterminate), q, c, indeterminate)
 
 
@@ -321,31 +320,19 @@ def _force_claims(laws: StackedLaws, q: np.ndarray, c: np.ndarray) -> tuple[np.n
     sliding = closed & (np.abs(u_t) > MOVING) & frictional
     single = ~frictional | sliding
     tilt = np.where(sliding, -laws.mu * np.sign(u_t), 0.0)
-    one = Jn + tilt[..., None] * Jt  # (N, m, 3)
+    one = Jn + tilt[..., None] * Jt  # (N, m, 3): a frictionless or sliding contact's one force direction
     clear = _clear(u_n, MOVING) & _clear(u_t, MOVING)
     unique, indeterminate = np.zeros(clear.size, dtype=bool), np.zeros(clear.size, dtype=bool)
     m = Jn.shape[1]
     patterns = np.concatenate((closed, single), axis=1)
     for pattern in np.unique(patterns[clear], axis=0):
         members = np.flatnonzero(clear & (patterns == pattern).all(axis=1))
-        shut, alone = pattern[:m], pattern[m:]
-        contacts = np.flatnonzero(shut)
+        contacts, alone = np.flatnonzero(pattern[:m]), pattern[m:]
         if not contacts.size:
             unique[members] = True  # no closed contact: no force at all
             continue
-        columns: list[np.ndarray] = []
-        normal_at: list[int] = []
-        tangent_at: list[int] = []
-        for i in contacts.tolist():  # in contact order, as the per-point columns
-            if alone[i]:
-                normal_at.append(len(columns))
-                tangent_at.append(-1)
-                columns.append(one[members, i])
-            else:
-                tangent_at.append(len(columns))
-                normal_at.append(len(columns) + 1)
-                columns += [Jt[members, i], Jn[members, i]]
-        wrenches = np.stack(columns, axis=2)  # (k, 3, f)
+        layout = _ForceLayout.of(contacts, alone)
+        wrenches = layout.wrenches({"t": Jt, "n": Jn, "one": one}, members)  # (k, 3, f) wrench maps
         sigma = np.linalg.svd(wrenches, compute_uv=False)
         settled = _clear(sigma, FORCE_RANK)
         full = (sigma > FORCE_RANK).all(axis=1) & (wrenches.shape[2] <= 3)
@@ -354,10 +341,41 @@ def _force_claims(laws: StackedLaws, q: np.ndarray, c: np.ndarray) -> tuple[np.n
         if loose.size:
             picked = members[loose]
             _, sigma, vt = np.linalg.svd(wrenches[loose])
-            cone = _cones(contacts, alone, laws.mu[picked], normal_at, tangent_at)
-            x = _coordinates(c[picked], contacts, normal_at, tangent_at, wrenches.shape[2])
+            cone = _cones(contacts, alone, laws.mu[picked], layout.normal_at, layout.tangent_at)
+            x = _coordinates(c[picked], contacts, layout.normal_at, layout.tangent_at, wrenches.shape[2])
             indeterminate[picked] = _wide(wrenches[loose], laws.g[picked], sigma, vt, x, cone)
     return unique, indeterminate
+
+
+@dataclass(frozen=True)
+class _ForceLayout:
+    """The closed contacts' force coordinates in the per-point code's column order: each contact's tangent then normal
+    coordinate, or its one tilted normal (``columns``: ``("t" | "n" | "one", contact)``), and where each contact's normal
+    and tangent coordinates sit (``tangent_at`` -1 for a single coordinate)."""
+
+    columns: tuple[tuple[str, int], ...]
+    normal_at: list[int]
+    tangent_at: list[int]
+
+    @staticmethod
+    def of(contacts: np.ndarray, alone: np.ndarray) -> _ForceLayout:
+        columns: list[tuple[str, int]] = []
+        normal_at: list[int] = []
+        tangent_at: list[int] = []
+        for i in contacts.tolist():  # in contact order, as the per-point columns
+            if alone[i]:
+                normal_at.append(len(columns))
+                tangent_at.append(-1)
+                columns.append(("one", i))
+            else:
+                tangent_at.append(len(columns))
+                normal_at.append(len(columns) + 1)
+                columns += [("t", i), ("n", i)]
+        return _ForceLayout(tuple(columns), normal_at, tangent_at)
+
+    def wrenches(self, rows: dict[str, np.ndarray], members: np.ndarray) -> np.ndarray:
+        """The wrench map of ``members`` (k, 3, f): each coordinate's column from ``rows`` (N, m, 3) by its kind."""
+        return np.stack([rows[kind][members, i] for kind, i in self.columns], axis=2)
 
 
 def _wide(wrenches: np.ndarray, g: np.ndarray, sigma: np.ndarray, vt: np.ndarray, x: np.ndarray, cone: _Cones) -> np.ndarray:
