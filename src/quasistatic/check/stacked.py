@@ -79,8 +79,7 @@ def _contact_sums(stack: PlanarStack, twists: FloatArray, forces: FloatArray) ->
     offset = stack.point - stack.origin
     spin = stack.twist[..., 2]
     mover = np.stack([stack.twist[..., 0] - spin * offset[..., 1], stack.twist[..., 1] + spin * offset[..., 0]], axis=-1)
-    loads = stack.wrench.copy()
-    loads[:, :2] += stack.mass[:, None] * stack.gravity
+    loads = stack.loads()
     vx, vy, w = twists[:, 0], twists[:, 1], twists[:, 2]
     zeros = [np.zeros(stack.size) for _ in range(7)]
     sums = _Sums(loads, [loads[:, 0].copy(), loads[:, 1].copy(), loads[:, 2].copy()], *zeros, *(np.empty(stack.mu.shape) for _ in range(2)))

@@ -61,7 +61,8 @@ def assemble_stack(stack: PlanarStack) -> StackedLaws | None:
     """The laws of every point; None when some point's scales need the rule for coincident points (then each point
     is assembled alone)."""
     velocities = _mover_velocities(stack)
-    scales = _scales(stack, velocities)
+    load = stack.loads()
+    scales = _scales(stack, velocities, load)
     if scales is None:
         return None
     origin, L, F, V = scales
@@ -76,8 +77,6 @@ def assemble_stack(stack: PlanarStack) -> StackedLaws | None:
     rows[..., 2] = arms[..., None, 0] * frames[..., 1] - arms[..., None, 1] * frames[..., 0]
     J = 0.0 + rows  # assemble adds each block into zeros
     b = (frames[..., 0] * velocities[..., None, 0] + frames[..., 1] * velocities[..., None, 1]) / V[:, None, None]
-    load = stack.wrench.copy()
-    load[:, :2] += stack.mass[:, None] * stack.gravity
     units = np.stack([F, F, F * L], axis=1)
     return StackedLaws(stack, frames, J, b, load / units, stack.mu.copy(), L, F, V)
 
@@ -92,7 +91,7 @@ def _mover_velocities(stack: PlanarStack) -> FloatArray:
     return 0.0 + twist[..., :2] + spin
 
 
-def _scales(stack: PlanarStack, velocities: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None:
+def _scales(stack: PlanarStack, velocities: FloatArray, load: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None:
     """Origin, length, force and velocity of each point, as ``scene_scales``: the contact points and the com, their
     sums in order (as NumPy adds a column, and the few-point rule in Python floats)."""
     places = np.concatenate((stack.point, stack.com[:, None, :]), axis=1)  # (N, m + 1, 2): contacts, then the body
@@ -104,8 +103,6 @@ def _scales(stack: PlanarStack, velocities: FloatArray) -> tuple[FloatArray, Flo
     length = np.sqrt((offset[..., 0] * offset[..., 0] + offset[..., 1] * offset[..., 1]).max(axis=1))
     if not (length > 0.0).all():
         return None
-    load = stack.wrench.copy()
-    load[:, :2] += stack.mass[:, None] * stack.gravity
     linear = np.maximum(0.0, np.sqrt(load[:, 0] * load[:, 0] + load[:, 1] * load[:, 1]))
     angular = np.maximum(0.0, np.sqrt(load[:, 2] * load[:, 2]))
     force = np.maximum(linear, angular / length)

@@ -8,7 +8,7 @@ each read them their own way, as they read a Scene, without a Scene per point.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -56,6 +56,17 @@ class PlanarStack:
     def size(self) -> int:
         """Points in the stack."""
         return int(self.mu.shape[0])
+
+    def loads(self) -> FloatArray:
+        """Gravity plus applied wrench on the body, about its com (N, 3), as :meth:`Scene.load` adds them."""
+        load = self.wrench.copy()
+        load[:, :2] += self.mass[:, None] * self.gravity
+        return load
+
+    def taken(self, members: np.ndarray) -> PlanarStack:
+        """The stack of the points ``members`` (indices) only."""
+        arrays = {f.name: getattr(self, f.name)[members] for f in fields(self) if f.name != "scene"}
+        return PlanarStack(self.scene, **arrays)
 
     @classmethod
     def tiled(cls, scene: Scene, count: int) -> PlanarStack:

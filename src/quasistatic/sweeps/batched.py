@@ -56,7 +56,7 @@ def batched_points(scenes: PointScenes, tasks: Sequence[Task], options: Mapping[
         members = np.flatnonzero(valid & (frictional == mask).all(axis=1))
         for start in range(0, members.size, BATCH_POINTS):  # bounded arrays, whatever the chunk's size
             part = members[start : start + BATCH_POINTS]
-            answers += _decided(_taken(stack, part), part, tolerance)
+            answers += _decided(stack.taken(part), part, tolerance)
     seconds = (time.perf_counter() - started) / max(len(answers), 1)  # a batched point's share of the batch's time
     body = scenes.base.bodies[0].name
     return {answer.position: answer.record(tasks[answer.position], body, seconds) for answer in answers}
@@ -159,11 +159,6 @@ def _valid(values: np.ndarray, setters: list[_Setter]) -> np.ndarray:
         if "mass" in kinds:
             valid &= values[:, column] >= 0.0
     return valid
-
-
-def _taken(stack: PlanarStack, members: np.ndarray) -> PlanarStack:
-    arrays = (stack.point, stack.normal, stack.mu, stack.mass, stack.com, stack.wrench, stack.gravity, stack.twist, stack.origin)
-    return PlanarStack(stack.scene, *(a[members] for a in arrays))
 
 
 def _decided(stack: PlanarStack, positions: np.ndarray, tolerance: float) -> list[_Answer]:

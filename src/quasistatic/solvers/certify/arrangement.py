@@ -160,6 +160,7 @@ __all__ = [
     "EDGE_BITS",
     "CLAIM_LOOSENESS",
     "CLAIM_REACH",
+    "triple_columns",
 ]
 
 VERTEX_PROOF = (
@@ -353,7 +354,7 @@ class _Vertices:
 
 
 @functools.cache
-def _triples(count: int) -> tuple[np.ndarray, np.ndarray]:
+def triple_columns(count: int) -> tuple[np.ndarray, np.ndarray]:
     """Every triple ``i < j < k`` of ``count`` indices, (T, 3), and the columns of :attr:`_Planes.triple` of its
     adjugate's rows ``n_j x n_k``, ``n_k x n_i``, ``n_i x n_j`` (3, T)."""
     triples = np.array(list(itertools.combinations(range(count), 3)), dtype=np.intp).reshape(-1, 3)
@@ -373,7 +374,7 @@ def _vertices(planes: _Planes) -> _Vertices | None:
     P = rhs.size
     if P < 3:
         return None
-    triples, columns = _triples(P)
+    triples, columns = triple_columns(P)
     det = planes.triple[triples[:, 0], columns[0]]
     independent = np.abs(det) > planes.dependent
     if not independent.all():

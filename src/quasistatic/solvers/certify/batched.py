@@ -25,14 +25,13 @@ does not say which certificate proved it). The cross-checks of ``tests/test_swee
 
 from __future__ import annotations
 
-import functools
-import itertools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ...laws.stacked import StackedLaws
+from ...model.kinematics import cross
 from ...tolerances import (
     ARRANGEMENT_ROUNDOFF,
     BATCH_TIE,
@@ -46,7 +45,7 @@ from ...tolerances import (
 )
 from ..numerics.lcp import PIVOTS_PER_ROW, PLANAR_EDGES, split_lcp_points
 from ..numerics.lemke import SOLUTION
-from .arrangement import CLAIM_LOOSENESS, CLAIM_REACH, EDGE_BITS
+from .arrangement import CLAIM_LOOSENESS, CLAIM_REACH, EDGE_BITS, triple_columns
 
 __all__ = ["BatchedMotions", "certify_batch"]
 
@@ -140,20 +139,6 @@ def _few_closed(laws: StackedLaws, q: np.ndarray) -> np.ndarray:
     return ((np.abs(gap) <= MODE_SPEED).sum(axis=1) <= 3) & _clear(gap, MODE_SPEED)
 
 
-@functools.cache
-def _triples(count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Every triple ``i < j < k`` (T, 3) and the flat pair columns of its adjugate's rows (3, T), as arrangement.py."""
-    triples = np.array(list(itertools.combinations(range(count), 3)), dtype=np.intp).reshape(-1, 3)
-    i, j, k = triples.T
-    return triples, np.stack([j * count + k, k * count + i, i * count + j])
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
-
-
 @dataclass(frozen=True)
 class _Planes:
     """Every point's arrangement (:mod:`.arrangement`'s ``_Planes`` with a leading axis): ``normals`` (N, P, 3),
@@ -179,7 +164,7 @@ def _planes(laws: StackedLaws, points: np.ndarray) -> _Planes:
     Jt, Jn = J[..., 0, :], J[..., 1, :]
     normals = np.concatenate((Jn, Jt[:, frictional]), axis=1)
     N, P = normals.shape[:2]
-    crosses = _cross(normals[:, :, None, :], normals[:, None, :, :]).reshape(N, P * P, 3)
+    crosses = cross(normals[:, :, None, :], normals[:, None, :, :]).reshape(N, P * P, 3)
     triple = np.matmul(normals, crosses.transpose(0, 2, 1))
     longest = np.sqrt((normals * normals).sum(axis=2).max(axis=1))
     rhs = np.concatenate((b[..., 1], b[:, frictional, 0]), axis=1)
@@ -205,7 +190,7 @@ class _Exclusions:
         count = loads.shape[2]
         columns = loads.transpose(0, 2, 1)  # (N, 2m, 3)
         i, j = np.triu_indices(count, 1)
-        normals = _cross(columns[:, i], columns[:, j])
+        normals = cross(columns[:, i], columns[:, j])
         square = (columns * columns).sum(axis=2)
         toward = (columns * -g[:, None, :]).sum(axis=2) / np.maximum(square, 1e-300)
         along = -g[:, None, :] - toward[..., None] * columns
@@ -249,7 +234,7 @@ def _vertex_proof(laws: StackedLaws, q: np.ndarray, todo: np.ndarray) -> np.ndar
     N, P = planes.rhs.shape
     if P < 3:
         return proven
-    triples, columns = _triples(P)
+    triples, columns = triple_columns(P)
     det = planes.triple[:, triples[:, 0], columns[0]]  # (N, T)
     independent = np.abs(det) > planes.dependent[:, None]
     det = np.where(independent, det, 1.0)
