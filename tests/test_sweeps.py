@@ -233,6 +233,14 @@ def test_cli_bad_param_is_one_error_line() -> None:
     assert done.stderr.strip().splitlines() == ["error: contacts[9].mu: contacts has 3 entries; the index must be below 3 (got 9)"]
     done = _run("sweep", BOX, "--param", "contacts[0].mu=0:1")
     assert done.returncode == 2 and done.stderr.startswith("error: --param contacts[0].mu:")
+    # A huge COUNT is refused before its values exist (it once allocated 8 GB and ran on).
+    done = _run("sweep", BOX, "--param", "contacts[0].mu=0:1:1000000000")
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines() == ["error: --param contacts[0].mu: the grid has more than 10,000,000 points (got 1000000000)"]
+    # Ends beyond a float's range: one line, no numpy warning.
+    done = _run("sweep", BOX, "--param", "contacts[0].mu=0:1e400:3")
+    assert done.returncode == 2
+    assert [line[:60] for line in done.stderr.strip().splitlines()] == ["error: contacts[0].mu: the values must be a non-empty 1-D li"]
 
 
 def test_whitney_sweep_stays_above_the_jamming_line() -> None:

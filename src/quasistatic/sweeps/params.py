@@ -139,17 +139,23 @@ def parse_param_spec(text: str) -> tuple[str, np.ndarray]:
     name, sep, spec = text.partition("=")
     if not sep or not name.strip():
         raise SceneError("--param", text, "expected PATH=START:STOP:COUNT or PATH=V1,V2,..., e.g. contacts[2].mu=0:1:101")
+    field = f"--param {name.strip()}"
     try:
         if ":" in spec:
             start, stop, count = spec.split(":")
             number = int(count)
             if number < 1:
                 raise ValueError
-            return name.strip(), np.linspace(float(start), float(stop), number)
+            if number > _MAX_POINTS:  # refused before the values are made: a COUNT of 1e9 would take 8 GB
+                raise OverflowError
+            with np.errstate(all="ignore"):  # ends beyond a float's range: left to the values' finiteness check
+                return name.strip(), np.linspace(float(start), float(stop), number)
         return name.strip(), np.array([float(v) for v in spec.split(",")])
+    except OverflowError:
+        raise SceneError(field, number, f"the grid has more than {_MAX_POINTS:,} points") from None
     except ValueError:
         reason = "values must be START:STOP:COUNT (COUNT an integer >= 1) or numbers separated by commas"
-        raise SceneError(f"--param {name.strip()}", spec, reason) from None
+        raise SceneError(field, spec, reason) from None
 
 
 def _param(data: Mapping[str, Any], name: str, values: Any) -> SweepParam:
