@@ -23,7 +23,6 @@ LEAVES = {
     "quasistatic.solution",
     "quasistatic.stdio",
     "quasistatic.compiled",
-    "quasistatic._lemke",  # the C extension quasistatic.compiled wraps: compiled code, it imports nothing of the package
 }
 
 # Stage -> the stages it may import (besides itself and the leaves).

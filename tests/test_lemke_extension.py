@@ -23,6 +23,7 @@ import pytest
 import quasistatic as qs
 from quasistatic import compiled
 from quasistatic.jit import HAVE_NUMBA
+from quasistatic.laws import fixed_modes
 from quasistatic.solvers.numerics import lcp
 from quasistatic.solvers.numerics import lemke as lemke_module
 from quasistatic.solvers.numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION, lemke
@@ -209,3 +210,47 @@ def test_without_numba_the_default_install_runs_the_extension() -> None:
         """
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+# --------------------------------------------------------------------------- the fixed-mode laws in C
+
+
+def _laws_cases() -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]]:
+    """Bench scenes (2-D and 3-D, frictional and frictionless contacts) at random modes and random unknowns."""
+    rng = np.random.default_rng(8)
+    for family, size in (("grasp-2d", 4), ("grasp-3d", 4), ("grasp-3d", 8), ("box-push", 4), ("box-push-nf", 4)):
+        data = qs.assemble(FAMILIES[family].make(size, 0)).derived("fast", lcp.LemkeInputs)
+        m, d, n = data.J.shape
+        for trial in range(8):
+            kind = rng.integers(0, 3, m).astype(np.int64)  # separating, rolling and sliding mixed
+            if trial == 0:
+                kind[:] = fixed_modes.SLIDING
+            column, unknowns = fixed_modes.columns(kind, n, d - 1)
+            x = rng.normal(size=unknowns)
+            if trial == 1:
+                x[:n] = np.linalg.lstsq(data.J[:, :-1].reshape(-1, n), data.b[:, :-1].ravel(), rcond=None)[0]  # slips near zero
+            yield data.J, data.b, data.mu, data.g, x, kind, column, n
+
+
+@needs_extension
+def test_the_extensions_fixed_mode_laws_are_the_kernels() -> None:
+    """Residual, Jacobian and forces as the kernel gives them (the same loops: equal to round-off, in practice to the bit)."""
+    reference = fixed_modes.system if HAVE_NUMBA else fixed_modes._system_numpy
+    for case in _laws_cases():
+        for got, want in zip(compiled.fixed_mode_system(*case), reference(*case), strict=True):
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-14)
+
+
+@needs_extension
+def test_the_extensions_fixed_mode_laws_check_their_arrays() -> None:
+    J, b, mu, g, x, kind, column, n = next(_laws_cases())
+    with pytest.raises(ValueError, match="J must have shape"):
+        compiled.fixed_mode_system(J[0], b, mu, g, x, kind, column, n)
+    with pytest.raises(ValueError, match=r"b must have shape"):
+        compiled.fixed_mode_system(J, b[:-1], mu, g, x, kind, column, n)
+    with pytest.raises(ValueError, match="J must have shape"):
+        compiled.fixed_mode_system(J, b, mu, g, x, kind, column, n + 1)
+    with pytest.raises(ValueError, match="outside x"):
+        compiled.fixed_mode_system(J, b, mu, g, x[: n + 1], np.full_like(kind, fixed_modes.ROLLING), column, n)
+    with pytest.raises(ValueError, match="is not 0, 1 or 2"):
+        compiled.fixed_mode_system(J, b, mu, g, x, np.full_like(kind, 7), column, n)

@@ -1,23 +1,27 @@
-"""The compiled extension ``quasistatic._lemke``: Lemke's method in C, for installs without numba.
+"""The compiled extension ``quasistatic._lemke``: Lemke's method and the fixed-mode laws in C, for installs without numba.
 
 ``pip install .`` builds it with the machine's C compiler (setuptools only: no
 numpy headers); it is optional, so an install without a compiler still works
 and runs the numpy twin instead. ``HAVE_EXTENSION`` says whether it was built.
-:func:`lemke` takes the arguments of the numba kernel
-(``solvers/numerics/lemke.py::lemke``), makes them C-contiguous float64, and
-returns what the kernel returns; the C code pivots by the kernel's rules.
+:func:`lemke` and :func:`fixed_mode_system` take the arguments of the numba
+kernels ``solvers/numerics/lemke.py::lemke`` and ``laws/fixed_modes.py::system``,
+make them C-contiguous, and return what the kernels return; the C code makes the
+kernels' choices in the kernels' order of arithmetic.
 """
 
 from __future__ import annotations
 
+import importlib
+from typing import Any
+
 import numpy as np
 
-try:
-    import quasistatic._lemke as extension
+try:  # by name: a typed import would make mypy read the whole package from this leaf
+    extension: Any = importlib.import_module("quasistatic._lemke")
 except ImportError:  # built without a C compiler: callers fall back to numpy
     extension = None
 
-__all__ = ["HAVE_EXTENSION", "lemke"]
+__all__ = ["HAVE_EXTENSION", "lemke", "fixed_mode_system"]
 
 HAVE_EXTENSION = extension is not None
 
@@ -51,3 +55,31 @@ def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: flo
         basis,
     )
     return status, z, pivots, basis
+
+
+def fixed_mode_system(
+    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, x: np.ndarray, kind: np.ndarray, column: np.ndarray, n: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The fixed-mode laws in C: residual (N,), Jacobian (N, N) and forces (m, d), as ``laws/fixed_modes.py::system``.
+
+    ``J`` (m, d, n), ``b`` (m, d), ``mu`` (m,), ``g`` (n,), ``x`` (N,), ``kind`` and
+    ``column`` (m,) int as there; ``n`` must be ``J.shape[2]``.
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree, or a contact's kind or column would put its unknowns outside ``x``.
+    """
+    if J.ndim != 3 or J.shape[2] != n:
+        raise ValueError(f"J must have shape (m, d, n) with n = {n}, not {J.shape}")
+    size = x.shape[0]
+    residual, jacobian, forces = np.empty(size), np.empty((size, size)), np.empty(J.shape[:2])
+    extension.fixed_mode_system(
+        *(np.ascontiguousarray(a, np.float64) for a in (J, b, mu, g, x)),
+        np.ascontiguousarray(kind, np.int64),
+        np.ascontiguousarray(column, np.int64),
+        residual,
+        jacobian,
+        forces,
+    )
+    return residual, jacobian, forces

@@ -29,7 +29,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.blas import dger
 
-from ... import compiled
+from ...compiled import HAVE_EXTENSION
+from ...compiled import lemke as compiled_lemke
 from ...jit import njit
 
 __all__ = ["lemke", "SOLUTION", "RAY", "PIVOT_LIMIT", "STATUS_NAMES"]
@@ -148,7 +149,7 @@ def _basic_z_numpy(basis: np.ndarray, xB: np.ndarray) -> np.ndarray:
 
 
 # Without numba: the C extension when it was built, else the numpy twin.
-_PLAIN_LEMKE = compiled.lemke if compiled.HAVE_EXTENSION else _lemke_numpy
+_PLAIN_LEMKE = compiled_lemke if HAVE_EXTENSION else _lemke_numpy
 
 
 @njit(python=_PLAIN_LEMKE)
