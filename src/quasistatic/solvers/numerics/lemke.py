@@ -123,19 +123,28 @@ def _tie_break_numpy(Binv: np.ndarray, col: np.ndarray, rows: np.ndarray, tol: f
     """The column loop of :func:`_ratio_test` in whole-array steps: the same row.
 
     The loop keeps, column by column of ``B^-1``, the rows whose value is within
-    ``tol`` of the smallest; a column where every row is close keeps them all. So
-    only the first column that separates the rows acts: keep its close rows, then
-    look again from the next column (each step drops a row, at most ``rows.size - 1`` steps).
+    ``tol`` of the smallest among the rows still kept. A column where every row is
+    close keeps them all, and while a row attaining the smallest value of all the
+    rows here is still kept, that is the smallest among those kept: so every
+    separating column up to the first where no such row is left is applied at once
+    (a cumulative AND of their masks), then the values are read again from there.
     """
     start = 0
     while rows.size > 1:
         values = Binv[rows, start:] / col[rows, None]
-        close = values <= values.min(axis=0) + tol
+        smallest = values.min(axis=0)
+        close = values <= smallest + tol
         separating = np.flatnonzero(~close.all(axis=0))
-        if separating.size == 0 or not close[:, separating[0]].any():  # no column separates them (or NaN data)
+        if separating.size == 0:
             break
-        rows = rows[close[:, separating[0]]]
-        start += int(separating[0]) + 1
+        kept = np.logical_and.accumulate(close[:, separating], axis=1)  # the rows kept after each separating column
+        kept_before = np.column_stack((np.ones(rows.size, dtype=bool), kept[:, :-1]))
+        exact = ((values[:, separating] == smallest[separating]) & kept_before).any(axis=0)
+        steps = separating.size if exact.all() else int(exact.argmin())
+        if steps == 0:  # nothing attains the smallest value: NaN data
+            break
+        rows = rows[kept[:, steps - 1]]
+        start += int(separating[steps - 1]) + 1
     return int(rows[0])
 
 
