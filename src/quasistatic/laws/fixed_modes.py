@@ -11,7 +11,8 @@ in 3-D, the two edges in 2-D):
 Unknowns ``x``: the twist ``q`` (n), then per closed contact its normal force
 and, when it rolls, its tangential force. The system is square. This module is
 the one place these laws are written (once as loops for numba, once as
-whole-array numpy for plain Python; tests keep the two equal): the fast path's
+whole-array numpy for plain Python, and in C in ``quasistatic._lemke`` for installs
+without numba; tests keep the three equal): the fast path's
 Newton iteration, the exact-cone refinement and the paper method's polish all
 solve it.
 
@@ -25,6 +26,8 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from ..compiled import HAVE_EXTENSION
+from ..compiled import fixed_mode_system as compiled_fixed_mode_system
 from ..jit import njit
 from ..model import FloatArray
 from .assemble import Problem
@@ -116,7 +119,11 @@ def _sliding_friction_numpy(
     jacobian[:n, :n] += (rows * np.repeat(k, tangent.shape[1])[:, None]).T.dot(rows) - (along * k[:, None]).T.dot(along)
 
 
-@njit(python=_system_numpy)
+# Without numba: the C extension's loops when it was built, else the whole-array twin.
+_PLAIN_SYSTEM = compiled_fixed_mode_system if HAVE_EXTENSION else _system_numpy
+
+
+@njit(python=_PLAIN_SYSTEM)
 def system(
     J: FloatArray, b: FloatArray, mu: FloatArray, g: FloatArray, x: FloatArray, kind: IntArray, column: IntArray, n: int
 ) -> tuple[FloatArray, FloatArray, FloatArray]:

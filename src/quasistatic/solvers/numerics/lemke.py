@@ -10,9 +10,11 @@ the ratio test are broken by the lexicographic rule on the rows of
 ``[x_B, B^-1]``, which is equivalent to perturbing ``q`` by ``(eps, eps^2, ...)``
 and so cannot cycle on degenerate problems. The kernel is compiled with numba
 when it is installed; its steps are whole-array numpy operations, which numba
-compiles as fast as loops (measured). Without numba its twin :func:`_lemke_numpy`
-runs instead: the same pivots in fewer, BLAS-backed numpy calls (12 us a pivot
-against the kernel's 33 us as plain Python; 1.5-3 us compiled).
+compiles as fast as loops (measured). Without numba the compiled extension
+``quasistatic._lemke`` (:mod:`quasistatic.compiled`: C by the kernel's rules, built
+by ``pip install .``) runs instead, and where it was not built (no C compiler) the
+whole-array twin :func:`_lemke_numpy`: the same pivots in fewer, BLAS-backed numpy
+calls (12 us a pivot against the kernel's 33 us as plain Python; 1.5-3 us compiled).
 
 Lemke's path from its primary ray ends at a solution of index +1 (``sgn det M_SS``
 of its support) or on a secondary ray, for every covering vector ``d > 0``: an LCP
@@ -27,6 +29,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.blas import dger
 
+from ...compiled import HAVE_EXTENSION
+from ...compiled import lemke as compiled_lemke
 from ...jit import njit
 
 __all__ = ["lemke", "SOLUTION", "RAY", "PIVOT_LIMIT", "STATUS_NAMES"]
@@ -45,8 +49,8 @@ def _lemke_numpy(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, t
     one table ``[B^-1, x_B]`` (Fortran order) updated in place by one BLAS
     rank-one update per pivot (``dger``), keeps the columns of ``-M`` as rows
     (one matrix-vector product per pivot), and settles the ratio test in a few
-    whole-array steps unless two ratios tie (then :func:`_ratio_test` decides,
-    as in the kernel).
+    whole-array steps; where two ratios tie, :func:`_tied_ratio_test_numpy`
+    applies the kernel's rule, its lexicographic tie-break in whole-array steps too.
     """
     n = q.shape[0]
     basis = np.arange(n)
@@ -97,8 +101,51 @@ def _quick_ratio_test(
     theta = ratios[row]
     ratios[row] = np.inf
     if ratios[ratios.argmin()] <= theta + tol * (1.0 + abs(theta)):  # a tie (degenerate step): the kernel's rule decides
-        return _ratio_test(Binv, xB, col, basis, artificial, tol)
+        return _tied_ratio_test_numpy(Binv, xB, col, basis, artificial, tol, pivot_tol)
     return row
+
+
+def _tied_ratio_test_numpy(
+    Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, basis: np.ndarray, artificial: int, tol: float, pivot_tol: float
+) -> int:
+    """:func:`_ratio_test` where ratios tie: the rows within the tie width, ``z0``'s first, else the lexicographic rule."""
+    rows = np.flatnonzero(col > pivot_tol)
+    ratios = xB[rows] / col[rows]
+    theta = ratios.min()
+    rows = rows[ratios <= theta + tol * (1.0 + abs(theta))]
+    artificial_rows = rows[basis[rows] == artificial]
+    if artificial_rows.size > 0:
+        return int(artificial_rows[0])  # z0 can leave: that ends the path at a solution
+    return _tie_break_numpy(Binv, col, rows, tol)
+
+
+def _tie_break_numpy(Binv: np.ndarray, col: np.ndarray, rows: np.ndarray, tol: float) -> int:
+    """The column loop of :func:`_ratio_test` in whole-array steps: the same row.
+
+    The loop keeps, column by column of ``B^-1``, the rows whose value is within
+    ``tol`` of the smallest among the rows still kept. A column where every row is
+    close keeps them all, and while a row attaining the smallest value of all the
+    rows here is still kept, that is the smallest among those kept: so every
+    separating column up to the first where no such row is left is applied at once
+    (a cumulative AND of their masks), then the values are read again from there.
+    """
+    start = 0
+    while rows.size > 1:
+        values = Binv[rows, start:] / col[rows, None]
+        smallest = values.min(axis=0)
+        close = values <= smallest + tol
+        separating = np.flatnonzero(~close.all(axis=0))
+        if separating.size == 0:
+            break
+        kept = np.logical_and.accumulate(close[:, separating], axis=1)  # the rows kept after each separating column
+        kept_before = np.column_stack((np.ones(rows.size, dtype=bool), kept[:, :-1]))
+        exact = ((values[:, separating] == smallest[separating]) & kept_before).any(axis=0)
+        steps = separating.size if exact.all() else int(exact.argmin())
+        if steps == 0:  # nothing attains the smallest value: NaN data
+            break
+        rows = rows[kept[:, steps - 1]]
+        start += int(separating[steps - 1]) + 1
+    return int(rows[0])
 
 
 def _basic_z_numpy(basis: np.ndarray, xB: np.ndarray) -> np.ndarray:
@@ -110,7 +157,11 @@ def _basic_z_numpy(basis: np.ndarray, xB: np.ndarray) -> np.ndarray:
     return z
 
 
-@njit(python=_lemke_numpy)
+# Without numba: the C extension when it was built, else the numpy twin.
+_PLAIN_LEMKE = compiled_lemke if HAVE_EXTENSION else _lemke_numpy
+
+
+@njit(python=_PLAIN_LEMKE)
 def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
     """Solve ``w = M z + q, z >= 0, w >= 0, z . w = 0`` by Lemke's method.
 

@@ -1,0 +1,85 @@
+"""The compiled extension ``quasistatic._lemke``: Lemke's method and the fixed-mode laws in C, for installs without numba.
+
+``pip install .`` builds it with the machine's C compiler (setuptools only: no
+numpy headers); it is optional, so an install without a compiler still works
+and runs the numpy twin instead. ``HAVE_EXTENSION`` says whether it was built.
+:func:`lemke` and :func:`fixed_mode_system` take the arguments of the numba
+kernels ``solvers/numerics/lemke.py::lemke`` and ``laws/fixed_modes.py::system``,
+make them C-contiguous, and return what the kernels return; the C code makes the
+kernels' choices in the kernels' order of arithmetic.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+import numpy as np
+
+try:  # by name: a typed import would make mypy read the whole package from this leaf
+    extension: Any = importlib.import_module("quasistatic._lemke")
+except ImportError:  # built without a C compiler: callers fall back to numpy
+    extension = None
+
+__all__ = ["HAVE_EXTENSION", "lemke", "fixed_mode_system"]
+
+HAVE_EXTENSION = extension is not None
+
+
+def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
+    """Lemke's method in C: ``(status, z, pivots, basis)`` as ``solvers/numerics/lemke.py::lemke`` returns them.
+
+    Parameters
+    ----------
+    M : (n, n) float array
+    q, d : (n,) float arrays
+    max_pivots : int
+    tol : float
+        Pivot tolerance and tie width, as the kernel's [-].
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree (``M`` not ``(n, n)`` or ``d`` not ``(n,)``).
+    """
+    n = q.shape[0]
+    z = np.empty(n)
+    basis = np.empty(n, np.int64)
+    status, pivots = extension.lemke(
+        np.ascontiguousarray(M, np.float64),
+        np.ascontiguousarray(q, np.float64),
+        np.ascontiguousarray(d, np.float64),
+        max_pivots,
+        tol,
+        z,
+        basis,
+    )
+    return status, z, pivots, basis
+
+
+def fixed_mode_system(
+    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, x: np.ndarray, kind: np.ndarray, column: np.ndarray, n: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The fixed-mode laws in C: residual (N,), Jacobian (N, N) and forces (m, d), as ``laws/fixed_modes.py::system``.
+
+    ``J`` (m, d, n), ``b`` (m, d), ``mu`` (m,), ``g`` (n,), ``x`` (N,), ``kind`` and
+    ``column`` (m,) int as there; ``n`` must be ``J.shape[2]``.
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree, or a contact's kind or column would put its unknowns outside ``x``.
+    """
+    if J.ndim != 3 or J.shape[2] != n:
+        raise ValueError(f"J must have shape (m, d, n) with n = {n}, not {J.shape}")
+    size = x.shape[0]
+    residual, jacobian, forces = np.empty(size), np.empty((size, size)), np.empty(J.shape[:2])
+    extension.fixed_mode_system(
+        *(np.ascontiguousarray(a, np.float64) for a in (J, b, mu, g, x)),
+        np.ascontiguousarray(kind, np.int64),
+        np.ascontiguousarray(column, np.int64),
+        residual,
+        jacobian,
+        forces,
+    )
+    return residual, jacobian, forces

@@ -1,0 +1,256 @@
+"""The compiled extension ``quasistatic._lemke``: Lemke's method in C, pivot for pivot the numba kernel's.
+
+It runs wherever numba is missing (the default install), so it must make the
+kernel's choices exactly: the same status, pivot count and final basis, and the
+same point to round-off, on well-posed, degenerate (many ties), ray-ending and
+pivot-limited LCPs, and on the LCPs of the benchmark scenes. The reference is the
+numba kernel when numba is installed, else the numpy twin (itself checked
+against the kernel in ``test_fast.py``).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+
+import quasistatic as qs
+from quasistatic import compiled
+from quasistatic.jit import HAVE_NUMBA
+from quasistatic.laws import fixed_modes
+from quasistatic.solvers.numerics import lcp
+from quasistatic.solvers.numerics import lemke as lemke_module
+from quasistatic.solvers.numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION, lemke
+from quasistatic.tools.bench.families import FAMILIES
+
+TOL = 1e-11
+NO_EXTENSION = "QUASISTATIC_NO_EXTENSION"  # set to 1 where an install without a C compiler is intended
+
+needs_extension = pytest.mark.skipif(not compiled.HAVE_EXTENSION, reason=f"built without the C extension ({NO_EXTENSION} set)")
+REFERENCE: Callable[..., Any] = lemke if HAVE_NUMBA else lemke_module._lemke_numpy
+
+
+def test_the_extension_was_built() -> None:
+    """``pip install .`` builds ``quasistatic._lemke`` wherever a C compiler and the Python headers exist.
+
+    The build is optional (a machine without a compiler still installs, and runs
+    the slower numpy twin), so a broken build would pass silently; this test makes
+    it loud. It requires the extension unless the environment variable
+    ``QUASISTATIC_NO_EXTENSION=1`` says a compiler-less install is intended.
+    """
+    if os.environ.get(NO_EXTENSION) == "1":
+        pytest.skip(f"{NO_EXTENSION}=1: an install without the C extension is intended")
+    assert compiled.HAVE_EXTENSION, "quasistatic._lemke did not build: is there a C compiler and the Python headers?"
+
+
+def _same_run(got: tuple, want: tuple) -> None:
+    """The same status, pivots and basis, and the same point to round-off."""
+    assert (int(got[0]), int(got[2])) == (int(want[0]), int(want[2]))
+    np.testing.assert_array_equal(got[3], want[3])
+    np.testing.assert_allclose(got[1], want[1], rtol=1e-9, atol=1e-12)
+
+
+def _random_lcps(rng: np.random.Generator, count: int) -> Iterator[tuple[str, np.ndarray, np.ndarray]]:
+    """LCPs of every kind Lemke meets: positive definite, copositive, general, and degenerate integer ones with many ties."""
+    for trial in range(count):
+        n = int(rng.integers(0, 16))
+        A = rng.normal(size=(n, n))
+        kind = ("definite", "copositive", "general", "degenerate")[trial % 4]
+        if kind == "definite":
+            M, q = A @ A.T + 0.1 * np.eye(n), rng.normal(size=n)
+        elif kind == "copositive":
+            M, q = np.abs(A) * (rng.random((n, n)) < 0.5), rng.normal(size=n)
+        elif kind == "general":
+            M, q = A, rng.normal(size=n)
+        else:  # small integers: equal ratios and equal rows of B^-1 at many pivots
+            M = np.round(A)
+            q = np.round(rng.normal(size=n)) * (rng.random(n) < 0.5) - (rng.random(n) < 0.3)
+        yield kind, M, q
+
+
+@needs_extension
+def test_the_extension_pivots_as_the_kernel_on_random_lcps() -> None:
+    rng = np.random.default_rng(3)
+    seen: set[int] = set()
+    for _, M, q in _random_lcps(rng, 400):
+        d = np.ones(q.shape[0])
+        for max_pivots in (1000, 3):
+            want = REFERENCE(M, q, d, max_pivots, TOL)
+            _same_run(compiled.lemke(M, q, d, max_pivots, TOL), want)
+            seen.add(int(want[0]))
+    assert seen == {SOLUTION, RAY, PIVOT_LIMIT}  # every ending was met
+
+
+@needs_extension
+@pytest.mark.parametrize("n", [0, 1])
+def test_the_extension_on_the_smallest_lcps(n: int) -> None:
+    for q in ([], [2.0]) if n == 0 else ([-2.0], [2.0], [0.0]):
+        for M in (np.full((n, n), 3.0), np.full((n, n), -1.0)):
+            args = (M, np.array(q[:n], float), np.full(n, 0.5), 10, TOL)
+            _same_run(compiled.lemke(*args), REFERENCE(*args))
+
+
+def test_the_numpy_twins_tie_break_is_the_kernels() -> None:
+    """The whole-array tie-break (installs without a compiler) keeps the kernel's column loop's row among tied rows."""
+    rng = np.random.default_rng(5)
+    ties = 0
+    for trial in range(150):
+        n = int(rng.integers(2, 12))
+        # small integers (many equal values, so later columns decide) or the identity (the first pivot's ties)
+        Binv = np.eye(n) if trial % 3 == 0 else np.round(rng.normal(size=(n, n)))
+        col = rng.integers(1, 3, n).astype(float)
+        rows = np.flatnonzero(rng.random(n) < 0.7)
+        if rows.size < 2:
+            continue
+        ties += 1
+        xB = np.where(np.isin(np.arange(n), rows), 0.0, 1.0)  # the rows tie at ratio 0, the others are above it
+        want = lemke_module._ratio_test(Binv, xB, col, np.zeros(n, np.int64), 2 * n, TOL)
+        assert lemke_module._tie_break_numpy(Binv, col, rows, TOL) == want
+    assert ties > 100
+
+
+def _bench_lcps() -> Iterator[tuple[str, np.ndarray, np.ndarray]]:
+    """The split-twist LCPs of the benchmark rows where Lemke's method dominates the time."""
+    rows = [("grasp-2d", 2), ("grasp-2d", 4), ("grasp-2d", 8), ("grasp-3d", 4), ("grasp-2d-nf", 8)]
+    rows += [("box-push-nf", 4), ("box-push-nf", 16), ("box-push-nf", 64), ("pile-nf", 10)]
+    for family, size in rows:
+        for instance in range(2):
+            data = qs.assemble(FAMILIES[family].make(size, instance)).derived("fast", lcp.LemkeInputs)
+            Jn, bn, Jt, bt, mu_f = lcp._split_rows(data.J, data.b, data.mu, data.frictional)
+            edges = lcp._edges(data.base, np.zeros(data.frictional.shape[0]), data.J.shape[1] - 1)
+            M, q = lcp._assemble(Jn, Jt, bn, bt, mu_f, data.g, edges, data.frictional)
+            yield f"{family} {size} #{instance}", M, q
+
+
+@needs_extension
+def test_the_extension_pivots_as_the_kernel_on_the_bench_lcps() -> None:
+    for name, M, q in _bench_lcps():
+        d = np.ones(q.shape[0])
+        cap = lcp.PIVOTS_PER_ROW * q.shape[0]
+        got, want = compiled.lemke(M, q, d, cap, TOL), REFERENCE(M, q, d, cap, TOL)
+        assert int(want[2]) > 0, name  # Lemke pivots on every one
+        _same_run(got, want)
+
+
+@needs_extension
+@pytest.mark.parametrize(
+    ("M", "q", "d", "message"),
+    [
+        (np.zeros((3, 2)), -np.ones(3), np.ones(3), r"M must have shape \(3, 3\)"),
+        (np.zeros(9), -np.ones(3), np.ones(3), r"M must have shape \(3, 3\)"),
+        (np.zeros((3, 3)), -np.ones(3), np.ones(2), r"d must have shape \(3,\)"),
+        (np.zeros((3, 3)), -np.ones((3, 1)), np.ones(3), "q must be one-dimensional"),
+    ],
+)
+def test_bad_shapes_raise(M: np.ndarray, q: np.ndarray, d: np.ndarray, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        compiled.lemke(M, q, d, 10, TOL)
+
+
+@needs_extension
+def test_bad_output_buffers_raise() -> None:
+    """The raw entry point checks the buffers it fills: their length, type and layout."""
+    from quasistatic import _lemke  # type: ignore[attr-defined]
+
+    M, q, d = np.eye(3), -np.ones(3), np.ones(3)
+    with pytest.raises(ValueError, match=r"z must have shape \(3,\)"):
+        _lemke.lemke(M, q, d, 10, TOL, np.empty(2), np.empty(3, np.int64))
+    with pytest.raises(ValueError, match="basis must be a C-contiguous int64"):
+        _lemke.lemke(M, q, d, 10, TOL, np.empty(3), np.empty(3, np.int32))
+    with pytest.raises(ValueError):
+        _lemke.lemke(M, q, d, 10, TOL, np.empty(3), np.empty(6, np.int64)[::2])
+    with pytest.raises(ValueError):
+        _lemke.lemke(M, q, d, 10, TOL, np.empty(3)[::-1], np.empty(3, np.int64))
+    frozen = np.empty(3)
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError):
+        _lemke.lemke(M, q, d, 10, TOL, frozen, np.empty(3, np.int64))
+    with pytest.raises(TypeError):
+        _lemke.lemke(M, q, d, 10, TOL, np.empty(3))
+
+
+@needs_extension
+@pytest.mark.parametrize("where", ["M", "q", "d", "all"])
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_nan_and_inf_end_within_the_pivot_limit(where: str, value: float) -> None:
+    """Non-finite data give a meaningless but bounded run (callers audit every answer): no crash, no endless loop."""
+    rng = np.random.default_rng(0)
+    A = rng.normal(size=(6, 6))
+    M, q, d = A @ A.T, -np.ones(6), np.ones(6)
+    if where in ("M", "all"):
+        M[rng.random((6, 6)) < 0.3] = value
+    if where in ("q", "all"):
+        q[1] = value
+    if where in ("d", "all"):
+        d[2] = value
+    status, z, pivots, basis = compiled.lemke(M, q, d, 40, TOL)
+    assert status in (SOLUTION, RAY, PIVOT_LIMIT) and 0 <= pivots <= 40
+    assert z.shape == (6,) and set(basis.tolist()) <= set(range(13))  # w, z or z0 in every row
+
+
+def test_without_numba_the_default_install_runs_the_extension() -> None:
+    """With numba unimportable, ``lemke`` is the extension's wrapper (or, without it, the numpy twin) and solves."""
+    code = textwrap.dedent(
+        """
+        import sys
+        sys.modules["numba"] = None
+        import numpy as np
+        from quasistatic import compiled
+        from quasistatic.solvers.numerics import lemke as module
+        expected = compiled.lemke if compiled.HAVE_EXTENSION else module._lemke_numpy
+        assert module.lemke is expected, module.lemke
+        status, z, pivots, _ = module.lemke(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), np.ones(2), 10, 1e-11)
+        assert status == module.SOLUTION and np.allclose(z, [4 / 3, 7 / 3])
+        """
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+# --------------------------------------------------------------------------- the fixed-mode laws in C
+
+
+def _laws_cases() -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]]:
+    """Bench scenes (2-D and 3-D, frictional and frictionless contacts) at random modes and random unknowns."""
+    rng = np.random.default_rng(8)
+    for family, size in (("grasp-2d", 4), ("grasp-3d", 4), ("grasp-3d", 8), ("box-push", 4), ("box-push-nf", 4)):
+        data = qs.assemble(FAMILIES[family].make(size, 0)).derived("fast", lcp.LemkeInputs)
+        m, d, n = data.J.shape
+        for trial in range(8):
+            kind = rng.integers(0, 3, m).astype(np.int64)  # separating, rolling and sliding mixed
+            if trial == 0:
+                kind[:] = fixed_modes.SLIDING
+            column, unknowns = fixed_modes.columns(kind, n, d - 1)
+            x = rng.normal(size=unknowns)
+            if trial == 1:
+                x[:n] = np.linalg.lstsq(data.J[:, :-1].reshape(-1, n), data.b[:, :-1].ravel(), rcond=None)[0]  # slips near zero
+            yield data.J, data.b, data.mu, data.g, x, kind, column, n
+
+
+@needs_extension
+def test_the_extensions_fixed_mode_laws_are_the_kernels() -> None:
+    """Residual, Jacobian and forces as the kernel gives them (the same loops: equal to round-off, in practice to the bit)."""
+    reference = fixed_modes.system if HAVE_NUMBA else fixed_modes._system_numpy
+    for case in _laws_cases():
+        for got, want in zip(compiled.fixed_mode_system(*case), reference(*case), strict=True):
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-14)
+
+
+@needs_extension
+def test_the_extensions_fixed_mode_laws_check_their_arrays() -> None:
+    J, b, mu, g, x, kind, column, n = next(_laws_cases())
+    with pytest.raises(ValueError, match="J must have shape"):
+        compiled.fixed_mode_system(J[0], b, mu, g, x, kind, column, n)
+    with pytest.raises(ValueError, match=r"b must have shape"):
+        compiled.fixed_mode_system(J, b[:-1], mu, g, x, kind, column, n)
+    with pytest.raises(ValueError, match="J must have shape"):
+        compiled.fixed_mode_system(J, b, mu, g, x, kind, column, n + 1)
+    with pytest.raises(ValueError, match="outside x"):
+        compiled.fixed_mode_system(J, b, mu, g, x[: n + 1], np.full_like(kind, fixed_modes.ROLLING), column, n)
+    with pytest.raises(ValueError, match="is not 0, 1 or 2"):
+        compiled.fixed_mode_system(J, b, mu, g, x, np.full_like(kind, 7), column, n)
