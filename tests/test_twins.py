@@ -9,13 +9,14 @@ values it uses without numba are held to the Jacobi kernel's ranks apart.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
 
 import quasistatic as qs
+from quasistatic.check import audit
 from quasistatic.solvers import lp
 from quasistatic.solvers.numerics.lcp import PIVOTS_PER_ROW
 from quasistatic.tolerances import FORCE_RANK, MODE_SPEED, MOTION_RANK, PIVOT, ZERO
@@ -134,3 +135,71 @@ def test_lemke_pair_twin_equals_the_kernel_on_bench_scenes(family: str) -> None:
             np.testing.assert_allclose(c, want[2], rtol=1e-12, atol=1e-14)
             assert c.min(initial=0.0) >= 0.0
             _assert_same_analysis(analysis, want[3])
+
+
+# --------------------------------------------------------------------------- the audit's kernel
+
+
+def _audit_scenes() -> Iterator[qs.Scene]:
+    """Planar and spatial scenes: mover contacts, contacts between free bodies (the pile), exact cones and pyramids."""
+    for family, size in (("grasp-2d", 4), ("pile", 10), ("grasp-3d", 6), ("box-push", 16)):
+        yield FAMILIES[family].make(size, 1)
+    from quasistatic.tools.bench.families import grasp_3d
+
+    yield grasp_3d(6, 1, friction="pyramid:4")
+
+
+def _kernel_of(scene: qs.Scene) -> Callable[..., tuple[np.ndarray, ...]]:
+    return audit._laws_2d if scene.dimension == 2 else audit._laws_3d
+
+
+def _assert_same_evaluation(got: tuple[np.ndarray, ...], want: tuple[np.ndarray, ...]) -> None:
+    scale = max(1.0, *(float(np.max(np.abs(w), initial=0.0)) for w in want))
+    for g, w in zip(got, want, strict=True):
+        np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-13 * scale)
+
+
+def test_audit_twin_equals_the_kernel() -> None:
+    """Random twists and forces (some contacts sliding past the slide speed, some still), and the rest twist."""
+    rng = np.random.default_rng(17)
+    for scene in _audit_scenes():
+        geometry = audit.AuditGeometry.of(scene)
+        links, contacts, loads, facets, directions = geometry.arrays
+        k = 3 if scene.dimension == 2 else 6
+        for trial in range(6):
+            T = rng.normal(size=(len(scene.bodies), k)) if trial else np.zeros((len(scene.bodies), k))
+            forces = rng.normal(size=(len(scene.contacts), scene.dimension))
+            forces[::3] = 0.0
+            args = (links, contacts, loads, T, forces, facets, directions, geometry.facet_scale, 0.5)
+            _assert_same_evaluation(audit._laws_numpy(*args), _kernel_of(scene)(*args))
+
+
+def test_audit_twin_without_contacts_and_on_values_that_are_not_finite() -> None:
+    """No contacts: only the loads' balance; a NaN force or an infinite twist: a check sum that is not finite."""
+    scene = next(_audit_scenes())
+    links, contacts, loads, facets, directions = audit.AuditGeometry.of(scene).arrays
+    T = np.array([[0.1, -0.2, 0.3]])
+    none = (links[:0], contacts[:0], loads, T, np.zeros((0, 2)), facets, directions, 1.0, 0.5)
+    _assert_same_evaluation(audit._laws_numpy(*none), audit._laws_2d(*none))
+    for bad_twist, bad_force in ((np.inf, 0.0), (0.0, np.nan)):
+        forces = np.ones((len(links), 2))
+        forces[1, 0] += bad_force
+        got = audit._laws_numpy(links, contacts, loads, T + bad_twist, forces, facets, directions, 1.0, 0.5)
+        assert not np.isfinite(got[0][audit._CHECK])
+
+
+def test_many_contacts_are_audited_by_the_twin_without_numba(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Past ``LOOP_CONTACTS`` contacts the audit without numba runs the twin: the same verdict and residuals."""
+    problem = qs.assemble(FAMILIES["box-push-nf"].make(64, 0))
+    assert problem.n_contacts > audit.LOOP_CONTACTS
+    solution = qs.solve(problem, method="lp")
+    geometry = audit.AuditGeometry.of(problem.scene)
+    twists = np.array([solution.twists[name] for name in geometry.names])
+    forces = np.array([contact.force for contact in solution.contacts])
+    want = audit.audit_arrays(geometry, twists, forces, problem.scales)
+    monkeypatch.setattr(audit, "HAVE_NUMBA", False)
+    got = audit.audit_arrays(geometry, twists, forces, problem.scales)
+    assert got[0].passed and want[0].passed
+    for field in ("equilibrium", "cone", "complementarity", "dissipation", "power"):
+        assert getattr(got[0], field) == pytest.approx(getattr(want[0], field), rel=1e-9, abs=1e-15)
+    _assert_same_evaluation((got[2].velocities, got[2].slips, got[2].normal), (want[2].velocities, want[2].slips, want[2].normal))
