@@ -203,3 +203,21 @@ def test_many_contacts_are_audited_by_the_twin_without_numba(monkeypatch: pytest
     for field in ("equilibrium", "cone", "complementarity", "dissipation", "power"):
         assert getattr(got[0], field) == pytest.approx(getattr(want[0], field), rel=1e-9, abs=1e-15)
     _assert_same_evaluation((got[2].velocities, got[2].slips, got[2].normal), (want[2].velocities, want[2].slips, want[2].normal))
+
+
+def test_roundoff_twin_equals_the_kernel() -> None:
+    """Entries within their column's round-off of zero set to 0 in place, others (NaN included) kept."""
+    from quasistatic.check import motion
+
+    rng = np.random.default_rng(19)
+    for rows, cols in ((0, 3), (1, 3), (7, 2), (40, 6)):
+        values = rng.normal(size=(rows, cols)) * 10.0 ** rng.integers(-14, 1, size=(rows, cols))
+        if rows:
+            values[0, 0] = np.nan
+        roundoff = np.full(cols, 1e-9)
+        roundoff[0] = 0.0  # exact zeros only
+        want = motion._drop_roundoff(values.copy(), roundoff)
+        copy = values.copy()
+        got = motion._drop_roundoff_numpy(copy, roundoff)
+        assert got is copy
+        np.testing.assert_array_equal(got, want)
