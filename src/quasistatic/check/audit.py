@@ -222,6 +222,7 @@ def _evaluate(geometry: AuditGeometry, T: np.ndarray, forces: np.ndarray, slide_
     return Evaluation(np.asarray(sums), np.asarray(u), np.asarray(slips), np.asarray(normal))
 
 
+@np.errstate(all="ignore")  # values that are not finite fail by the check sum, as in the loop: no warning
 def _laws_numpy(
     links: np.ndarray,
     contacts: np.ndarray,
@@ -237,28 +238,12 @@ def _laws_numpy(
 
     The same quantities to round-off (sums taken in another order); ``T``'s width (3 or 6) gives the dimension.
     """
-    with np.errstate(all="ignore"):  # values that are not finite fail by the check sum, as in the loop: no warning
-        return _whole_array_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed)
-
-
-def _whole_array_laws(
-    links: np.ndarray,
-    contacts: np.ndarray,
-    loads: np.ndarray,
-    T: np.ndarray,
-    f: np.ndarray,
-    facets: np.ndarray,
-    directions: np.ndarray,
-    facet_scale: float,
-    slide_speed: float,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`_laws_numpy`'s arithmetic."""
     d = 2 if T.shape[1] == 3 else 3
     m, n_bodies = links.shape[0], loads.shape[0]
     body, other = links[:, 0], links[:, 1]
     arms = contacts[:, d * d : d * d + 2 * d].reshape(m, 2, d)  # to the point from the body's and the other's com
     mover, mu = contacts[:, d * d + 2 * d : d * d + 3 * d], contacts[:, -1]
-    # incidence (bodies, m): +1 where a contact acts on the body, -1 where on the other free body
+    # incidences (bodies, m): 1 where a contact has the body as its ``body`` (``other``); a mover is no row
     on_body = (body == np.arange(n_bodies)[:, None]).astype(float)
     on_other = (other == np.arange(n_bodies)[:, None]).astype(float)
     u = _point_velocities(T[body], arms[:, 0], d) - _point_velocities(on_other.T @ T, arms[:, 1], d) - mover
