@@ -13,7 +13,8 @@ data (points, normals, frames, moment arms, mover velocities, loads) is read
 once into flat arrays (:class:`AuditGeometry`, which a caller may keep and
 pass again for the same scene), and the laws are checked contact by
 contact in one scalar loop per dimension, compiled by numba when it is
-installed (without numba the same loop runs as plain Python on nested lists).
+installed (without numba the same loop runs as plain Python on nested lists, and
+beyond ``LOOP_CONTACTS`` contacts its whole-array twin :func:`_laws_numpy` runs instead).
 The loop also returns what a report needs per contact (relative velocity,
 slip, normal velocity and force), so nothing is computed twice.
 """
@@ -43,6 +44,7 @@ __all__ = [
 ]
 
 DEFAULT_TOLERANCE = AUDIT
+LOOP_CONTACTS = 24  # without numba: most contacts audited by the scalar loop (beyond: numpy; measured crossover 20-30)
 
 
 @dataclass(frozen=True)
@@ -206,11 +208,11 @@ def _evaluate(geometry: AuditGeometry, T: np.ndarray, forces: np.ndarray, slide_
     """Run the law kernel on twists ``T`` (bodies, k) and world forces ``forces`` (m, d), physical units."""
     T = np.ascontiguousarray(T, dtype=float)
     forces = np.ascontiguousarray(forces, dtype=float)
-    if HAVE_NUMBA:
-        arrays = geometry.arrays
-        kernel = _laws_2d if geometry.dimension == 2 else _laws_3d
+    arrays = geometry.arrays
+    if HAVE_NUMBA or len(arrays[0]) > LOOP_CONTACTS:
+        kernel = (_laws_2d if geometry.dimension == 2 else _laws_3d) if HAVE_NUMBA else _laws_numpy
         return Evaluation(*kernel(arrays[0], arrays[1], arrays[2], T, forces, arrays[3], arrays[4], geometry.facet_scale, slide_speed))
-    # Plain Python: the same kernel reads nested lists faster than numpy scalars.
+    # Plain Python, few contacts: the kernel's loop on nested lists beats the ~60 calls of its whole-array twin.
     kernel = _laws_2d if geometry.dimension == 2 else _laws_3d
     lists = geometry.lists
     assert lists is not None
@@ -218,6 +220,81 @@ def _evaluate(geometry: AuditGeometry, T: np.ndarray, forces: np.ndarray, slide_
         lists[0], lists[1], lists[2], T.tolist(), forces.tolist(), lists[3], lists[4], geometry.facet_scale, slide_speed
     )
     return Evaluation(np.asarray(sums), np.asarray(u), np.asarray(slips), np.asarray(normal))
+
+
+@np.errstate(all="ignore")  # values that are not finite fail by the check sum, as in the loop: no warning
+def _laws_numpy(
+    links: np.ndarray,
+    contacts: np.ndarray,
+    loads: np.ndarray,
+    T: np.ndarray,
+    f: np.ndarray,
+    facets: np.ndarray,
+    directions: np.ndarray,
+    facet_scale: float,
+    slide_speed: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_laws_2d` and :func:`_laws_3d` in whole-array numpy calls (without numba, on many contacts).
+
+    The same quantities to round-off (sums taken in another order); ``T``'s width (3 or 6) gives the dimension.
+    """
+    d = 2 if T.shape[1] == 3 else 3
+    m, n_bodies = links.shape[0], loads.shape[0]
+    body, other = links[:, 0], links[:, 1]
+    arms = contacts[:, d * d : d * d + 2 * d].reshape(m, 2, d)  # to the point from the body's and the other's com
+    mover, mu = contacts[:, d * d + 2 * d : d * d + 3 * d], contacts[:, -1]
+    # incidences (bodies, m): 1 where a contact has the body as its ``body`` (``other``); a mover is no row
+    on_body = (body == np.arange(n_bodies)[:, None]).astype(float)
+    on_other = (other == np.arange(n_bodies)[:, None]).astype(float)
+    u = _point_velocities(T[body], arms[:, 0], d) - _point_velocities(on_other.T @ T, arms[:, 1], d) - mover
+    # frame rows (normal, tangents) against forces and velocities: (m, d, 2)
+    local = contacts[:, : d * d].reshape(m, d, d) @ np.stack((f, u), axis=2)
+    f_n, u_n, f_t, u_t = local[:, 0, 0], local[:, 0, 1], local[:, 1:, 0], local[:, 1:, 1]
+    radius = mu * np.maximum(f_n, 0.0)
+    sums = np.zeros(11)
+    if len(facets) > 0:  # 3-D pyramid: the largest facet excursion, and the support function of the slip
+        outside = (f_t @ facets.T).max(axis=1) - radius * facet_scale
+        support = (-(u_t @ directions.T)).max(axis=1)
+    else:
+        outside = np.sqrt((f_t * f_t).sum(axis=1)) - radius
+        support = np.sqrt((u_t * u_t).sum(axis=1))
+        sliding = support > slide_speed
+        if d == 3 and sliding.any():  # sliding: the friction must be -mu f_n slip/|slip| exactly
+            e = f_t[sliding] + (radius[sliding] / support[sliding])[:, None] * u_t[sliding]
+            sums[_MISALIGN] = np.sqrt((e * e).sum(axis=1)).max()
+    sums[_CONE] = max(0.0, float(np.concatenate((-f_n, outside)).max(initial=0.0)))
+    sums[_PENETRATION] = (-u_n).max(initial=0.0)
+    sums[_NORMAL_POWER] = np.abs(f_n * u_n).max(initial=0.0)
+    sums[_SHORTFALL] = (radius * support + (f_t * u_t).sum(axis=1)).max(initial=0.0)
+    sums[_SUPPLIED] = (f * mover).sum()
+    sums[_DISSIPATED] = -((f * u).sum() - (f_n * u_n).sum())  # tangential force . slip
+    slips = u - u_n[:, None] * contacts[:, :d]
+    normal = np.column_stack((u_n, np.sqrt((slips * slips).sum(axis=1)), f_n))
+    totals = loads + on_body @ np.hstack((f, _moments(arms[:, 0], f, d))) - on_other @ np.hstack((f, _moments(arms[:, 1], f, d)))
+    raised = -float((loads * T).sum())
+    sums[_LINEAR] = np.abs(totals[:, :d]).max(initial=0.0)
+    sums[_ANGULAR] = np.abs(totals[:, d:]).max(initial=0.0)
+    sums[_RAISED] = raised
+    sums[_CHECK] = f.sum() + u.sum() + totals.sum() + raised
+    return sums, u, slips, normal
+
+
+_NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])  # cross products by columns: (a x b)_i = a_{i+1} b_{i+2} - a_{i+2} b_{i+1}
+
+
+def _point_velocities(T: np.ndarray, arms: np.ndarray, d: int) -> np.ndarray:
+    """Velocities (m, d) of the points at ``arms`` from their bodies' coms, for twists ``T`` (m, 3 or 6)."""
+    if d == 2:
+        return T[:, :2] + T[:, 2:3] * arms[:, ::-1] * np.array([-1.0, 1.0])
+    w = T[:, 3:]
+    return T[:, :3] + w[:, _NEXT] * arms[:, _AFTER] - w[:, _AFTER] * arms[:, _NEXT]
+
+
+def _moments(arms: np.ndarray, f: np.ndarray, d: int) -> np.ndarray:
+    """Moments (m, 1 or 3) of forces ``f`` (m, d) applied at ``arms`` from the coms."""
+    if d == 2:
+        return arms[:, :1] * f[:, 1:] - arms[:, 1:] * f[:, :1]
+    return arms[:, _NEXT] * f[:, _AFTER] - arms[:, _AFTER] * f[:, _NEXT]
 
 
 @njit

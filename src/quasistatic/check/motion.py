@@ -106,7 +106,13 @@ def audited_motion(
     )
 
 
-@njit
+def _drop_roundoff_numpy(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray:
+    """:func:`_drop_roundoff` in one numpy call (what runs without numba), in place."""
+    values[np.abs(values) <= roundoff] = 0.0
+    return values
+
+
+@njit(python=_drop_roundoff_numpy)
 def _drop_roundoff(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray:
     """``values`` (rows, c) with entries within ``roundoff[j]`` of zero set to 0, in place (one compiled loop: small arrays)."""
     for i in range(values.shape[0]):

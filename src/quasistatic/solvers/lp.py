@@ -93,7 +93,31 @@ class _Frictionless:
         self.lemke = 2 * problem.n_dof + problem.n_contacts <= LEMKE_MAX_ROWS
 
 
-@njit
+def _lemke_pair_numpy(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    frictional: np.ndarray,
+    base: np.ndarray,
+    Jn: np.ndarray,
+    bn: np.ndarray,
+    mode_tol: float,
+    pivot_tol: float,
+    pivots_per_row: int,
+    zero: float,
+    motion_rank: float,
+    force_rank: float,
+) -> tuple[int, np.ndarray, np.ndarray, tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, int]]:
+    """:func:`_lemke_pair` in whole-array numpy calls (what runs without numba)."""
+    status, _, q, c, _, _ = solve_split_lcp(J, b, mu, g, frictional, base, False, 0, 0.0, mode_tol, pivot_tol, 0.0, pivots_per_row)
+    normal = c[:, -1].copy()
+    analysis = _analyse(Jn, bn, g, q, normal, zero, motion_rank, force_rank)
+    c[:, -1] = np.maximum(normal, 0.0)
+    return status, q, c, analysis
+
+
+@njit(python=_lemke_pair_numpy)
 def _lemke_pair(
     J: np.ndarray,
     b: np.ndarray,
@@ -124,7 +148,35 @@ def _lemke_pair(
     return status, q, c, analysis
 
 
-@njit
+def _analyse_numpy(
+    Jn: np.ndarray, bn: np.ndarray, g: np.ndarray, q: np.ndarray, forces: np.ndarray, zero: float, motion_rank: float, force_rank: float
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, int]:
+    """:func:`_analyse` in whole-array numpy calls (what runs without numba): the same verdicts, residuals to round-off."""
+    n = Jn.shape[1]
+    finite = bool(np.isfinite(q).all() and np.isfinite(forces).all())
+    if finite:
+        slack = Jn @ q - bn
+    else:
+        with np.errstate(invalid="ignore", over="ignore"):  # a pair that is not finite is reported as such, not warned about
+            slack = Jn @ q - bn
+    support = forces > zero
+    closed = slack <= zero
+    tight = closed & ~support
+    if not (finite and np.isfinite(slack).all()):
+        return np.inf, slack, support, tight, closed, 0, 0
+    imbalance = g + Jn.T @ forces
+    residual = float(np.concatenate((-slack, -forces, np.abs(forces * slack), np.abs(imbalance))).max(initial=0.0))
+    k = int(np.count_nonzero(closed))
+    forces_unique = 1 if k == 0 else (0 if k > n else _full_rank(Jn[closed], force_rank, k))
+    n_support = int(np.count_nonzero(support))
+    if forces_unique == 1 and not np.any(support & ~closed):  # supporting rows among independent closed ones
+        motion_unique = int(n_support == n)
+    else:
+        motion_unique = 0 if n_support < n else _full_rank(Jn[support], motion_rank, n)
+    return residual, slack, support, tight, closed, motion_unique, forces_unique
+
+
+@njit(python=_analyse_numpy)
 def _analyse(
     Jn: np.ndarray, bn: np.ndarray, g: np.ndarray, q: np.ndarray, forces: np.ndarray, zero: float, motion_rank: float, force_rank: float
 ) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, int]:
@@ -181,7 +233,13 @@ def _full_rank(A: np.ndarray, tol: float, rank: int) -> int:
     return int(np.sum(_singular_values(A) > tol) == rank)
 
 
-@njit
+def _singular_values_numpy(A: np.ndarray) -> np.ndarray:
+    """:func:`_singular_values` by LAPACK (what runs without numba: one call, where the rotations in Python loops cost
+    milliseconds); sorted, largest first. Below ``JACOBI_MAX`` columns OpenBLAS runs it on one thread whatever its setting."""
+    return np.linalg.svd(A, compute_uv=False)
+
+
+@njit(python=_singular_values_numpy)
 def _singular_values(A: np.ndarray) -> np.ndarray:
     """Singular values of a small matrix by one-sided Jacobi rotations (Hestenes), unsorted.
 
