@@ -584,11 +584,13 @@ def farkas_excludes(forces: ForcesAtTwist, g: np.ndarray) -> bool:
 
     Every point the LP may return (each of its rows met to ``LP_FEASIBILITY``, columns down to
     ``-LP_FEASIBILITY``) balances the load ``g`` (n,) within ``margin`` (2-norm) with non-negative weights on
-    the generators of its free columns: per closed contact its normal, and its normal plus ``mu`` times each
-    edge it may use (``cn`` times a convex combination of these is any force with ``sum beta <= mu cn``).
-    Round-off moves the wrench by at most ``LP_FEASIBILITY`` times each column's norm for a column below zero,
-    as much for a held one, and ``K + 2`` times as much for edges past ``mu cn`` (the friction row and the
-    slack's bound), which ``margin`` adds, generously, to the equilibrium rows' own. A non-negative least-squares fit on the generators that
+    the generators of its free columns: per closed contact its normal plus ``mu`` times each edge it may use,
+    and its normal alone unless its slack is held (a sliding contact: ``sum beta = mu cn``); ``cn`` times a
+    convex combination of these is any force the contact's rows allow. Round-off moves the wrench by at most
+    ``LP_FEASIBILITY`` times each column's norm for a column below zero, as much for a held one, ``K + 2``
+    times as much for edges past ``mu cn`` (the friction row and the slack's bound), and, at a sliding
+    contact, its normal's norm over ``mu`` times as much for friction short of ``mu cn``: ``margin`` adds
+    these, generously, to the equilibrium rows' own. A non-negative least-squares fit on the generators that
     misses the load leaves ``y = -(G w + g)``; with ``reserve = -g.y - margin |y| > 0`` and
     ``max(G^T y) FORCE_CEILING < reserve``, no weights of total normal force below :data:`FORCE_CEILING` come
     within ``margin`` of the load (as the mode branch and bound's Farkas vectors).
@@ -596,14 +598,16 @@ def farkas_excludes(forces: ForcesAtTwist, g: np.ndarray) -> bool:
     polytope = forces.polytope
     m, K, n = polytope.m, polytope.K, g.size
     balance = polytope.A[:n].toarray()  # (n, m (K + 2)): the equilibrium rows
-    margin = LP_FEASIBILITY * (np.sqrt(n) + (K + 4) * float(np.linalg.norm(balance, axis=0).sum()))
     normal = balance[:, polytope.normal]
     closed = ~forces.fixed[polytope.normal]
-    free_edges = ~forces.fixed[polytope.beta].reshape(m, K)
+    free_edges = ~forces.fixed[polytope.beta].reshape(m, K) & closed[:, None]
     friction = polytope.A[n:, polytope.normal].diagonal()  # mu per contact (the friction rows' normal entries)
+    on_cone = closed & forces.fixed[polytope.slack] & (friction > 0.0) & free_edges.any(axis=1)
+    shortfall = np.linalg.norm(normal[:, on_cone], axis=0) / friction[on_cone]
+    margin = LP_FEASIBILITY * (np.sqrt(n) + (K + 4) * (float(np.linalg.norm(balance, axis=0).sum()) + float(shortfall.sum())))
+    owners, edges_used = np.nonzero(free_edges)
     edge_columns = balance[:, polytope.beta].reshape(n, m, K)
-    owners, edges_used = np.nonzero(free_edges & closed[:, None])
-    G = np.hstack([normal[:, closed], normal[:, owners] + friction[owners] * edge_columns[:, owners, edges_used]])
+    G = np.hstack([normal[:, closed & ~on_cone], normal[:, owners] + friction[owners] * edge_columns[:, owners, edges_used]])
     if not G.shape[1]:
         y = -g
     else:
