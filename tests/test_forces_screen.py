@@ -19,18 +19,11 @@ from quasistatic.laws import ModeMasks, Problem
 from random_scenes import random_scene
 
 
-def _answer(solution: qs.Solution) -> tuple[object, ...]:
-    """Status, message and every motion's twists, modes and forces, exactly."""
-    motions = solution.solutions or ((solution.motion,) if solution.motion is not None else ())
-    return (
-        solution.status,
-        solution.certified,
-        solution.message,
-        tuple(
-            (tuple(np.concatenate([np.ravel(t) for t in m.twists.values()]).tolist()), m.modes, m.forces_and_slips()[0].tolist())
-            for m in motions
-        ),
-    )
+def _answer(solution: qs.Solution) -> dict[str, object]:
+    """Everything the solution reports (status, message, motions, forces, ranges), but the time it took."""
+    answer = solution.to_dict()
+    del answer["seconds"]
+    return answer
 
 
 @pytest.mark.parametrize("seed", [28, 92])
@@ -69,11 +62,24 @@ def _resting_box(pull: float) -> Problem:
 
 @pytest.mark.parametrize(("pull", "excluded"), [(0.7, True), (0.3, False)])
 def test_screen_decides_only_where_friction_cannot_hold_the_pull(pull: float, excluded: bool) -> None:
-    """At rest (the contact rolling, 64-gon inside the circle of radius 0.5): a pull of 0.7 of the weight leaves
-    every force; one of 0.3 is held, and the screen must not say otherwise."""
+    """At rest (the contact rolling, 64-gon inside the circle of radius 0.5): no force balances a pull of 0.7 of
+    the weight; one of 0.3 is held, and the screen must not say otherwise."""
     problem = _resting_box(pull)
     q = np.zeros(problem.n_dof)
     masks = ModeMasks(np.array([True]), np.array([True]), np.array([False]))
+    edges = forces.aligned_edges(problem, 64, forces.slips(problem, q))
+    assert forces.farkas_excludes(forces.forces_at_twist(problem, edges, q, masks), problem.g) is excluded
+    assert (forces.least_normal_forces(problem, q, masks, 64) is None) is excluded
+
+
+@pytest.mark.parametrize(("pull", "excluded"), [(0.3, True), (0.5, False)])
+def test_screen_holds_a_sliding_contact_to_its_cone(pull: float, excluded: bool) -> None:
+    """Sliding along the pull (+x), friction is exactly 0.5 of the weight against it: a pull of 0.3 cannot be
+    balanced (the normal force alone is no generator of a sliding contact), one of 0.5 is."""
+    problem = _resting_box(pull)
+    q = np.zeros(problem.n_dof)
+    q[0] = 1.0  # the box's velocity along x (scene-relative)
+    masks = ModeMasks(np.array([True]), np.array([False]), np.array([True]))
     edges = forces.aligned_edges(problem, 64, forces.slips(problem, q))
     assert forces.farkas_excludes(forces.forces_at_twist(problem, edges, q, masks), problem.g) is excluded
     assert (forces.least_normal_forces(problem, q, masks, 64) is None) is excluded
