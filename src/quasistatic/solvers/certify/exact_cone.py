@@ -434,7 +434,7 @@ def _inside_cones(problem: Problem, c: np.ndarray, rolling: np.ndarray) -> bool:
 
 def _forces_at(problem: Problem, q: np.ndarray, masks: ModeMasks) -> np.ndarray | None:
     """Least total normal force (m, 3) that balances the load at twist ``q`` with the given modes; None if none does."""
-    return least_normal_forces(problem, q, masks, RANGE_EDGES)
+    return least_normal_forces(problem, q, masks, RANGE_EDGES, screen=True)
 
 
 def _twist_is_free(jacobian: np.ndarray, n_twist: int) -> bool:

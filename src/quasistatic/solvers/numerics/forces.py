@@ -27,7 +27,7 @@ from scipy.optimize import nnls
 
 from ...laws import ForceSet, ModeMasks, Problem, slips
 from ...laws.polyhedral import ForcePolytope, aligned_edges, dense_force_matrix, force_polytope
-from ...tolerances import FORCE_INTERIOR, FORCE_RANK, LP_FEASIBILITY, MOVING, ZERO
+from ...tolerances import FORCE_CEILING, FORCE_INTERIOR, FORCE_RANK, LP_FEASIBILITY, MOVING, ZERO
 from ..result import Range
 from .highs import solve_lp
 from .ranges import Bounds, linear_ranges, null_space, ranges_are_wide, rows_feasible, rows_in_row_space, value_ranges
@@ -43,6 +43,7 @@ __all__ = [
     "indeterminate_forces",
     "measured_forces_at_twist",
     "least_normal_forces",
+    "farkas_excludes",
     "measured_masks",
 ]
 
@@ -559,16 +560,58 @@ def _step(x: np.ndarray, z: np.ndarray) -> float:
     return float(np.min(x[falling] / -z[falling])) if falling.any() else np.inf
 
 
-def least_normal_forces(problem: Problem, q: np.ndarray, masks: ModeMasks, edge_count: int) -> np.ndarray | None:
+def least_normal_forces(problem: Problem, q: np.ndarray, masks: ModeMasks, edge_count: int, screen: bool = False) -> np.ndarray | None:
     """Contact-frame forces (m, d) of least total normal force consistent with twist ``q`` and the modes; None if none.
 
     Edges (``edge_count`` per contact) are turned so one opposes each slip: a
     sliding contact's friction is then exactly ``-mu cn slip/|slip|``, and a
-    rolling one's lies in a polygon inscribed in its exact cone.
+    rolling one's lies in a polygon inscribed in its exact cone. ``screen``: first look for a checked Farkas
+    vector (:func:`farkas_excludes`, one small non-negative fit, dense: for small problems) and answer None
+    without the LP where one excludes every force the LP could return (an infeasible LP costs HiGHS two runs).
     """
     edges = aligned_edges(problem, edge_count, slips(problem, q))
     forces = forces_at_twist(problem, edges, q, masks)
+    if screen and farkas_excludes(forces, problem.g):
+        return None
     cost = np.zeros(forces.fixed.size)
     cost[forces.polytope.normal] = 1.0
     lp = solve_lp(cost, forces.A, forces.rhs, forces.rhs, np.zeros(cost.size))
     return forces.contact_forces(lp.x) if lp.status == "optimal" else None
+
+
+def farkas_excludes(forces: ForcesAtTwist, g: np.ndarray) -> bool:
+    """Whether a checked Farkas vector shows that :func:`least_normal_forces`' LP on ``forces`` has no point.
+
+    Every point the LP may return (each of its rows met to ``LP_FEASIBILITY``, columns down to
+    ``-LP_FEASIBILITY``) balances the load ``g`` (n,) within ``margin`` (2-norm) with non-negative weights on
+    the generators of its free columns: per closed contact its normal plus ``mu`` times each edge it may use,
+    and its normal alone unless its slack is held (a sliding contact: ``sum beta = mu cn``); ``cn`` times a
+    convex combination of these is any force the contact's rows allow. Round-off moves the wrench by at most
+    ``LP_FEASIBILITY`` times each column's norm for a column below zero, as much for a held one, ``K + 2``
+    times as much for edges past ``mu cn`` (the friction row and the slack's bound), and, at a sliding
+    contact, its normal's norm over ``mu`` times as much for friction short of ``mu cn``: ``margin`` adds
+    these, generously, to the equilibrium rows' own. A non-negative least-squares fit on the generators that
+    misses the load leaves ``y = -(G w + g)``; with ``reserve = -g.y - margin |y| > 0`` and
+    ``max(G^T y) FORCE_CEILING < reserve``, no weights of total normal force below :data:`FORCE_CEILING` come
+    within ``margin`` of the load (as the mode branch and bound's Farkas vectors).
+    """
+    polytope = forces.polytope
+    m, K, n = polytope.m, polytope.K, g.size
+    balance = polytope.A[:n].toarray()  # (n, m (K + 2)): the equilibrium rows
+    normal = balance[:, polytope.normal]
+    closed = ~forces.fixed[polytope.normal]
+    free_edges = ~forces.fixed[polytope.beta].reshape(m, K) & closed[:, None]
+    friction = polytope.A[n:, polytope.normal].diagonal()  # mu per contact (the friction rows' normal entries)
+    on_cone = closed & forces.fixed[polytope.slack] & (friction > 0.0) & free_edges.any(axis=1)
+    shortfall = np.linalg.norm(normal[:, on_cone], axis=0) / friction[on_cone]
+    margin = LP_FEASIBILITY * (np.sqrt(n) + (K + 4) * (float(np.linalg.norm(balance, axis=0).sum()) + float(shortfall.sum())))
+    owners, edges_used = np.nonzero(free_edges)
+    edge_columns = balance[:, polytope.beta].reshape(n, m, K)
+    G = np.hstack([normal[:, closed & ~on_cone], normal[:, owners] + friction[owners] * edge_columns[:, owners, edges_used]])
+    if not G.shape[1]:
+        y = -g
+    else:
+        weights, _ = nnls(G, -g)
+        y = -(G @ weights + g)
+    reserve = -float(g @ y) - margin * float(np.linalg.norm(y))
+    return bool(reserve > 0.0 and float(np.max(G.T @ y, initial=0.0)) * FORCE_CEILING < reserve)
