@@ -228,7 +228,7 @@ def test_a_yaml_file_of_a_million_values_is_refused_in_well_under_the_old_ten_se
     counted by a regular expression first, 0.8 s, nearly all of it the process's imports."""
     for command in ("check", "solve"):
         _, elapsed = cli_runs[(case, command)]
-        assert elapsed < 3.0, f"{command}: {elapsed:.1f} s"
+        assert elapsed < FAST, f"{command}: {elapsed:.1f} s"  # wall time, two processes at once: 0.8 s of CPU each
 
 
 @pytest.mark.parametrize("command", ["check", "solve"])
@@ -334,10 +334,10 @@ def test_unexpected_exception_in_main_is_one_line(
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_load_scene_raises_scene_error(case_files: dict[str, Path], case: str) -> None:
     _, field, fragments = CASES[case]
-    started = time.perf_counter()
+    started = time.process_time()
     with pytest.raises(qs.SceneError) as info:
         qs.load_scene(case_files[case])
-    assert time.perf_counter() - started < FAST
+    assert time.process_time() - started < FAST
     assert info.value.field.startswith(field)
     for fragment in fragments:
         assert fragment in str(info.value), (fragment, str(info.value))
@@ -384,10 +384,10 @@ def _self_referencing() -> list[Any]:
 def test_load_scene_of_hostile_data_raises_scene_error(mutate: Callable[[dict[str, Any]], None], field: str, fragment: str) -> None:
     data = good_data()
     mutate(data)
-    started = time.perf_counter()
+    started = time.process_time()
     with pytest.raises(qs.SceneError) as info:
         qs.load_scene(data)
-    assert time.perf_counter() - started < FAST
+    assert time.process_time() - started < FAST
     assert info.value.field.startswith(field), str(info.value)
     assert fragment in str(info.value)
     assert len(str(info.value)) < 400
@@ -395,11 +395,11 @@ def test_load_scene_of_hostile_data_raises_scene_error(mutate: Callable[[dict[st
 
 def test_scene_error_message_is_bounded_whatever_the_value() -> None:
     """The message's repr never materialises the value: 9 ** 30 numbers, a 1e6-character name, a 10 ** 5000 integer."""
-    started = time.perf_counter()
+    started = time.process_time()  # CPU time: a busy machine stretches the wall clock, not this
     for value in (_shared(30), "x" * 1_000_000, 10**5000, _self_referencing(), {"k": _nested(DEEP)}):
         message = str(qs.SceneError("a" * 1000, value, "bad"))
         assert len(message) < 300, message
-    assert time.perf_counter() - started < 1.0
+    assert time.process_time() - started < 1.0
 
 
 # --------------------------------------------------------------------------- fuzzing: hostile text
