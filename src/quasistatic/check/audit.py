@@ -279,7 +279,9 @@ def _laws_numpy(
     return sums, u, slips, normal
 
 
-_NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])  # cross products by columns: (a x b)_i = a_{i+1} b_{i+2} - a_{i+2} b_{i+1}
+# Cross products by columns, (a x b)_i = a_{i+1} b_{i+2} - a_{i+2} b_{i+1}, written out rather than model.kinematics.cross
+# so that v + w x r is summed left to right as the loop kernel sums it (the same rounding).
+_NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
 
 
 def _point_velocities(T: np.ndarray, arms: np.ndarray, d: int) -> np.ndarray:
