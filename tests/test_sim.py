@@ -169,6 +169,13 @@ def test_a_thin_plate_is_not_passed_through_with_a_long_step() -> None:
 # --------------------------------------------------------------------------- the pure step, inputs
 
 
+def test_a_run_that_reaches_the_step_limit_says_so_and_keeps_its_steps() -> None:
+    trajectory = qs.simulate(TIP, duration=1.0, dt=0.25, max_steps=4)  # exactly enough steps of dt, but events bisect them
+    assert trajectory.status == "max_steps", trajectory.message
+    assert "largest number of steps" in trajectory.message
+    assert 0.0 < trajectory.final.time < 1.0 and len(trajectory.steps) == 5  # 4 steps and the final state
+
+
 def test_step_is_pure_and_repeatable() -> None:
     world = qs.load_world(TIP)
     model = SimModel(world, StepOptions(dt=0.1))
@@ -222,6 +229,8 @@ def test_bad_inputs_and_runs_are_refused() -> None:
         InputTable((0.5, 1.0), (Inputs(), Inputs()))
     with pytest.raises(qs.SceneError, match="duration"):
         qs.simulate(TIP, duration=math.nan)
+    with pytest.raises(qs.SceneError, match="max_steps = 3 steps of dt = 0.25 s"):
+        qs.simulate(TIP, duration=1.0, dt=0.25, max_steps=3)
     with pytest.raises(qs.SceneError, match="listed contacts"):
         qs.simulate(qs.load_scene(Path(__file__).resolve().parents[1] / "examples" / "squeeze.yaml"), duration=1.0)
 
@@ -275,6 +284,7 @@ def test_simulate_command_writes_the_trajectory_and_prints_the_events(tmp_path: 
         (["--duration", "1", "--ambiguous", "maybe"], "--ambiguous"),
         (["--duration", "1", "--out", "x.csv"], "--out"),
         (["--duration", "1", "--dt", "0"], "dt"),
+        (["--duration", "1e308"], "max_steps = 100000"),  # would run for minutes to the step limit
     ],
 )
 def test_simulate_command_bad_input_is_one_error_line(args: list[str], words: str) -> None:

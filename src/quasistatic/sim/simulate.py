@@ -76,7 +76,7 @@ def simulate(
         ``failed``) and its message; ``max_steps`` if the step limit was reached first.
     """
     world = _world(scene)
-    _check_run(duration, event_tolerance, max_steps)
+    _check_run(duration, dt, event_tolerance, max_steps)
     model = SimModel(world, StepOptions(dt, ambiguous, method, certify, reuse=reuse))
     tolerance = dt * SIM_EVENT_TIME if event_tolerance is None else event_tolerance
     state = State.of(world)
@@ -111,13 +111,21 @@ def _world(scene: AnyWorld | Scene | str | Path | dict[str, Any]) -> AnyWorld:
     return world
 
 
-def _check_run(duration: float, event_tolerance: float | None, max_steps: int) -> None:
+def _check_run(duration: float, dt: float, event_tolerance: float | None, max_steps: int) -> None:
     if not (math.isfinite(duration) and duration > 0):
         raise SceneError("duration", duration, "must be a positive number of seconds")
     if event_tolerance is not None and not (math.isfinite(event_tolerance) and event_tolerance > 0):
         raise SceneError("event_tolerance", event_tolerance, "must be a positive number of seconds")
     if max_steps < 1:
         raise SceneError("max_steps", max_steps, "must be at least 1")
+    # Steps are never longer than dt, so such a run could only end at the step limit, minutes and
+    # gigabytes later; refused at once instead (dt itself is checked by StepOptions).
+    if math.isfinite(dt) and dt > 0 and duration * (1 - 1e-12) / dt > max_steps:
+        raise SceneError(
+            "duration",
+            duration,
+            f"needs more than max_steps = {max_steps} steps of dt = {dt:g} s; shorten the run or lengthen dt",
+        )
 
 
 def _step_length(current: Evaluation, dt: float, duration: float, inputs: InputSource) -> float:
