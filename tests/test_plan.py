@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -164,7 +165,7 @@ contacts:
 
 
 def _run(*arguments: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(["quasistatic", *arguments], capture_output=True, text=True, timeout=120, check=False)
+    return subprocess.run([str(Path(sys.executable).with_name("quasistatic")), *arguments], capture_output=True, text=True, timeout=120, check=False)
 
 
 def test_the_plan_command_prints_the_plan_as_json(tmp_path: Path) -> None:
