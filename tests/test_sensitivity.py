@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import pickle
 from pathlib import Path
 
@@ -36,6 +37,7 @@ def _central_difference(scene: qs.Scene, j: int, h: float) -> tuple[np.ndarray, 
     return (sides[0][0] - sides[1][0]) / (2 * h), (sides[0][1] - sides[1][1]) / (2 * h)
 
 
+@functools.cache  # several tests check the same scenes; each solve and its sensitivity is worked out once
 def _differentiable(dimension: int, friction: str = "exact") -> list[tuple[qs.Scene, qs.Solution, qs.Sensitivity]]:
     found = []
     for seed in SEEDS[dimension]:
