@@ -305,15 +305,64 @@ def test_without_numba_the_default_install_runs_the_kernels() -> None:
         sys.modules["numba"] = None
         import quasistatic as qs
         from quasistatic import compiled
-        from quasistatic.check import audit
+        from quasistatic.check import audit, motion
         from quasistatic.solvers import lp
         from quasistatic.tools.bench.families import FAMILIES
         if compiled.HAVE_KERNELS:
             assert lp._analyse is lp._analyse_compiled and audit._array_kernel(2, 3) is compiled.audit_laws
+            assert motion._drop_roundoff is compiled.drop_roundoff
         else:
             assert lp._analyse is lp._analyse_numpy and audit._array_kernel(2, 3) is None
+            assert motion._drop_roundoff is motion._drop_roundoff_numpy
         solution = qs.solve(FAMILIES["grasp-3d-nf"].make(8, 0), method="lp")
         assert solution.status == "solved" and solution.audit.passed, solution.message
         """
     )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+
+# --------------------------------------------------------------------------- the conversions on every answer's path
+
+
+@needs_kernels
+def test_to_world_gives_the_numba_kernels_bits() -> None:
+    """Physical twists and world forces of the bench scenes' frames, random scene-relative motions, and no contacts."""
+    from quasistatic.laws import motion
+
+    numba = pytest.importorskip("numba")
+    assert isinstance(motion._to_world_kernel, numba.core.registry.CPUDispatcher)
+    rng = np.random.default_rng(31)
+    for scene in _scenes():
+        problem = qs.assemble(scene)
+        layout = motion._layout(problem)
+        m, d, k = problem.n_contacts, problem.dimension, layout.units.size
+        for rows in (m, 0):
+            q, c = rng.normal(size=len(scene.bodies) * k), rng.normal(size=(rows, d))
+            frames = layout.frames[:rows]
+            want = motion._to_world_kernel(q, c, np.ascontiguousarray(frames), layout.units, 2.5)
+            _assert_same_bits(compiled.to_world(q, c, frames, layout.units, 2.5), want)
+    with pytest.raises(ValueError, match="multiple of units"):
+        compiled.to_world(np.zeros(7), np.zeros((1, 3)), np.zeros((1, 3, 3)), np.ones(6), 1.0)
+    with pytest.raises(ValueError, match="frames must have 3 dimensions"):
+        compiled.to_world(np.zeros(6), np.zeros((2, 3)), np.zeros((1, 3, 3)), np.ones(6), 1.0)
+
+
+@needs_kernels
+def test_drop_roundoff_gives_the_kernels_values() -> None:
+    """Entries within their column's round-off of zero set to 0 in place, others (NaN included) kept; bad arrays refused."""
+    from quasistatic.check import motion
+
+    rng = np.random.default_rng(37)
+    for rows, cols in ((0, 3), (1, 3), (7, 2), (40, 6)):
+        values = rng.normal(size=(rows, cols)) * 10.0 ** rng.integers(-14, 1, size=(rows, cols))
+        if rows:
+            values[0, 0] = np.nan
+        roundoff = np.full(cols, 1e-9)
+        roundoff[0] = 0.0  # exact zeros only
+        copy = values.copy()
+        assert compiled.drop_roundoff(copy, roundoff) is copy
+        np.testing.assert_array_equal(copy, motion._drop_roundoff(values.copy(), roundoff))
+    with pytest.raises(ValueError, match="roundoff must have 1 dimensions"):
+        compiled.drop_roundoff(np.zeros((2, 3)), np.zeros(2))
+    with pytest.raises(ValueError, match="values must be a C-contiguous, writable float64"):
+        compiled.drop_roundoff(np.zeros((3, 2)).T, np.zeros(3))

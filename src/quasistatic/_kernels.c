@@ -12,6 +12,10 @@
  *       solvers/lp.py::_analyse: the optimality residual of a primal-dual pair, the slacks
  *       and contact masks (filled), and the two rank verdicts by the same one-sided Jacobi
  *       rotations as solvers/lp.py::_singular_values (1, 0, or -1 past jacobi_max).
+ *   to_world(q, c, frames, units, force, T, forces) -> None
+ *       laws/motion.py::_to_world_kernel: physical twists T (bodies, k) and world forces (m, d), filled.
+ *   drop_roundoff(values, roundoff) -> None
+ *       check/motion.py::_drop_roundoff: values (rows, c) within roundoff (c,) of zero set to 0, in place.
  *
  * The Python C API and buffers only (every array C-contiguous, no numpy headers), so setuptools
  * alone builds it; quasistatic/compiled.py wraps it. Shapes and indices are checked
@@ -496,6 +500,72 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- small conversions on every answer's path */
+
+static PyObject *to_world(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 7) {
+        PyErr_SetString(PyExc_TypeError, "to_world(q, c, frames, units, force, T, forces) takes 7 arguments");
+        return NULL;
+    }
+    double force;
+    if (take_floats(args[4], &force, "force") < 0) return NULL;
+    Buffers b = {.taken = 0};
+    Py_ssize_t q[1] = {-1}, c[2] = {-1, -1}, units[1] = {-1};
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "q", FLOATS, 0, 1, q) < 0 || take_next(&b, args[1], "c", FLOATS, 0, 2, c) < 0 ||
+        take_next(&b, args[3], "units", FLOATS, 0, 1, units) < 0)
+        goto done;
+    const Py_ssize_t size = q[0], m = c[0], d = c[1], k = units[0];
+    if (k == 0 || size % k != 0) {
+        PyErr_SetString(PyExc_ValueError, "q must hold whole twists: its length a multiple of units' (not 0)");
+        goto done;
+    }
+    Py_ssize_t frames[3] = {m, d, d}, T[2] = {size / k, k}, forces[2] = {m, d};
+    if (take_next(&b, args[2], "frames", FLOATS, 0, 3, frames) < 0 || take_next(&b, args[5], "T", FLOATS, 1, 2, T) < 0 ||
+        take_next(&b, args[6], "forces", FLOATS, 1, 2, forces) < 0)
+        goto done;
+    const double *qv = b.views[0].buf, *cv = b.views[1].buf, *uv = b.views[2].buf, *fv = b.views[3].buf;
+    double *Tv = b.views[4].buf, *out = b.views[5].buf;
+    /* laws/motion.py::_to_world_kernel: each twist entry times its unit; each force the frame's rows
+     * weighted by the contact-frame components, summed in order, then times the force scale. */
+    for (Py_ssize_t r = 0; r < size; r++) Tv[r] = qv[r] * uv[r % k];
+    for (Py_ssize_t i = 0; i < m; i++) {
+        for (Py_ssize_t j = 0; j < d; j++) {
+            double total = 0.0;
+            for (Py_ssize_t s = 0; s < d; s++) total += cv[i * d + s] * fv[(i * d + s) * d + j];
+            out[i * d + j] = total * force;
+        }
+    }
+    result = Py_NewRef(Py_None);
+done:
+    release(&b);
+    return result;
+}
+
+static PyObject *drop_roundoff(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "drop_roundoff(values, roundoff) takes 2 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t values[2] = {-1, -1}, roundoff[1] = {-1};
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "values", FLOATS, 1, 2, values) < 0) goto done;
+    roundoff[0] = values[1];
+    if (take_next(&b, args[1], "roundoff", FLOATS, 0, 1, roundoff) < 0) goto done;
+    double *v = b.views[0].buf;
+    const double *limit = b.views[1].buf;
+    /* check/motion.py::_drop_roundoff: entries within their column's round-off of zero set to 0 (NaN kept) */
+    for (Py_ssize_t r = 0; r < values[0] * values[1]; r++)
+        if (fabs(v[r]) <= limit[r % values[1]]) v[r] = 0.0;
+    result = Py_NewRef(Py_None);
+done:
+    release(&b);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"audit_laws", (PyCFunction)(void (*)(void))audit_laws, METH_FASTCALL,
      "audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed, sums, u, slips, normal):\n"
@@ -505,6 +575,12 @@ static PyMethodDef methods[] = {
      "analyse_frictionless(Jn, bn, g, q, forces, zero, motion_rank, force_rank, orthogonal, jacobi_max, slack, support, tight,\n"
      "closed) -> (residual, motion_unique, forces_unique): the frictionless LP pair's analysis, the numba kernel's loops;\n"
      "fills slack (m,) float64 and the three masks (m,) bool. See quasistatic.solvers.lp."},
+    {"to_world", (PyCFunction)(void (*)(void))to_world, METH_FASTCALL,
+     "to_world(q, c, frames, units, force, T, forces): physical twists and world forces, the numba kernel's loops;\n"
+     "fills T (bodies, k) and forces (m, d). See quasistatic.laws.motion.to_world."},
+    {"drop_roundoff", (PyCFunction)(void (*)(void))drop_roundoff, METH_FASTCALL,
+     "drop_roundoff(values, roundoff): entries of values (rows, c) within roundoff[j] of zero set to 0, in place.\n"
+     "See quasistatic.check.motion."},
     {NULL, NULL, 0, NULL},
 };
 

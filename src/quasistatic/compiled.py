@@ -7,7 +7,8 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``solvers/numerics/lemke.py::lemke`` and ``laws/fixed_modes.py::system``),
 ``HAVE_KERNELS`` whether ``_kernels`` was (:func:`audit_laws`, the audit's
 ``check/audit.py::_laws_2d`` / ``_laws_3d``; :func:`analyse_frictionless`,
-``solvers/lp.py::_analyse``). Each wrapper takes its kernel's arguments, makes
+``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
+``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``). Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
 kernels' choices in the kernels' order of arithmetic.
 """
@@ -31,7 +32,16 @@ def _load(name: str) -> Any:
 extension: Any = _load("quasistatic._lemke")
 kernels: Any = _load("quasistatic._kernels")
 
-__all__ = ["HAVE_EXTENSION", "HAVE_KERNELS", "lemke", "fixed_mode_system", "audit_laws", "analyse_frictionless"]
+__all__ = [
+    "HAVE_EXTENSION",
+    "HAVE_KERNELS",
+    "lemke",
+    "fixed_mode_system",
+    "audit_laws",
+    "analyse_frictionless",
+    "to_world",
+    "drop_roundoff",
+]
 
 HAVE_EXTENSION = extension is not None
 HAVE_KERNELS = kernels is not None
@@ -165,3 +175,31 @@ def analyse_frictionless(
         closed,
     )
     return residual, slack, support, tight, closed, motion_unique, forces_unique
+
+
+def to_world(q: np.ndarray, c: np.ndarray, frames: np.ndarray, units: np.ndarray, force: float) -> tuple[np.ndarray, np.ndarray]:
+    """Physical twists (bodies, k) and world forces (m, d) in C, as ``laws/motion.py::_to_world_kernel`` returns them.
+
+    ``q`` (bodies * k,), ``c`` (m, d), ``frames`` (m, d, d), ``units`` (k,), ``force`` [force].
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree (``q``'s length not a multiple of ``k``, ``frames`` not ``(m, d, d)``).
+    """
+    k = len(units)
+    T, forces = np.empty((len(q) // max(k, 1), k)), np.empty(c.shape)
+    kernels.to_world(*(np.ascontiguousarray(a, np.float64) for a in (q, c, frames, units)), force, T, forces)
+    return T, forces
+
+
+def drop_roundoff(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray:
+    """``values`` (rows, c), a C-contiguous float64 array, with entries within ``roundoff[j]`` of zero set to 0 in place, in C.
+
+    Raises
+    ------
+    ValueError
+        When ``values`` is not a writable C-contiguous float64 array, or ``roundoff`` is not ``(c,)``.
+    """
+    kernels.drop_roundoff(values, np.ascontiguousarray(roundoff, np.float64))
+    return values
