@@ -515,17 +515,20 @@ print(json.dumps(out))
 
 
 def test_audit_kernel_compiled_and_plain_python_agree() -> None:
-    """The law kernel gives the same sums, velocities and slips compiled and as plain Python (numba made unimportable)."""
+    """The law kernel gives the same sums, velocities and slips compiled by numba, in C (numba made unimportable)
+    and as plain Python on lists (the C extension unimportable too)."""
     import json
 
     runs = []
-    for block in ("", "import sys; sys.modules['numba'] = None\n"):
+    no_numba = "import sys; sys.modules['numba'] = None\n"
+    for block in ("", no_numba, no_numba + "sys.modules['quasistatic._kernels'] = None\n"):
         out = subprocess.run([sys.executable, "-c", block + _KERNEL_CASES], capture_output=True, text=True, timeout=120, cwd=ROOT)
         assert out.returncode == 0, out.stderr
         runs.append(json.loads(out.stdout))
-    for compiled, python in zip(*runs, strict=True):
-        for a, b in zip(compiled, python, strict=True):
-            np.testing.assert_allclose(np.asarray(a), np.asarray(b), rtol=1e-13, atol=1e-15)
+    for compiled, *others in zip(*runs, strict=True):
+        for python in others:
+            for a, b in zip(compiled, python, strict=True):
+                np.testing.assert_allclose(np.asarray(a), np.asarray(b), rtol=1e-13, atol=1e-15)
 
 
 def test_audit_rejects_non_finite_motions() -> None:

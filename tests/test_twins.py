@@ -16,6 +16,7 @@ import pytest
 from threadpoolctl import threadpool_limits
 
 import quasistatic as qs
+from quasistatic import compiled
 from quasistatic.check import audit
 from quasistatic.solvers import lp
 from quasistatic.solvers.numerics.lcp import PIVOTS_PER_ROW
@@ -135,6 +136,10 @@ def test_lemke_pair_twin_equals_the_kernel_on_bench_scenes(family: str) -> None:
             np.testing.assert_allclose(c, want[2], rtol=1e-12, atol=1e-14)
             assert c.min(initial=0.0) >= 0.0
             _assert_same_analysis(analysis, want[3])
+            if compiled.HAVE_KERNELS:  # the C analysis (what runs without numba) on the kernel's pair: the kernel's bits
+                pair = (data.Jn, data.bn, data.g, want[1], want[2][:, -1].copy(), ZERO, MOTION_RANK, FORCE_RANK)
+                for got, kernel in zip(lp._analyse_compiled(*pair), lp._analyse(*pair), strict=True):
+                    np.testing.assert_array_equal(got, kernel)
 
 
 # --------------------------------------------------------------------------- the audit's kernel
@@ -198,6 +203,7 @@ def test_many_contacts_are_audited_by_the_twin_without_numba(monkeypatch: pytest
     forces = np.array([contact.force for contact in solution.contacts])
     want = audit.audit_arrays(geometry, twists, forces, problem.scales)
     monkeypatch.setattr(audit, "HAVE_NUMBA", False)
+    monkeypatch.setattr(audit, "HAVE_KERNELS", False)  # an install without a C compiler
     got = audit.audit_arrays(geometry, twists, forces, problem.scales)
     assert got[0].passed and want[0].passed
     for field in ("equilibrium", "cone", "complementarity", "dissipation", "power"):
@@ -205,9 +211,15 @@ def test_many_contacts_are_audited_by_the_twin_without_numba(monkeypatch: pytest
     _assert_same_evaluation((got[2].velocities, got[2].slips, got[2].normal), (want[2].velocities, want[2].slips, want[2].normal))
 
 
-def test_roundoff_twin_equals_the_kernel() -> None:
-    """Entries within their column's round-off of zero set to 0 in place, others (NaN included) kept."""
+@pytest.mark.parametrize("twin", ["numpy", "C"])
+def test_roundoff_twin_equals_the_kernel(twin: str) -> None:
+    """Entries within their column's round-off of zero set to 0 in place, others (NaN included) kept: the numpy twin,
+    and the C extension's loop (``compiled.drop_roundoff``, what runs without numba where it was built)."""
     from quasistatic.check import motion
+
+    if twin == "C" and not compiled.HAVE_KERNELS:
+        pytest.skip("built without the C extensions")
+    drop = motion._drop_roundoff_numpy if twin == "numpy" else compiled.drop_roundoff
 
     rng = np.random.default_rng(19)
     for rows, cols in ((0, 3), (1, 3), (7, 2), (40, 6)):
@@ -218,6 +230,6 @@ def test_roundoff_twin_equals_the_kernel() -> None:
         roundoff[0] = 0.0  # exact zeros only
         want = motion._drop_roundoff(values.copy(), roundoff)
         copy = values.copy()
-        got = motion._drop_roundoff_numpy(copy, roundoff)
+        got = drop(copy, roundoff)
         assert got is copy
         np.testing.assert_array_equal(got, want)

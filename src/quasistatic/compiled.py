@@ -1,11 +1,15 @@
-"""The compiled extension ``quasistatic._lemke``: Lemke's method and the fixed-mode laws in C, for installs without numba.
+"""The compiled extensions ``quasistatic._lemke`` and ``quasistatic._kernels``: numba kernels in C, for installs without numba.
 
-``pip install .`` builds it with the machine's C compiler (setuptools only: no
-numpy headers); it is optional, so an install without a compiler still works
-and runs the numpy twin instead. ``HAVE_EXTENSION`` says whether it was built.
-:func:`lemke` and :func:`fixed_mode_system` take the arguments of the numba
-kernels ``solvers/numerics/lemke.py::lemke`` and ``laws/fixed_modes.py::system``,
-make them C-contiguous, and return what the kernels return; the C code makes the
+``pip install .`` builds them with the machine's C compiler (setuptools only: no
+numpy headers); each is optional, so an install without a compiler still works
+and runs the numpy twins instead. ``HAVE_EXTENSION`` says whether ``_lemke`` was
+built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
+``solvers/numerics/lemke.py::lemke`` and ``laws/fixed_modes.py::system``),
+``HAVE_KERNELS`` whether ``_kernels`` was (:func:`audit_laws`, the audit's
+``check/audit.py::_laws_2d`` / ``_laws_3d``; :func:`analyse_frictionless`,
+``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
+``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``). Each wrapper takes its kernel's arguments, makes
+them C-contiguous, and returns what the kernel returns; the C code makes the
 kernels' choices in the kernels' order of arithmetic.
 """
 
@@ -16,14 +20,31 @@ from typing import Any
 
 import numpy as np
 
-try:  # by name: a typed import would make mypy read the whole package from this leaf
-    extension: Any = importlib.import_module("quasistatic._lemke")
-except ImportError:  # built without a C compiler: callers fall back to numpy
-    extension = None
 
-__all__ = ["HAVE_EXTENSION", "lemke", "fixed_mode_system"]
+def _load(name: str) -> Any:
+    """The extension module ``name``, or None where it was not built (no C compiler: callers fall back to numpy)."""
+    try:  # by name: a typed import would make mypy read the whole package from this leaf
+        return importlib.import_module(name)
+    except ImportError:
+        return None
+
+
+extension: Any = _load("quasistatic._lemke")
+kernels: Any = _load("quasistatic._kernels")
+
+__all__ = [
+    "HAVE_EXTENSION",
+    "HAVE_KERNELS",
+    "lemke",
+    "fixed_mode_system",
+    "audit_laws",
+    "analyse_frictionless",
+    "to_world",
+    "drop_roundoff",
+]
 
 HAVE_EXTENSION = extension is not None
+HAVE_KERNELS = kernels is not None
 
 
 def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
@@ -83,3 +104,102 @@ def fixed_mode_system(
         forces,
     )
     return residual, jacobian, forces
+
+
+def audit_laws(
+    links: np.ndarray,
+    contacts: np.ndarray,
+    loads: np.ndarray,
+    T: np.ndarray,
+    f: np.ndarray,
+    facets: np.ndarray,
+    directions: np.ndarray,
+    facet_scale: float,
+    slide_speed: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The audit's laws in C: ``(sums (11,), velocities (m, d), slips (m, d), normal (m, 3))`` as ``check/audit.py::_laws_2d``
+    (``T`` (bodies, 3)) or ``_laws_3d`` (``T`` (bodies, 6)) return them, from their arguments.
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree, or a contact's ``links`` name a body that is not there.
+    """
+    m, d = len(links), 2 if T.shape[-1] == 3 else 3
+    sums, u, slips, normal = np.empty(11), np.empty((m, d)), np.empty((m, d)), np.empty((m, 3))
+    kernels.audit_laws(
+        np.ascontiguousarray(links, np.int64),
+        *(np.ascontiguousarray(a, np.float64) for a in (contacts, loads, T, f, facets, directions)),
+        facet_scale,
+        slide_speed,
+        sums,
+        u,
+        slips,
+        normal,
+    )
+    return sums, u, slips, normal
+
+
+def analyse_frictionless(
+    Jn: np.ndarray,
+    bn: np.ndarray,
+    g: np.ndarray,
+    q: np.ndarray,
+    forces: np.ndarray,
+    zero: float,
+    motion_rank: float,
+    force_rank: float,
+    orthogonal: float,
+    jacobi_max: int,
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, int]:
+    """The frictionless LP pair's analysis in C: ``(residual, slack, support, tight, closed, motion_unique, forces_unique)``
+    as ``solvers/lp.py::_analyse`` returns them; ``orthogonal`` and ``jacobi_max`` are its Jacobi rotations' limits.
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree (``Jn`` not ``(m, n)``, ``bn`` and ``forces`` not ``(m,)``, ``g`` and ``q`` not ``(n,)``).
+    """
+    m = len(bn)
+    slack, support, tight, closed = np.empty(m), np.empty(m, bool), np.empty(m, bool), np.empty(m, bool)
+    residual, motion_unique, forces_unique = kernels.analyse_frictionless(
+        *(np.ascontiguousarray(a, np.float64) for a in (Jn, bn, g, q, forces)),
+        zero,
+        motion_rank,
+        force_rank,
+        orthogonal,
+        jacobi_max,
+        slack,
+        support,
+        tight,
+        closed,
+    )
+    return residual, slack, support, tight, closed, motion_unique, forces_unique
+
+
+def to_world(q: np.ndarray, c: np.ndarray, frames: np.ndarray, units: np.ndarray, force: float) -> tuple[np.ndarray, np.ndarray]:
+    """Physical twists (bodies, k) and world forces (m, d) in C, as ``laws/motion.py::_to_world_kernel`` returns them.
+
+    ``q`` (bodies * k,), ``c`` (m, d), ``frames`` (m, d, d), ``units`` (k,), ``force`` [force].
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree (``q``'s length not a multiple of ``k``, ``frames`` not ``(m, d, d)``).
+    """
+    k = len(units)
+    T, forces = np.empty((len(q) // max(k, 1), k)), np.empty(c.shape)
+    kernels.to_world(*(np.ascontiguousarray(a, np.float64) for a in (q, c, frames, units)), force, T, forces)
+    return T, forces
+
+
+def drop_roundoff(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray:
+    """``values`` (rows, c), a C-contiguous float64 array, with entries within ``roundoff[j]`` of zero set to 0 in place, in C.
+
+    Raises
+    ------
+    ValueError
+        When ``values`` is not a writable C-contiguous float64 array, or ``roundoff`` is not ``(c,)``.
+    """
+    kernels.drop_roundoff(values, np.ascontiguousarray(roundoff, np.float64))
+    return values

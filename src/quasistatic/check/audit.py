@@ -13,8 +13,9 @@ data (points, normals, frames, moment arms, mover velocities, loads) is read
 once into flat arrays (:class:`AuditGeometry`, which a caller may keep and
 pass again for the same scene), and the laws are checked contact by
 contact in one scalar loop per dimension, compiled by numba when it is
-installed (without numba the same loop runs as plain Python on nested lists, and
-beyond ``LOOP_CONTACTS`` contacts its whole-array twin :func:`_laws_numpy` runs instead).
+installed (without numba its C twin in the ``quasistatic._kernels`` extension, the same
+arithmetic in the same order; where that was not built, the same loop as plain Python on
+nested lists, and beyond ``LOOP_CONTACTS`` contacts its whole-array twin :func:`_laws_numpy`).
 The loop also returns what a report needs per contact (relative velocity,
 slip, normal velocity and force), so nothing is computed twice.
 """
@@ -22,11 +23,13 @@ slip, normal velocity and force), so nothing is computed twice.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from ..compiled import HAVE_KERNELS, audit_laws
 from ..jit import HAVE_NUMBA, njit
 from ..model import Contact, Mover, Scales, Scene
 from ..solution import Audit, PowerBalance
@@ -134,7 +137,7 @@ def _read_geometry(scene: Scene) -> AuditGeometry:
     )
     for array in arrays:
         array.setflags(write=False)
-    lists = None if HAVE_NUMBA else tuple(array.tolist() for array in arrays)
+    lists = None if HAVE_NUMBA or HAVE_KERNELS else tuple(array.tolist() for array in arrays)
     return AuditGeometry(dim, names, facet_scale, arrays, lists)
 
 
@@ -209,8 +212,8 @@ def _evaluate(geometry: AuditGeometry, T: np.ndarray, forces: np.ndarray, slide_
     T = np.ascontiguousarray(T, dtype=float)
     forces = np.ascontiguousarray(forces, dtype=float)
     arrays = geometry.arrays
-    if HAVE_NUMBA or len(arrays[0]) > LOOP_CONTACTS:
-        kernel = (_laws_2d if geometry.dimension == 2 else _laws_3d) if HAVE_NUMBA else _laws_numpy
+    kernel = _array_kernel(geometry.dimension, len(arrays[0]))
+    if kernel is not None:
         return Evaluation(*kernel(arrays[0], arrays[1], arrays[2], T, forces, arrays[3], arrays[4], geometry.facet_scale, slide_speed))
     # Plain Python, few contacts: the kernel's loop on nested lists beats the ~60 calls of its whole-array twin.
     kernel = _laws_2d if geometry.dimension == 2 else _laws_3d
@@ -220,6 +223,16 @@ def _evaluate(geometry: AuditGeometry, T: np.ndarray, forces: np.ndarray, slide_
         lists[0], lists[1], lists[2], T.tolist(), forces.tolist(), lists[3], lists[4], geometry.facet_scale, slide_speed
     )
     return Evaluation(np.asarray(sums), np.asarray(u), np.asarray(slips), np.asarray(normal))
+
+
+def _array_kernel(dimension: int, contacts: int) -> Callable[..., tuple[np.ndarray, ...]] | None:
+    """The laws' kernel on arrays: numba's loops, else their C twin (the ``_kernels`` extension, the same arithmetic),
+    else past ``LOOP_CONTACTS`` contacts the numpy twin; None: the loop as plain Python on nested lists."""
+    if HAVE_NUMBA:
+        return _laws_2d if dimension == 2 else _laws_3d
+    if HAVE_KERNELS:
+        return audit_laws
+    return _laws_numpy if contacts > LOOP_CONTACTS else None
 
 
 @np.errstate(all="ignore")  # values that are not finite fail by the check sum, as in the loop: no warning

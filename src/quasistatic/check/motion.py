@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from ..compiled import HAVE_KERNELS, drop_roundoff
 from ..jit import njit
 from ..model import Scales, Scene
 from ..solution import Audit, ContactResult, Later, Mode, Motion, PowerBalance, UnprovenExtreme
@@ -112,7 +113,7 @@ def _drop_roundoff_numpy(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray
     return values
 
 
-@njit(python=_drop_roundoff_numpy)
+@njit(python=drop_roundoff if HAVE_KERNELS else _drop_roundoff_numpy)  # without numba: the loop in C where it was built
 def _drop_roundoff(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray:
     """``values`` (rows, c) with entries within ``roundoff[j]`` of zero set to 0, in place (one compiled loop: small arrays)."""
     for i in range(values.shape[0]):

@@ -8,6 +8,8 @@ from typing import Protocol
 
 import numpy as np
 
+from ..compiled import HAVE_KERNELS
+from ..compiled import to_world as compiled_to_world
 from ..jit import HAVE_NUMBA, njit
 from ..model import FloatArray
 from .assemble import Problem
@@ -161,6 +163,8 @@ def to_world(problem: Problem, q: FloatArray, c: FloatArray) -> tuple[FloatArray
     if HAVE_NUMBA:
         q, c = np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(c, dtype=float)
         return _to_world_kernel(q, c, layout.frames, layout.units, force)
+    if HAVE_KERNELS:  # the kernel's loops in C: without numba, a few numpy calls cost more than the arithmetic
+        return compiled_to_world(q, c, layout.frames, layout.units, force)
     T = np.reshape(q, (-1, layout.units.size)) * layout.units
     return T, np.matmul(c[:, None, :], layout.frames)[:, 0, :] * force
 

@@ -22,6 +22,7 @@ from functools import partial
 import numpy as np
 import scipy.sparse as sp
 
+from ..compiled import HAVE_KERNELS, analyse_frictionless
 from ..jit import njit
 from ..laws import Problem, RawMotion
 from ..solution import Certificate, CertificateKind, Diagnosis
@@ -176,7 +177,14 @@ def _analyse_numpy(
     return residual, slack, support, tight, closed, motion_unique, forces_unique
 
 
-@njit(python=_analyse_numpy)
+def _analyse_compiled(
+    Jn: np.ndarray, bn: np.ndarray, g: np.ndarray, q: np.ndarray, forces: np.ndarray, zero: float, motion_rank: float, force_rank: float
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, int]:
+    """:func:`_analyse` in C (what runs without numba where the ``_kernels`` extension was built): its loops and rotations."""
+    return analyse_frictionless(Jn, bn, g, q, forces, zero, motion_rank, force_rank, JACOBI_ORTHOGONAL, JACOBI_MAX)
+
+
+@njit(python=_analyse_compiled if HAVE_KERNELS else _analyse_numpy)
 def _analyse(
     Jn: np.ndarray, bn: np.ndarray, g: np.ndarray, q: np.ndarray, forces: np.ndarray, zero: float, motion_rank: float, force_rank: float
 ) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, int]:

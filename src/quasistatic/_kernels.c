@@ -1,0 +1,592 @@
+/* Compiled twins of small numba kernels, for installs without numba:
+ *
+ *   audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed,
+ *              sums, u, slips, normal) -> None
+ *       The audit's per-contact laws, check/audit.py::_laws_2d and _laws_3d (T's width, 3 or 6,
+ *       gives the dimension) loop for loop: the same products and sums in the same order, and
+ *       max() as Python's and numba's (a later value replaces the one kept only when greater),
+ *       so the results are the kernel's to the bit where both round alike. The last four
+ *       arrays are filled.
+ *   analyse_frictionless(Jn, bn, g, q, forces, zero, motion_rank, force_rank, orthogonal,
+ *                        jacobi_max, slack, support, tight, closed) -> (residual, motion_unique, forces_unique)
+ *       solvers/lp.py::_analyse: the optimality residual of a primal-dual pair, the slacks
+ *       and contact masks (filled), and the two rank verdicts by the same one-sided Jacobi
+ *       rotations as solvers/lp.py::_singular_values (1, 0, or -1 past jacobi_max).
+ *   to_world(q, c, frames, units, force, T, forces) -> None
+ *       laws/motion.py::_to_world_kernel: physical twists T (bodies, k) and world forces (m, d), filled.
+ *   drop_roundoff(values, roundoff) -> None
+ *       check/motion.py::_drop_roundoff: values (rows, c) within roundoff (c,) of zero set to 0, in place.
+ *
+ * The Python C API and buffers only (every array C-contiguous, no numpy headers), so setuptools
+ * alone builds it; quasistatic/compiled.py wraps it. Shapes and indices are checked
+ * (ValueError, never a read or write out of bounds); the GIL is released while it computes.
+ * Products are not fused into multiply-adds (numba does not fuse them either).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#if defined(__clang__)
+#pragma clang fp contract(off)
+#elif defined(__GNUC__)
+#pragma GCC optimize("fp-contract=off")
+#endif
+
+/* Python's and numba's max(kept, value): the value replaces the kept one only when greater. */
+static inline double greater(double kept, double value) { return value > kept ? value : kept; }
+
+/* ---------------------------------------------------------------- buffers */
+
+enum { FLOATS, INTEGERS, BOOLEANS };
+
+/* Whether a buffer holds the native items of `type`: float64, int64, or numpy's one-byte bool. */
+static int has_items(const Py_buffer *view, int type) {
+    const char *format = view->format ? view->format : "B";
+    if (*format == '@' || *format == '=' || *format == '<') format++;
+    if (format[0] == '\0' || format[1] != '\0') return 0;
+    if (type == BOOLEANS) return view->itemsize == 1 && format[0] == '?';
+    return view->itemsize == 8 && strchr(type == FLOATS ? "d" : "ql", format[0]) != NULL;
+}
+
+/* Argument `arg` as a C-contiguous buffer of `type`, `ndim` dimensions; a shape entry of -1
+ * takes the buffer's own (read back through `shape`). Returns 0, or -1 with ValueError set. */
+static int take(PyObject *arg, Py_buffer *view, const char *name, int type, int writable, int ndim, Py_ssize_t *shape) {
+    static const char *items[3] = {"float64", "int64", "bool"};
+    const int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(arg, view, flags) < 0) {
+        /* not contiguous, or read-only where it is filled (numpy says so by BufferError or ValueError) */
+        if (PyErr_ExceptionMatches(PyExc_BufferError) || PyErr_ExceptionMatches(PyExc_ValueError)) {
+            PyErr_Clear();
+            PyErr_Format(PyExc_ValueError, "%s must be a C-contiguous%s %s array", name, writable ? ", writable" : "", items[type]);
+        }
+        return -1;
+    }
+    int same = view->ndim == ndim;
+    for (int k = 0; same && k < ndim; k++) {
+        if (shape[k] < 0) shape[k] = view->shape[k];
+        same = view->shape[k] == shape[k];
+    }
+    if (!has_items(view, type)) {
+        PyErr_Format(PyExc_ValueError, "%s must be a C-contiguous %s array", name, items[type]);
+    } else if (!same) {
+        PyErr_Format(PyExc_ValueError, "%s must have %d dimensions, shaped as the other arguments", name, ndim);
+    } else {
+        return 0;
+    }
+    PyBuffer_Release(view);
+    return -1;
+}
+
+/* Up to 16 argument buffers taken in order; `release` frees those taken so far. */
+typedef struct {
+    Py_buffer views[16];
+    int taken;
+} Buffers;
+
+static int take_next(Buffers *b, PyObject *arg, const char *name, int type, int writable, int ndim, Py_ssize_t *shape) {
+    if (take(arg, &b->views[b->taken], name, type, writable, ndim, shape) < 0) return -1;
+    b->taken++;
+    return 0;
+}
+
+static void release(Buffers *b) {
+    for (int k = 0; k < b->taken; k++) PyBuffer_Release(&b->views[k]);
+    b->taken = 0;
+}
+
+static int take_floats(PyObject *arg, double *value, const char *name) {
+    *value = PyFloat_AsDouble(arg);
+    if (*value == -1.0 && PyErr_Occurred()) {
+        PyErr_Format(PyExc_TypeError, "%s must be a float", name);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------- the audit's laws */
+
+/* Columns of sums, as check/audit.py names them. */
+enum { LINEAR, ANGULAR, CONE, PENETRATION, NORMAL_POWER, SHORTFALL, SUPPLIED, DISSIPATED, RAISED, CHECK, MISALIGN, SUMS };
+
+/* The audit's arrays (row-major): links (m, 2), contacts (m, w), loads and T (bodies, k), f (m, d),
+ * facets and directions (K, 2); out: sums (11,), u and slips (m, d), normal (m, 3). */
+typedef struct {
+    Py_ssize_t m, bodies, edges;
+    const int64_t *links;
+    const double *contacts, *loads, *T, *f, *facets, *directions;
+    double facet_scale, slide_speed;
+    double *sums, *u, *slips, *normal, *totals;
+} Laws;
+
+/* What both dimensions' loops accumulate over the contacts. */
+typedef struct {
+    double cone, penetration, normal_power, shortfall, supplied, dissipated, check, misalign;
+} Running;
+
+static void laws_2d(const Laws *L, Running *r) {
+    for (Py_ssize_t i = 0; i < L->m; i++) {
+        const int64_t b = L->links[2 * i], o = L->links[2 * i + 1];
+        const double *c = L->contacts + 11 * i, *fi = L->f + 2 * i;
+        const double nx = c[0], ny = c[1], tx = c[2], ty = c[3], rbx = c[4], rby = c[5], rox = c[6], roy = c[7];
+        const double mvx = c[8], mvy = c[9], mu = c[10], fx = fi[0], fy = fi[1];
+        const double *t = L->T + 3 * b;
+        double ux = t[0] - t[2] * rby, uy = t[1] + t[2] * rbx;
+        double *total = L->totals + 3 * b;
+        total[0] += fx;
+        total[1] += fy;
+        total[2] += rbx * fy - rby * fx;
+        if (o >= 0) {
+            t = L->T + 3 * o;
+            ux = ux - (t[0] - t[2] * roy);
+            uy = uy - (t[1] + t[2] * rox);
+            total = L->totals + 3 * o;
+            total[0] -= fx;
+            total[1] -= fy;
+            total[2] -= rox * fy - roy * fx;
+        } else {
+            ux = ux - mvx;
+            uy = uy - mvy;
+            r->supplied += fx * mvx + fy * mvy;
+        }
+        const double f_n = fx * nx + fy * ny, f_t = fx * tx + fy * ty;
+        const double u_n = ux * nx + uy * ny, u_t = ux * tx + uy * ty;
+        const double radius = mu * greater(f_n, 0.0);
+        r->cone = greater(greater(r->cone, -f_n), fabs(f_t) - radius);
+        r->penetration = greater(r->penetration, -u_n);
+        r->normal_power = greater(r->normal_power, fabs(f_n * u_n));
+        r->shortfall = greater(r->shortfall, radius * fabs(u_t) + f_t * u_t);
+        r->dissipated -= fx * ux + fy * uy - f_n * u_n;
+        r->check += fx + fy + ux + uy;
+        const double sx = ux - u_n * nx, sy = uy - u_n * ny;
+        L->u[2 * i] = ux, L->u[2 * i + 1] = uy;
+        L->slips[2 * i] = sx, L->slips[2 * i + 1] = sy;
+        double *normal = L->normal + 3 * i;
+        normal[0] = u_n, normal[1] = sqrt(sx * sx + sy * sy), normal[2] = f_n;
+    }
+}
+
+/* The friction set's excursion and the slip's support of a 3-D pyramid (its facets and edge directions). */
+static void pyramid(const Laws *L, double f_1, double f_2, double u_1, double u_2, double radius, double *outside, double *support) {
+    *outside = -INFINITY;
+    *support = -INFINITY;
+    for (Py_ssize_t k = 0; k < L->edges; k++) {
+        const double *facet = L->facets + 2 * k, *direction = L->directions + 2 * k;
+        *outside = greater(*outside, facet[0] * f_1 + facet[1] * f_2);
+        *support = greater(*support, -(direction[0] * u_1 + direction[1] * u_2));
+    }
+    *outside -= radius * L->facet_scale;
+}
+
+static void laws_3d(const Laws *L, Running *r) {
+    for (Py_ssize_t i = 0; i < L->m; i++) {
+        const int64_t b = L->links[2 * i], o = L->links[2 * i + 1];
+        const double *c = L->contacts + 19 * i, *fi = L->f + 3 * i;
+        const double nx = c[0], ny = c[1], nz = c[2], ax = c[3], ay = c[4], az = c[5], bx = c[6], by = c[7], bz = c[8];
+        const double rx = c[9], ry = c[10], rz = c[11], sx = c[12], sy = c[13], sz = c[14];
+        const double mx = c[15], my = c[16], mz = c[17], mu = c[18], fx = fi[0], fy = fi[1], fz = fi[2];
+        const double *t = L->T + 6 * b;
+        double ux = t[0] + t[4] * rz - t[5] * ry, uy = t[1] + t[5] * rx - t[3] * rz, uz = t[2] + t[3] * ry - t[4] * rx;
+        double *total = L->totals + 6 * b;
+        total[0] += fx;
+        total[1] += fy;
+        total[2] += fz;
+        total[3] += ry * fz - rz * fy;
+        total[4] += rz * fx - rx * fz;
+        total[5] += rx * fy - ry * fx;
+        if (o >= 0) {
+            t = L->T + 6 * o;
+            ux -= t[0] + t[4] * sz - t[5] * sy;
+            uy -= t[1] + t[5] * sx - t[3] * sz;
+            uz -= t[2] + t[3] * sy - t[4] * sx;
+            total = L->totals + 6 * o;
+            total[0] -= fx;
+            total[1] -= fy;
+            total[2] -= fz;
+            total[3] -= sy * fz - sz * fy;
+            total[4] -= sz * fx - sx * fz;
+            total[5] -= sx * fy - sy * fx;
+        } else {
+            ux = ux - mx, uy = uy - my, uz = uz - mz;
+            r->supplied += fx * mx + fy * my + fz * mz;
+        }
+        const double f_n = fx * nx + fy * ny + fz * nz;
+        const double f_1 = fx * ax + fy * ay + fz * az, f_2 = fx * bx + fy * by + fz * bz;
+        const double u_n = ux * nx + uy * ny + uz * nz;
+        const double u_1 = ux * ax + uy * ay + uz * az, u_2 = ux * bx + uy * by + uz * bz;
+        const double radius = mu * greater(f_n, 0.0);
+        double outside, support;
+        if (L->edges > 0) {
+            pyramid(L, f_1, f_2, u_1, u_2, radius, &outside, &support);
+        } else {
+            outside = sqrt(f_1 * f_1 + f_2 * f_2) - radius;
+            support = sqrt(u_1 * u_1 + u_2 * u_2);
+            if (support > L->slide_speed) { /* sliding: the friction must be -mu f_n slip/|slip| exactly */
+                const double e_1 = f_1 + radius * u_1 / support, e_2 = f_2 + radius * u_2 / support;
+                r->misalign = greater(r->misalign, sqrt(e_1 * e_1 + e_2 * e_2));
+            }
+        }
+        r->cone = greater(greater(r->cone, -f_n), outside);
+        r->penetration = greater(r->penetration, -u_n);
+        r->normal_power = greater(r->normal_power, fabs(f_n * u_n));
+        r->shortfall = greater(r->shortfall, radius * support + f_1 * u_1 + f_2 * u_2);
+        r->dissipated -= fx * ux + fy * uy + fz * uz - f_n * u_n;
+        r->check += fx + fy + fz + ux + uy + uz;
+        const double px = ux - u_n * nx, py = uy - u_n * ny, pz = uz - u_n * nz;
+        L->u[3 * i] = ux, L->u[3 * i + 1] = uy, L->u[3 * i + 2] = uz;
+        L->slips[3 * i] = px, L->slips[3 * i + 1] = py, L->slips[3 * i + 2] = pz;
+        double *normal = L->normal + 3 * i;
+        normal[0] = u_n, normal[1] = sqrt(px * px + py * py + pz * pz), normal[2] = f_n;
+    }
+}
+
+/* The kernel in dimension `dim`: the totals start at the loads, the contacts' loop, then _finish's
+ * largest unbalanced force and moment, the power against the loads and the finiteness check. */
+static void audit(const Laws *L, int dim) {
+    const Py_ssize_t k = dim == 2 ? 3 : 6;
+    memcpy(L->totals, L->loads, (size_t)(L->bodies * k) * sizeof(double));
+    Running r = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    if (dim == 2)
+        laws_2d(L, &r);
+    else
+        laws_3d(L, &r);
+    double linear = 0.0, angular = 0.0, raised = 0.0, check = r.check;
+    for (Py_ssize_t a = 0; a < L->bodies; a++) {
+        for (Py_ssize_t j = 0; j < k; j++) {
+            const double total = L->totals[a * k + j];
+            check += total;
+            if (j < dim)
+                linear = greater(linear, fabs(total));
+            else
+                angular = greater(angular, fabs(total));
+            raised -= L->loads[a * k + j] * L->T[a * k + j];
+        }
+    }
+    double *sums = L->sums;
+    for (int s = 0; s < SUMS; s++) sums[s] = 0.0;
+    sums[LINEAR] = linear, sums[ANGULAR] = angular, sums[RAISED] = raised, sums[CHECK] = check + raised;
+    sums[CONE] = r.cone, sums[PENETRATION] = r.penetration, sums[NORMAL_POWER] = r.normal_power, sums[SHORTFALL] = r.shortfall;
+    if (dim == 3) sums[MISALIGN] = r.misalign;
+    sums[SUPPLIED] = r.supplied, sums[DISSIPATED] = r.dissipated;
+}
+
+/* Whether every contact's body is a body and its other a body or -1 (a mover). */
+static int links_fit(const int64_t *links, Py_ssize_t m, Py_ssize_t bodies) {
+    for (Py_ssize_t i = 0; i < m; i++) {
+        const int64_t b = links[2 * i], o = links[2 * i + 1];
+        if (b < 0 || b >= bodies || o < -1 || o >= bodies) {
+            PyErr_Format(PyExc_ValueError, "links[%zd] = (%lld, %lld) names a body outside 0..%zd", i, (long long)b, (long long)o, bodies - 1);
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static PyObject *audit_laws(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 13) {
+        PyErr_SetString(PyExc_TypeError,
+                        "audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed, sums, u, slips, normal) "
+                        "takes 13 arguments");
+        return NULL;
+    }
+    double facet_scale, slide_speed;
+    if (take_floats(args[7], &facet_scale, "facet_scale") < 0 || take_floats(args[8], &slide_speed, "slide_speed") < 0) return NULL;
+    Buffers b = {.taken = 0};
+    Py_ssize_t twists[2] = {-1, -1};
+    PyObject *result = NULL;
+    double *totals = NULL;
+    if (take_next(&b, args[3], "T", FLOATS, 0, 2, twists) < 0) goto done;
+    const Py_ssize_t bodies = twists[0], k = twists[1];
+    if (k != 3 && k != 6) {
+        PyErr_SetString(PyExc_ValueError, "T must have shape (bodies, 3) or (bodies, 6)");
+        goto done;
+    }
+    const int dim = k == 3 ? 2 : 3;
+    Py_ssize_t links[2] = {-1, 2}, contacts[2] = {-1, 1 + dim * (dim + 3)}, loads[2] = {bodies, k}, f[2] = {-1, dim};
+    Py_ssize_t facets[2] = {-1, 2}, directions[2] = {-1, 2}, sums[1] = {SUMS}, u[2] = {-1, dim}, slips[2] = {-1, dim};
+    Py_ssize_t normal[2] = {-1, 3};
+    if (take_next(&b, args[0], "links", INTEGERS, 0, 2, links) < 0) goto done;
+    const Py_ssize_t m = links[0];
+    contacts[0] = f[0] = u[0] = slips[0] = normal[0] = m;
+    if (take_next(&b, args[1], "contacts", FLOATS, 0, 2, contacts) < 0 || take_next(&b, args[2], "loads", FLOATS, 0, 2, loads) < 0 ||
+        take_next(&b, args[4], "f", FLOATS, 0, 2, f) < 0 || take_next(&b, args[5], "facets", FLOATS, 0, 2, facets) < 0)
+        goto done;
+    directions[0] = facets[0];
+    if (take_next(&b, args[6], "directions", FLOATS, 0, 2, directions) < 0 || take_next(&b, args[9], "sums", FLOATS, 1, 1, sums) < 0 ||
+        take_next(&b, args[10], "u", FLOATS, 1, 2, u) < 0 || take_next(&b, args[11], "slips", FLOATS, 1, 2, slips) < 0 ||
+        take_next(&b, args[12], "normal", FLOATS, 1, 2, normal) < 0)
+        goto done;
+    const int64_t *link_values = b.views[1].buf;
+    if (!links_fit(link_values, m, bodies)) goto done;
+    totals = PyMem_RawMalloc((size_t)(bodies * k + 1) * sizeof(double)); /* +1: never a request for 0 bytes */
+    if (totals == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    const Laws L = {m, bodies, facets[0], link_values, b.views[2].buf, b.views[3].buf, b.views[0].buf, b.views[4].buf,
+                    b.views[5].buf, b.views[6].buf, facet_scale, slide_speed, b.views[7].buf, b.views[8].buf, b.views[9].buf,
+                    b.views[10].buf, totals};
+    Py_BEGIN_ALLOW_THREADS
+    audit(&L, dim);
+    Py_END_ALLOW_THREADS
+    result = Py_NewRef(Py_None);
+done:
+    PyMem_RawFree(totals);
+    release(&b);
+    return result;
+}
+
+/* ---------------------------------------------------------------- the frictionless LP's analysis */
+
+/* Singular values of the (rows, cols) matrix W, column-major, rows >= cols, by one-sided Jacobi rotations
+ * (Hestenes), solvers/lp.py::_singular_values sweep for sweep; W is rotated in place, sigma (cols) filled. */
+static void singular_values(double *W, Py_ssize_t rows, Py_ssize_t cols, double orthogonal, double *sigma) {
+    for (int sweep = 0; sweep < 60; sweep++) {
+        int rotated = 0;
+        for (Py_ssize_t p = 0; p + 1 < cols; p++) {
+            for (Py_ssize_t q = p + 1; q < cols; q++) {
+                double *wp = W + p * rows, *wq = W + q * rows;
+                double alpha = 0.0, beta = 0.0, gamma = 0.0;
+                for (Py_ssize_t i = 0; i < rows; i++) {
+                    alpha += wp[i] * wp[i];
+                    beta += wq[i] * wq[i];
+                    gamma += wp[i] * wq[i];
+                }
+                if (gamma == 0.0 || fabs(gamma) <= orthogonal * sqrt(alpha * beta)) continue;
+                rotated = 1;
+                /* tan of the rotation in the kernel's overflow-free form (see _singular_values) */
+                const double diff = beta - alpha;
+                const double sign = diff == 0.0 || (diff > 0.0) == (gamma > 0.0) ? 1.0 : -1.0;
+                const double t = sign * 2.0 * fabs(gamma) / (fabs(diff) + hypot(2.0 * gamma, diff));
+                const double cos = 1.0 / sqrt(1.0 + t * t), sin = cos * t;
+                for (Py_ssize_t i = 0; i < rows; i++) {
+                    const double a = wp[i], b = wq[i];
+                    wp[i] = cos * a - sin * b;
+                    wq[i] = sin * a + cos * b;
+                }
+            }
+        }
+        if (!rotated) break;
+    }
+    for (Py_ssize_t j = 0; j < cols; j++) {
+        double total = 0.0;
+        for (Py_ssize_t i = 0; i < rows; i++) total += W[j * rows + i] * W[j * rows + i];
+        sigma[j] = sqrt(total);
+    }
+}
+
+/* The frictionless analysis' arrays: Jn (m, n) row-major, bn (m,), g (n,), q (n,), forces (m,);
+ * out: slack (m,), the masks (m,); work: room for one (m, n) matrix and its n singular values. */
+typedef struct {
+    Py_ssize_t m, n;
+    const double *Jn, *bn, *g, *q, *forces;
+    double orthogonal;
+    Py_ssize_t jacobi_max;
+    double *slack;
+    char *support, *tight, *closed;
+    double *work, *sigma;
+} Pair;
+
+/* _full_rank on the rows of Jn where `rows` is set (count of them): 1 when `rank` singular values
+ * exceed tol, else 0; -1 when the matrix is too large for Jacobi rotations. */
+static int full_rank(const Pair *P, const char *rows, Py_ssize_t count, double tol, Py_ssize_t rank) {
+    const Py_ssize_t n = P->n;
+    if (count == 0 || n == 0) return rank == 0;
+    if ((count < n ? count : n) > P->jacobi_max) return -1;
+    /* W column-major: A itself when it is tall (a column of A a column of W), else A^T (a row of A a column). */
+    const int tall = count >= n;
+    Py_ssize_t r = 0;
+    for (Py_ssize_t i = 0; i < P->m; i++) {
+        if (!rows[i]) continue;
+        for (Py_ssize_t j = 0; j < n; j++) {
+            if (tall)
+                P->work[j * count + r] = P->Jn[i * n + j];
+            else
+                P->work[r * n + j] = P->Jn[i * n + j];
+        }
+        r++;
+    }
+    const Py_ssize_t wrows = tall ? count : n, wcols = tall ? n : count;
+    singular_values(P->work, wrows, wcols, P->orthogonal, P->sigma);
+    Py_ssize_t above = 0;
+    for (Py_ssize_t j = 0; j < wcols; j++) above += P->sigma[j] > tol;
+    return above == rank;
+}
+
+/* solvers/lp.py::_analyse: returns the residual (infinite when a value is not finite) and the two verdicts. */
+static double analyse(const Pair *P, double zero, double motion_rank, double force_rank, int *motion_unique, int *forces_unique) {
+    const Py_ssize_t m = P->m, n = P->n;
+    double residual = 0.0;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        double s = -P->bn[i];
+        for (Py_ssize_t j = 0; j < n; j++) s += P->Jn[i * n + j] * P->q[j];
+        P->slack[i] = s;
+        residual = greater(greater(greater(residual, -s), -P->forces[i]), fabs(P->forces[i] * s));
+    }
+    for (Py_ssize_t j = 0; j < n; j++) {
+        double e = P->g[j];
+        for (Py_ssize_t i = 0; i < m; i++) e += P->Jn[i * n + j] * P->forces[i];
+        residual = greater(residual, fabs(e));
+    }
+    int finite = 1;
+    Py_ssize_t k = 0, n_support = 0, loose_support = 0;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        P->support[i] = P->forces[i] > zero;
+        P->closed[i] = P->slack[i] <= zero;
+        P->tight[i] = P->closed[i] && !P->support[i];
+        k += P->closed[i];
+        n_support += P->support[i];
+        loose_support += P->support[i] && !P->closed[i];
+        finite = finite && isfinite(P->forces[i]) && isfinite(P->slack[i]);
+    }
+    for (Py_ssize_t j = 0; j < n; j++) finite = finite && isfinite(P->q[j]);
+    *motion_unique = *forces_unique = 0;
+    if (!finite) return INFINITY;
+    *forces_unique = k == 0 ? 1 : (k > n ? 0 : full_rank(P, P->closed, k, force_rank, k));
+    if (*forces_unique == 1 && loose_support == 0) /* supporting rows among independent closed ones */
+        *motion_unique = n_support == n;
+    else
+        *motion_unique = n_support < n ? 0 : full_rank(P, P->support, n_support, motion_rank, n);
+    return residual;
+}
+
+static PyObject *analyse_frictionless(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 14) {
+        PyErr_SetString(PyExc_TypeError,
+                        "analyse_frictionless(Jn, bn, g, q, forces, zero, motion_rank, force_rank, orthogonal, jacobi_max, "
+                        "slack, support, tight, closed) takes 14 arguments");
+        return NULL;
+    }
+    double tols[4];
+    static const char *tol_names[4] = {"zero", "motion_rank", "force_rank", "orthogonal"};
+    for (int k = 0; k < 4; k++)
+        if (take_floats(args[5 + k], &tols[k], tol_names[k]) < 0) return NULL;
+    const Py_ssize_t jacobi_max = PyLong_AsSsize_t(args[9]);
+    if (jacobi_max == -1 && PyErr_Occurred()) return NULL;
+    Buffers b = {.taken = 0};
+    Py_ssize_t shape[2] = {-1, -1};
+    PyObject *result = NULL;
+    double *work = NULL;
+    if (take_next(&b, args[0], "Jn", FLOATS, 0, 2, shape) < 0) goto done;
+    const Py_ssize_t m = shape[0], n = shape[1];
+    Py_ssize_t rows[1] = {m}, cols[1] = {n};
+    /* the vectors after Jn: the inputs, then what is filled (slack, then the three masks) */
+    static const char *names[8] = {"bn", "g", "q", "forces", "slack", "support", "tight", "closed"};
+    static const int positions[8] = {1, 2, 3, 4, 10, 11, 12, 13};
+    for (int k = 0; k < 8; k++) {
+        Py_ssize_t *size = k == 1 || k == 2 ? cols : rows;
+        const int type = k < 5 ? FLOATS : BOOLEANS;
+        if (take_next(&b, args[positions[k]], names[k], type, k >= 4, 1, size) < 0) goto done;
+    }
+    work = PyMem_RawMalloc((size_t)(m * n + n + 1) * sizeof(double)); /* W and its singular values (at most n); +1: never 0 bytes */
+    if (work == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    const Pair P = {m, n, b.views[0].buf, b.views[1].buf, b.views[2].buf, b.views[3].buf, b.views[4].buf, tols[3], jacobi_max,
+                    b.views[5].buf, b.views[6].buf, b.views[7].buf, b.views[8].buf, work, work + m * n};
+    int motion_unique, forces_unique;
+    double residual;
+    Py_BEGIN_ALLOW_THREADS
+    residual = analyse(&P, tols[0], tols[1], tols[2], &motion_unique, &forces_unique);
+    Py_END_ALLOW_THREADS
+    result = Py_BuildValue("(dii)", residual, motion_unique, forces_unique);
+done:
+    PyMem_RawFree(work);
+    release(&b);
+    return result;
+}
+
+/* ---------------------------------------------------------------- small conversions on every answer's path */
+
+static PyObject *to_world(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 7) {
+        PyErr_SetString(PyExc_TypeError, "to_world(q, c, frames, units, force, T, forces) takes 7 arguments");
+        return NULL;
+    }
+    double force;
+    if (take_floats(args[4], &force, "force") < 0) return NULL;
+    Buffers b = {.taken = 0};
+    Py_ssize_t q[1] = {-1}, c[2] = {-1, -1}, units[1] = {-1};
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "q", FLOATS, 0, 1, q) < 0 || take_next(&b, args[1], "c", FLOATS, 0, 2, c) < 0 ||
+        take_next(&b, args[3], "units", FLOATS, 0, 1, units) < 0)
+        goto done;
+    const Py_ssize_t size = q[0], m = c[0], d = c[1], k = units[0];
+    if (k == 0 || size % k != 0) {
+        PyErr_SetString(PyExc_ValueError, "q must hold whole twists: its length a multiple of units' (not 0)");
+        goto done;
+    }
+    Py_ssize_t frames[3] = {m, d, d}, T[2] = {size / k, k}, forces[2] = {m, d};
+    if (take_next(&b, args[2], "frames", FLOATS, 0, 3, frames) < 0 || take_next(&b, args[5], "T", FLOATS, 1, 2, T) < 0 ||
+        take_next(&b, args[6], "forces", FLOATS, 1, 2, forces) < 0)
+        goto done;
+    const double *qv = b.views[0].buf, *cv = b.views[1].buf, *uv = b.views[2].buf, *fv = b.views[3].buf;
+    double *Tv = b.views[4].buf, *out = b.views[5].buf;
+    /* laws/motion.py::_to_world_kernel: each twist entry times its unit; each force the frame's rows
+     * weighted by the contact-frame components, summed in order, then times the force scale. */
+    for (Py_ssize_t r = 0; r < size; r++) Tv[r] = qv[r] * uv[r % k];
+    for (Py_ssize_t i = 0; i < m; i++) {
+        for (Py_ssize_t j = 0; j < d; j++) {
+            double total = 0.0;
+            for (Py_ssize_t s = 0; s < d; s++) total += cv[i * d + s] * fv[(i * d + s) * d + j];
+            out[i * d + j] = total * force;
+        }
+    }
+    result = Py_NewRef(Py_None);
+done:
+    release(&b);
+    return result;
+}
+
+static PyObject *drop_roundoff(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "drop_roundoff(values, roundoff) takes 2 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t values[2] = {-1, -1}, roundoff[1] = {-1};
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "values", FLOATS, 1, 2, values) < 0) goto done;
+    roundoff[0] = values[1];
+    if (take_next(&b, args[1], "roundoff", FLOATS, 0, 1, roundoff) < 0) goto done;
+    double *v = b.views[0].buf;
+    const double *limit = b.views[1].buf;
+    /* check/motion.py::_drop_roundoff: entries within their column's round-off of zero set to 0 (NaN kept) */
+    for (Py_ssize_t r = 0; r < values[0] * values[1]; r++)
+        if (fabs(v[r]) <= limit[r % values[1]]) v[r] = 0.0;
+    result = Py_NewRef(Py_None);
+done:
+    release(&b);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"audit_laws", (PyCFunction)(void (*)(void))audit_laws, METH_FASTCALL,
+     "audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed, sums, u, slips, normal):\n"
+     "the audit's per-contact laws, the numba kernel's loops; fills sums (11,), u and slips (m, d), normal (m, 3).\n"
+     "See quasistatic.check.audit."},
+    {"analyse_frictionless", (PyCFunction)(void (*)(void))analyse_frictionless, METH_FASTCALL,
+     "analyse_frictionless(Jn, bn, g, q, forces, zero, motion_rank, force_rank, orthogonal, jacobi_max, slack, support, tight,\n"
+     "closed) -> (residual, motion_unique, forces_unique): the frictionless LP pair's analysis, the numba kernel's loops;\n"
+     "fills slack (m,) float64 and the three masks (m,) bool. See quasistatic.solvers.lp."},
+    {"to_world", (PyCFunction)(void (*)(void))to_world, METH_FASTCALL,
+     "to_world(q, c, frames, units, force, T, forces): physical twists and world forces, the numba kernel's loops;\n"
+     "fills T (bodies, k) and forces (m, d). See quasistatic.laws.motion.to_world."},
+    {"drop_roundoff", (PyCFunction)(void (*)(void))drop_roundoff, METH_FASTCALL,
+     "drop_roundoff(values, roundoff): entries of values (rows, c) within roundoff[j] of zero set to 0, in place.\n"
+     "See quasistatic.check.motion."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module_definition = {
+    PyModuleDef_HEAD_INIT, "quasistatic._kernels", "The audit's laws and the frictionless LP's analysis compiled (no numpy headers): see quasistatic.compiled.",
+    -1, methods, NULL, NULL, NULL, NULL,
+};
+
+PyMODINIT_FUNC PyInit__kernels(void) { return PyModule_Create(&module_definition); }
