@@ -165,7 +165,8 @@ contacts:
 
 
 def _run(*arguments: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([str(Path(sys.executable).with_name("quasistatic")), *arguments], capture_output=True, text=True, timeout=120, check=False)
+    command = [str(Path(sys.executable).with_name("quasistatic")), *arguments]  # the venv's script, found without PATH
+    return subprocess.run(command, capture_output=True, text=True, timeout=120, check=False)
 
 
 def test_the_plan_command_prints_the_plan_as_json(tmp_path: Path) -> None:
