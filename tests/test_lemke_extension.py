@@ -1,11 +1,12 @@
 """The compiled extension ``quasistatic._lemke``: Lemke's method in C, pivot for pivot the numba kernel's.
 
-It runs wherever numba is missing (the default install), so it must make the
-kernel's choices exactly: the same status, pivot count and final basis, and the
-same point to round-off, on well-posed, degenerate (many ties), ray-ending and
-pivot-limited LCPs, and on the LCPs of the benchmark scenes. The reference is the
-numba kernel when numba is installed, else the numpy twin (itself checked
-against the kernel in ``test_fast.py``).
+It runs wherever it was built: called from Python where numba is missing (the
+default install), and from compiled kernels through its plain C entry point where
+numba is installed. So it must make the kernel's choices exactly: the same status,
+pivot count and final basis, and the same point to round-off, on well-posed,
+degenerate (many ties), ray-ending and pivot-limited LCPs, and on the LCPs of the
+benchmark scenes, by either door. The reference is numba's own kernel when numba
+is installed, else the numpy twin (itself checked against the kernel in ``test_fast.py``).
 """
 
 from __future__ import annotations
@@ -33,7 +34,11 @@ TOL = 1e-11
 NO_EXTENSION = "QUASISTATIC_NO_EXTENSION"  # set to 1 where an install without a C compiler is intended
 
 needs_extension = pytest.mark.skipif(not compiled.HAVE_EXTENSION, reason=f"built without the C extension ({NO_EXTENSION} set)")
-REFERENCE: Callable[..., Any] = lemke if HAVE_NUMBA else lemke_module._lemke_numpy
+REFERENCE: Callable[..., Any] = lemke_module.numba_lemke if HAVE_NUMBA else lemke_module._lemke_numpy
+# The extension's two doors: its Python function, and (numba installed) its C entry point called by compiled ``lemke``.
+DOORS = [pytest.param(compiled.lemke, id="python-api")]
+if HAVE_NUMBA:
+    DOORS.append(pytest.param(lemke, id="from-numba"))
 
 
 def test_the_extension_was_built() -> None:
@@ -75,25 +80,27 @@ def _random_lcps(rng: np.random.Generator, count: int) -> Iterator[tuple[str, np
 
 
 @needs_extension
-def test_the_extension_pivots_as_the_kernel_on_random_lcps() -> None:
+@pytest.mark.parametrize("door", DOORS)
+def test_the_extension_pivots_as_the_kernel_on_random_lcps(door: Callable[..., Any]) -> None:
     rng = np.random.default_rng(3)
     seen: set[int] = set()
     for _, M, q in _random_lcps(rng, 400):
         d = np.ones(q.shape[0])
         for max_pivots in (1000, 3):
             want = REFERENCE(M, q, d, max_pivots, TOL)
-            _same_run(compiled.lemke(M, q, d, max_pivots, TOL), want)
+            _same_run(door(M, q, d, max_pivots, TOL), want)
             seen.add(int(want[0]))
     assert seen == {SOLUTION, RAY, PIVOT_LIMIT}  # every ending was met
 
 
 @needs_extension
+@pytest.mark.parametrize("door", DOORS)
 @pytest.mark.parametrize("n", [0, 1])
-def test_the_extension_on_the_smallest_lcps(n: int) -> None:
+def test_the_extension_on_the_smallest_lcps(n: int, door: Callable[..., Any]) -> None:
     for q in ([], [2.0]) if n == 0 else ([-2.0], [2.0], [0.0]):
         for M in (np.full((n, n), 3.0), np.full((n, n), -1.0)):
             args = (M, np.array(q[:n], float), np.full(n, 0.5), 10, TOL)
-            _same_run(compiled.lemke(*args), REFERENCE(*args))
+            _same_run(door(*args), REFERENCE(*args))
 
 
 def test_the_numpy_twins_tie_break_is_the_kernels() -> None:
@@ -129,11 +136,12 @@ def _bench_lcps() -> Iterator[tuple[str, np.ndarray, np.ndarray]]:
 
 
 @needs_extension
-def test_the_extension_pivots_as_the_kernel_on_the_bench_lcps() -> None:
+@pytest.mark.parametrize("door", DOORS)
+def test_the_extension_pivots_as_the_kernel_on_the_bench_lcps(door: Callable[..., Any]) -> None:
     for name, M, q in _bench_lcps():
         d = np.ones(q.shape[0])
         cap = lcp.PIVOTS_PER_ROW * q.shape[0]
-        got, want = compiled.lemke(M, q, d, cap, TOL), REFERENCE(M, q, d, cap, TOL)
+        got, want = door(M, q, d, cap, TOL), REFERENCE(M, q, d, cap, TOL)
         assert int(want[2]) > 0, name  # Lemke pivots on every one
         _same_run(got, want)
 
@@ -151,6 +159,14 @@ def test_the_extension_pivots_as_the_kernel_on_the_bench_lcps() -> None:
 def test_bad_shapes_raise(M: np.ndarray, q: np.ndarray, d: np.ndarray, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         compiled.lemke(M, q, d, 10, TOL)
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="the compiled door needs numba")
+@pytest.mark.parametrize(("M", "d"), [(np.zeros((3, 2)), np.ones(3)), (np.zeros((2, 3)), np.ones(3)), (np.zeros((3, 3)), np.ones(2))])
+def test_bad_shapes_raise_through_the_compiled_door(M: np.ndarray, d: np.ndarray) -> None:
+    """The C entry point trusts its sizes: the compiled ``lemke`` checks them first (never an out-of-bounds read)."""
+    with pytest.raises(ValueError, match=r"M must be \(n, n\) and d \(n,\)"):
+        lemke(M, -np.ones(3), d, 10, TOL)
 
 
 @needs_extension
@@ -176,9 +192,10 @@ def test_bad_output_buffers_raise() -> None:
 
 
 @needs_extension
+@pytest.mark.parametrize("door", DOORS)
 @pytest.mark.parametrize("where", ["M", "q", "d", "all"])
 @pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
-def test_nan_and_inf_end_within_the_pivot_limit(where: str, value: float) -> None:
+def test_nan_and_inf_end_within_the_pivot_limit(where: str, value: float, door: Callable[..., Any]) -> None:
     """Non-finite data give a meaningless but bounded run (callers audit every answer): no crash, no endless loop."""
     rng = np.random.default_rng(0)
     A = rng.normal(size=(6, 6))
@@ -189,7 +206,7 @@ def test_nan_and_inf_end_within_the_pivot_limit(where: str, value: float) -> Non
         q[1] = value
     if where in ("d", "all"):
         d[2] = value
-    status, z, pivots, basis = compiled.lemke(M, q, d, 40, TOL)
+    status, z, pivots, basis = door(M, q, d, 40, TOL)
     assert status in (SOLUTION, RAY, PIVOT_LIMIT) and 0 <= pivots <= 40
     assert z.shape == (6,) and set(basis.tolist()) <= set(range(13))  # w, z or z0 in every row
 
@@ -207,6 +224,35 @@ def test_without_numba_the_default_install_runs_the_extension() -> None:
         assert module.lemke is expected, module.lemke
         status, z, pivots, _ = module.lemke(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), np.ones(2), 10, 1e-11)
         assert status == module.SOLUTION and np.allclose(z, [4 / 3, 7 / 3])
+        """
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="numba's kernels only")
+def test_with_numba_but_no_extension_the_kernels_call_numbas_lemke() -> None:
+    """numba installed, the extension not built: compiled callers reach numba's own kernel through the same C name.
+
+    The kernels cached on disk by this session's processes (which call the extension) are loaded here with the
+    extension gone: the name must still be bound (to numba's kernel as a ``cfunc``), or loading them would crash.
+    """
+    code = textwrap.dedent(
+        """
+        import sys
+        sys.modules["quasistatic._lemke"] = None  # as if no C compiler had built it
+        import numpy as np
+        import quasistatic as qs
+        from quasistatic import compiled
+        from quasistatic.solvers.numerics import lemke as module
+        from quasistatic.tools.bench.families import grasp_2d
+        assert not compiled.HAVE_EXTENSION
+        rng = np.random.default_rng(1)
+        for n in (0, 3, 12):
+            A = rng.normal(size=(n, n))
+            args = (A @ A.T + np.eye(n), rng.normal(size=n), np.ones(n), 100, 1e-11)
+            got, want = module.lemke(*args), module.numba_lemke(*args)
+            assert (got[0], got[2]) == (want[0], want[2]) and (got[3] == want[3]).all() and (got[1] == want[1]).all()
+        assert qs.solve(qs.assemble(grasp_2d(4, 0)), method="fast").status == "solved"
         """
     )
     subprocess.run([sys.executable, "-c", code], check=True)

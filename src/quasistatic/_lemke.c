@@ -1,10 +1,13 @@
-/* Compiled kernels for installs without numba, each making the numba kernel's choices:
+/* Compiled kernels, each making the numba kernel's choices:
  *
  *   lemke(M, q, d, max_pivots, tol, z, basis) -> (status, pivots)
- *       Lemke's method with lexicographic anti-cycling, solvers/numerics/lemke.py::lemke pivot for
- *       pivot. M: (n, n) float64, q and d: (n,) float64; z: (n,) float64 and basis: (n,) int64
- *       are filled. NaN never qualifies in a comparison, so NaN data end on a ray or at
+ *       Lemke's method with lexicographic anti-cycling, solvers/numerics/lemke.py's numba kernel
+ *       pivot for pivot. M: (n, n) float64, q and d: (n,) float64; z: (n,) float64 and basis: (n,)
+ *       int64 are filled. NaN never qualifies in a comparison, so NaN data end on a ray or at
  *       max_pivots, never in a loop or out of bounds.
+ *   lemke_address
+ *       The address of quasistatic_lemke, the same method on raw pointers (no Python objects):
+ *       the numba install's kernels call it from compiled code.
  *   fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces) -> None
  *       The fixed-mode laws at x, laws/fixed_modes.py::system loop for loop (the 3-D fast
  *       path's Newton iterations call it); the last three arrays are filled.
@@ -30,13 +33,12 @@ typedef struct {
     Py_ssize_t n;
     const double *M, *q, *d;
     double *Binv, *xB, *col, *values;
-    int64_t *basis;
-    Py_ssize_t *rows;
+    int64_t *basis, *rows;
 } Lemke;
 
 /* Eliminate the entering column on `row`, in the kernel's arithmetic: the pivot row times the
  * reciprocal of the pivot, then every row minus its factor (the column, 0 on `row`) times it. */
-static void pivot(Lemke *s, Py_ssize_t row) {
+static void pivot(Lemke *s, int64_t row) {
     const Py_ssize_t n = s->n;
     const double scale = 1.0 / s->col[row];
     double *restrict factors = s->col; /* the column is not needed after this pivot */
@@ -78,7 +80,7 @@ static Py_ssize_t keep_smallest(Lemke *s, Py_ssize_t count, Py_ssize_t column, d
     const Py_ssize_t n = s->n;
     double smallest = INFINITY;
     for (Py_ssize_t k = 0; k < count; k++) {
-        const Py_ssize_t i = s->rows[k];
+        const int64_t i = s->rows[k];
         s->values[k] = (column < 0 ? s->xB[i] : s->Binv[column * n + i]) / s->col[i];
         if (s->values[k] < smallest) smallest = s->values[k];
     }
@@ -91,7 +93,7 @@ static Py_ssize_t keep_smallest(Lemke *s, Py_ssize_t count, Py_ssize_t column, d
 
 /* The leaving row by the lexicographic minimum ratio; -1 when no entry of the entering
  * column is above the pivot tolerance (relative to its largest magnitude). */
-static Py_ssize_t ratio_test(Lemke *s, int64_t artificial, double tol) {
+static int64_t ratio_test(Lemke *s, int64_t artificial, double tol) {
     const Py_ssize_t n = s->n;
     double largest = 1.0;
     for (Py_ssize_t i = 0; i < n; i++)
@@ -114,18 +116,18 @@ static Py_ssize_t ratio_test(Lemke *s, int64_t artificial, double tol) {
 
 /* The first pivot's row: z0 enters (column -d) and the row of the most negative q_i / d_i
  * leaves; ties go to the lexicographically smallest row of [q, I] / d, the largest index. */
-static Py_ssize_t first_row(const Lemke *s, double tol) {
+static int64_t first_row(const Lemke *s, double tol) {
     double smallest = INFINITY;
     for (Py_ssize_t i = 0; i < s->n; i++)
         if (s->q[i] / s->d[i] < smallest) smallest = s->q[i] / s->d[i];
-    Py_ssize_t row = 0;
+    int64_t row = 0;
     for (Py_ssize_t i = 0; i < s->n; i++)
         if (s->q[i] / s->d[i] <= smallest + tol * (1.0 + fabs(smallest))) row = i;
     return row;
 }
 
 /* Lemke's path from the artificial start; the state's basis and x_B hold the end point. */
-static int run(Lemke *s, long long max_pivots, double tol, long long *pivots) {
+static int run(Lemke *s, int64_t max_pivots, double tol, int64_t *pivots) {
     const Py_ssize_t n = s->n;
     const int64_t artificial = 2 * (int64_t)n;
     for (Py_ssize_t i = 0; i < n; i++) {
@@ -133,7 +135,7 @@ static int run(Lemke *s, long long max_pivots, double tol, long long *pivots) {
         s->xB[i] = s->q[i];
         s->col[i] = -s->d[i];
     }
-    Py_ssize_t row = first_row(s, tol);
+    int64_t row = first_row(s, tol);
     int64_t entering = artificial;
     *pivots = 0;
     for (;;) {
@@ -148,6 +150,27 @@ static int run(Lemke *s, long long max_pivots, double tol, long long *pivots) {
         row = ratio_test(s, artificial, tol);
         if (row < 0) return RAY;
     }
+}
+
+/* Lemke's method on raw arrays, no Python objects: the entry point numba kernels call (its address is the
+ * module's lemke_address). M (n, n) row-major, q and d (n,); fills z (n,), basis (n,) and *pivots; work
+ * (n (n + 3) doubles) and rows (n int64) are scratch space. The caller checks the sizes. Returns the status. */
+int64_t quasistatic_lemke(int64_t n, const double *M, const double *q, const double *d, int64_t max_pivots, double tol,
+                          double *z, int64_t *basis, int64_t *pivots, double *work, int64_t *rows) {
+    Lemke s = {(Py_ssize_t)n, M, q, d, work, work + n * n, work + n * n + n, work + n * n + 2 * n, basis, rows};
+    int status = SOLUTION;
+    int needs_pivots = 0;
+    *pivots = 0;
+    for (int64_t i = 0; i < n; i++) {
+        basis[i] = i;
+        z[i] = 0.0;
+        if (!(q[i] >= 0.0)) needs_pivots = 1; /* as np.min(q) >= 0 fails on NaN */
+    }
+    if (!needs_pivots) return status;
+    status = run(&s, max_pivots, tol, pivots);
+    for (int64_t i = 0; i < n; i++)
+        if (basis[i] >= n && basis[i] < 2 * n) z[basis[i] - n] = s.xB[i];
+    return status;
 }
 
 /* ---------------------------------------------------------------- buffers and the module */
@@ -224,34 +247,20 @@ static PyObject *lemke(PyObject *module, PyObject *const *args, Py_ssize_t nargs
         PyErr_NoMemory();
         goto done;
     }
-    const double *M = views[0].buf;
-    double *z = views[3].buf;
-    int64_t *basis = views[4].buf;
     /* B^-1, x_B, the column and the ratio values; +1 so that n = 0 asks for a byte */
     memory = PyMem_RawMalloc(((size_t)n * ((size_t)n + 3) + 1) * sizeof(double));
-    Py_ssize_t *rows = PyMem_RawMalloc(((size_t)n + 1) * sizeof(Py_ssize_t));
+    int64_t *rows = PyMem_RawMalloc(((size_t)n + 1) * sizeof(int64_t));
     if (memory == NULL || rows == NULL) {
         PyMem_RawFree(rows);
         PyErr_NoMemory();
         goto done;
     }
-    Lemke s = {n, M, views[1].buf, views[2].buf, memory, memory + n * n, memory + n * n + n, memory + n * n + 2 * n, basis, rows};
-    int status = SOLUTION;
-    long long pivots = 0;
+    int64_t status, pivots;
     Py_BEGIN_ALLOW_THREADS
-    int needs_pivots = 0;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        basis[i] = i;
-        if (!(s.q[i] >= 0.0)) needs_pivots = 1; /* as np.min(q) >= 0 fails on NaN */
-    }
-    if (needs_pivots) status = run(&s, max_pivots, tol, &pivots);
-    for (Py_ssize_t i = 0; i < n; i++) z[i] = 0.0;
-    if (needs_pivots)
-        for (Py_ssize_t i = 0; i < n; i++)
-            if (basis[i] >= n && basis[i] < 2 * (int64_t)n) z[basis[i] - n] = s.xB[i];
+    status = quasistatic_lemke(n, views[0].buf, views[1].buf, views[2].buf, max_pivots, tol, views[3].buf, views[4].buf, &pivots, memory, rows);
     Py_END_ALLOW_THREADS
     PyMem_RawFree(rows);
-    result = Py_BuildValue("(iL)", status, pivots);
+    result = Py_BuildValue("(LL)", (long long)status, (long long)pivots);
 done:
     PyMem_RawFree(memory);
     for (int k = 0; k < taken; k++) PyBuffer_Release(&views[k]);
@@ -414,4 +423,14 @@ static struct PyModuleDef module_definition = {
     PyModuleDef_HEAD_INIT, "quasistatic._lemke", "Lemke's method and the fixed-mode laws compiled (no numpy headers): see quasistatic.compiled.", -1, methods, NULL, NULL, NULL, NULL,
 };
 
-PyMODINIT_FUNC PyInit__lemke(void) { return PyModule_Create(&module_definition); }
+PyMODINIT_FUNC PyInit__lemke(void) {
+    PyObject *module = PyModule_Create(&module_definition);
+    if (module == NULL) return NULL;
+    PyObject *address = PyLong_FromVoidPtr((void *)quasistatic_lemke);
+    if (address == NULL || PyModule_AddObject(module, "lemke_address", address) < 0) {
+        Py_XDECREF(address);
+        Py_DECREF(module);
+        return NULL;
+    }
+    return module;
+}

@@ -6,7 +6,9 @@ and runs the numpy twin instead. ``HAVE_EXTENSION`` says whether it was built.
 :func:`lemke` and :func:`fixed_mode_system` take the arguments of the numba
 kernels ``solvers/numerics/lemke.py::lemke`` and ``laws/fixed_modes.py::system``,
 make them C-contiguous, and return what the kernels return; the C code makes the
-kernels' choices in the kernels' order of arithmetic.
+kernels' choices in the kernels' order of arithmetic. ``LEMKE_ADDRESS`` is where the
+same Lemke's method starts as a plain C function on raw pointers, which the numba
+install's kernels call (``solvers/numerics/lemke.py``).
 """
 
 from __future__ import annotations
@@ -21,9 +23,11 @@ try:  # by name: a typed import would make mypy read the whole package from this
 except ImportError:  # built without a C compiler: callers fall back to numpy
     extension = None
 
-__all__ = ["HAVE_EXTENSION", "lemke", "fixed_mode_system"]
+__all__ = ["HAVE_EXTENSION", "LEMKE_ADDRESS", "lemke", "fixed_mode_system"]
 
 HAVE_EXTENSION = extension is not None
+# quasistatic_lemke(n, M, q, d, max_pivots, tol, z, basis, pivots, work, rows) -> status; 0 when not built
+LEMKE_ADDRESS: int = extension.lemke_address if HAVE_EXTENSION else 0
 
 
 def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
