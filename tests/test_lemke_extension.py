@@ -300,3 +300,79 @@ def test_the_extensions_fixed_mode_laws_check_their_arrays() -> None:
         compiled.fixed_mode_system(J, b, mu, g, x[: n + 1], np.full_like(kind, fixed_modes.ROLLING), column, n)
     with pytest.raises(ValueError, match="is not 0, 1 or 2"):
         compiled.fixed_mode_system(J, b, mu, g, x, np.full_like(kind, 7), column, n)
+
+
+# --------------------------------------------------------------------------- the fast path's whole kernel in C
+
+
+def _split_lcp_cases() -> Iterator[tuple[str, lcp.LemkeInputs]]:
+    """The fast kernel's inputs on the bench families (2-D, 3-D exact and pyramid cones, frictionless) and random 3-D scenes.
+
+    Among them every ending of the kernel: Lemke's first motion, a ray, Newton's method (first, and after a
+    re-alignment: random #28), a ray after re-alignment (grasp-3d 5 #2), and re-alignment run to its limit
+    without converging (grasp-3d 5 #4, random #287).
+    """
+    from random_scenes import random_scene
+
+    rows = [("grasp-2d", 2), ("grasp-2d", 4), ("grasp-2d", 8), ("grasp-3d", 4), ("grasp-3d", 6), ("grasp-3d", 8)]
+    rows += [("grasp-2d-nf", 8), ("box-push", 4), ("box-push-nf", 16), ("pile-nf", 10)]
+    cases = [(family, size, instance) for family, size in rows for instance in range(3)] + [("grasp-3d", 5, 2), ("grasp-3d", 5, 4)]
+    for family, size, instance in cases:
+        yield f"{family} {size} #{instance}", qs.assemble(FAMILIES[family].make(size, instance)).derived("fast", lcp.LemkeInputs)
+    for seed in [*range(30), 28, 287]:
+        friction = "exact" if seed % 3 else "pyramid:4"
+        yield f"random 3-D #{seed} {friction}", qs.assemble(random_scene(3, seed, friction)).derived("fast", lcp.LemkeInputs)
+
+
+def _kernel_arguments(data: lcp.LemkeInputs) -> tuple[Any, ...]:
+    tolerances = (lcp.FRICTION_ALIGNMENT, lcp.MODE_SPEED, lcp.PIVOT, lcp.BASIS_FEASIBILITY, lcp.PIVOTS_PER_ROW)
+    return (data.J, data.b, data.mu, data.g, data.frictional, data.base, data.exact, lcp.REALIGNMENTS, *tolerances)
+
+
+@needs_extension
+@pytest.mark.skipif(not HAVE_NUMBA, reason="the reference is the numba kernel")
+def test_the_extensions_split_lcp_kernel_is_the_numba_kernels() -> None:
+    """The same status, stage, pivots and re-alignments, and the same motion to 1e-9 relative, on every case; every stage met."""
+    stages: set[tuple[int, int]] = set()
+    for name, data in _split_lcp_cases():
+        arguments = _kernel_arguments(data)
+        got, want = lcp._solve_split_lcp_compiled(*arguments), lcp.solve_split_lcp(*arguments)
+        assert [int(v) for v in (got[0], got[1], got[4], got[5])] == [int(v) for v in (want[0], want[1], want[4], want[5])], name
+        for g, w in ((got[2], want[2]), (got[3], want[3])):
+            np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(w).max(initial=0.0))), err_msg=name)
+        stages.add((int(want[0]), int(want[1])))
+    assert {(SOLUTION, 0), (SOLUTION, 2), (RAY, 0), (RAY, 1), (lcp.NOT_CONVERGED, 2)} <= stages, stages
+
+
+@needs_extension
+def test_the_extensions_split_lcp_kernel_checks_its_arrays() -> None:
+    data = qs.assemble(FAMILIES["grasp-3d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
+    arguments = list(_kernel_arguments(data))
+    bad = {
+        0: (data.J[0], "J must have shape"),
+        1: (data.b[:-1], r"b must have shape"),
+        3: (data.g[:-1], r"g must have shape"),
+        4: (np.array([0, 99]), "is not a contact index"),
+    }
+    for index, (value, message) in bad.items():
+        with pytest.raises(ValueError, match=message):
+            lcp._solve_split_lcp_compiled(*arguments[:index], value, *arguments[index + 1 :])
+    planar = qs.assemble(FAMILIES["grasp-2d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
+    with pytest.raises(ValueError, match="exact cones need 3-D contacts"):
+        lcp._solve_split_lcp_compiled(*_kernel_arguments(planar)[:6], True, *_kernel_arguments(planar)[7:])
+
+
+@needs_extension
+@pytest.mark.parametrize("value", [np.nan, np.inf])
+def test_the_extensions_split_lcp_kernel_ends_on_non_finite_data(value: float) -> None:
+    """NaN or inf in the laws: a bounded run with some status (the caller audits every answer), never a hang or a crash."""
+    data = qs.assemble(FAMILIES["grasp-3d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
+    for field in ("J", "b", "g", "mu"):
+        arguments = list(_kernel_arguments(data))
+        index = ("J", "b", "mu", "g").index(field)
+        spoiled = arguments[index].copy()
+        spoiled.flat[1] = value
+        arguments[index] = spoiled
+        status, stage, q, c, pivots, realignments = lcp._solve_split_lcp_compiled(*arguments)
+        assert status in (SOLUTION, RAY, PIVOT_LIMIT, lcp.NOT_CONVERGED) and 0 <= realignments <= lcp.REALIGNMENTS
+        assert q.shape == (data.J.shape[2],) and c.shape == data.J.shape[:2]

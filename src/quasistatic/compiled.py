@@ -14,7 +14,7 @@ install's kernels call (``solvers/numerics/lemke.py``).
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -23,7 +23,7 @@ try:  # by name: a typed import would make mypy read the whole package from this
 except ImportError:  # built without a C compiler: callers fall back to numpy
     extension = None
 
-__all__ = ["HAVE_EXTENSION", "LEMKE_ADDRESS", "lemke", "fixed_mode_system"]
+__all__ = ["HAVE_EXTENSION", "LEMKE_ADDRESS", "lemke", "fixed_mode_system", "solve_split_lcp", "NewtonTolerances"]
 
 HAVE_EXTENSION = extension is not None
 # quasistatic_lemke(n, M, q, d, max_pivots, tol, z, basis, pivots, work, rows) -> status; 0 when not built
@@ -87,3 +87,59 @@ def fixed_mode_system(
         forces,
     )
     return residual, jacobian, forces
+
+
+class NewtonTolerances(NamedTuple):
+    """The tolerances of the fast path's Newton iterations (``quasistatic.tolerances``' values, passed in by the caller)."""
+
+    cone_roundoff: float
+    damping: float
+    stop: float
+
+
+def solve_split_lcp(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    frictional: np.ndarray,
+    base: np.ndarray,
+    exact: bool,
+    max_realignments: int,
+    dissipation_tol: float,
+    mode_tol: float,
+    pivot_tol: float,
+    feasibility_tol: float,
+    pivots_per_row: int,
+    newton: NewtonTolerances,
+) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
+    """The fast path's kernel in C: ``(status, stage, q, c, pivots, realignments)`` as ``solvers/numerics/lcp.py::solve_split_lcp``.
+
+    Arguments as there (``J`` (m, d, n), ``b`` (m, d), ``mu`` (m,), ``g`` (n,), ``frictional`` (f,) int,
+    ``base`` (K,)), and the Newton iterations' tolerances.
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree, a frictional index is not a contact's, or ``exact`` is asked of 2-D contacts.
+    """
+    if J.ndim != 3:
+        raise ValueError(f"J must have shape (m, d, n), not {J.shape}")
+    m, d, n = J.shape
+    q, c = np.empty(n), np.empty((m, d))
+    status, stage, pivots, realignments = extension.solve_split_lcp(
+        *(np.ascontiguousarray(a, np.float64) for a in (J, b, mu, g)),
+        np.ascontiguousarray(frictional, np.int64),
+        np.ascontiguousarray(base, np.float64),
+        exact,
+        max_realignments,
+        dissipation_tol,
+        mode_tol,
+        pivot_tol,
+        feasibility_tol,
+        pivots_per_row,
+        *newton,
+        q,
+        c,
+    )
+    return status, stage, q, c, pivots, realignments
