@@ -46,7 +46,8 @@ static void pivot(Lemke *s, int64_t row) {
     for (Py_ssize_t j = 0; j < n; j++) {
         double *restrict column = s->Binv + j * n;
         const double value = column[row] * scale;
-        for (Py_ssize_t i = 0; i < n; i++) column[i] -= factors[i] * value;
+        if (value != 0.0) /* B^-1 fills in over the pivots: x - 0 y is x for finite y */
+            for (Py_ssize_t i = 0; i < n; i++) column[i] -= factors[i] * value;
         column[row] = value;
     }
     const double value = s->xB[row] * scale;
@@ -66,6 +67,7 @@ static void entering_column(Lemke *s, int64_t entering) {
     for (Py_ssize_t i = 0; i < n; i++) col[i] = 0.0;
     for (Py_ssize_t j = 0; j < n; j++) {
         const double a = entering < 2 * n ? s->M[j * n + (entering - n)] : s->d[j];
+        if (a == 0.0) continue; /* the split LCP's columns are mostly zeros; x + 0 y is x for finite y */
         const double *restrict column = s->Binv + j * n;
         for (Py_ssize_t i = 0; i < n; i++) col[i] += column[i] * a;
     }
