@@ -11,10 +11,12 @@ is installed, else the numpy twin (itself checked against the kernel in ``test_f
 
 from __future__ import annotations
 
+import importlib
 import os
 import subprocess
 import sys
 import textwrap
+import types
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -52,6 +54,18 @@ def test_the_extension_was_built() -> None:
     if os.environ.get(NO_EXTENSION) == "1":
         pytest.skip(f"{NO_EXTENSION}=1: an install without the C extension is intended")
     assert compiled.HAVE_EXTENSION, "quasistatic._lemke did not build: is there a C compiler and the Python headers?"
+
+
+def test_an_extension_built_from_an_older_source_is_not_used(monkeypatch: pytest.MonkeyPatch) -> None:
+    """An editable install keeps the .so of an older ``_lemke.c`` until rebuilt: it is left unused, with a warning."""
+    monkeypatch.setitem(sys.modules, "quasistatic._lemke", types.ModuleType("quasistatic._lemke"))  # no api_version
+    try:
+        with pytest.warns(RuntimeWarning, match="built from an older source"):
+            importlib.reload(compiled)
+        assert not compiled.HAVE_EXTENSION and compiled.LEMKE_ADDRESS == 0
+    finally:
+        monkeypatch.undo()
+        importlib.reload(compiled)
 
 
 def _same_run(got: tuple, want: tuple) -> None:

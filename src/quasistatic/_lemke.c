@@ -5,9 +5,13 @@
  *       pivot for pivot. M: (n, n) float64, q and d: (n,) float64; z: (n,) float64 and basis: (n,)
  *       int64 are filled. NaN never qualifies in a comparison, so NaN data end on a ray or at
  *       max_pivots, never in a loop or out of bounds.
+ *   solve_split_lcp(J, b, mu, g, frictional, base, exact, ..., q, c) -> (status, stage, pivots, realignments)
+ *       The fast path's whole kernel, solvers/numerics/lcp.py::solve_split_lcp step for step.
  *   lemke_address
  *       The address of quasistatic_lemke, the same method on raw pointers (no Python objects):
  *       the numba install's kernels call it from compiled code.
+ *   api_version
+ *       2; quasistatic/compiled.py runs without a .so built from an older source.
  *   fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces) -> None
  *       The fixed-mode laws at x, laws/fixed_modes.py::system loop for loop (the 3-D fast
  *       path's Newton iterations call it); the last three arrays are filled.
@@ -940,6 +944,11 @@ PyMODINIT_FUNC PyInit__lemke(void) {
     PyObject *address = PyLong_FromVoidPtr((void *)quasistatic_lemke);
     if (address == NULL || PyModule_AddObject(module, "lemke_address", address) < 0) {
         Py_XDECREF(address);
+        Py_DECREF(module);
+        return NULL;
+    }
+    /* what quasistatic/compiled.py checks: a .so built from an older source is not used */
+    if (PyModule_AddIntConstant(module, "api_version", 2) < 0) {
         Py_DECREF(module);
         return NULL;
     }

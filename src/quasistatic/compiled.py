@@ -14,13 +14,21 @@ install's kernels call (``solvers/numerics/lemke.py``).
 from __future__ import annotations
 
 import importlib
+import warnings
 from typing import Any, NamedTuple
 
 import numpy as np
 
+API_VERSION = 2  # the _lemke.c these wrappers call (its module attribute api_version)
+
 try:  # by name: a typed import would make mypy read the whole package from this leaf
     extension: Any = importlib.import_module("quasistatic._lemke")
 except ImportError:  # built without a C compiler: callers fall back to numpy
+    extension = None
+if extension is not None and getattr(extension, "api_version", 1) != API_VERSION:
+    # An editable install keeps the .so of an older _lemke.c until it is built again: run without it, and say so.
+    message = "quasistatic._lemke was built from an older source; run `pip install -e .` again to rebuild it"
+    warnings.warn(message, RuntimeWarning, stacklevel=1)
     extension = None
 
 __all__ = ["HAVE_EXTENSION", "LEMKE_ADDRESS", "lemke", "fixed_mode_system", "solve_split_lcp", "NewtonTolerances"]
