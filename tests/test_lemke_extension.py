@@ -367,6 +367,7 @@ def test_the_extensions_split_lcp_kernel_checks_its_arrays() -> None:
         1: (data.b[:-1], r"b must have shape"),
         3: (data.g[:-1], r"g must have shape"),
         4: (np.array([0, 99]), "is not a contact index"),
+        5: (data.base[None], "frictional and base must be one-dimensional"),
     }
     for index, (value, message) in bad.items():
         with pytest.raises(ValueError, match=message):

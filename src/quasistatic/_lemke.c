@@ -813,10 +813,72 @@ static SplitResult split_lcp(Split *s, int exact, int64_t max_realignments, doub
     }
 }
 
+enum { LARGEST_SPLIT = 1 << 20 }; /* LCP rows and Newton unknowns at most: keeps every size below in size_t */
+
+/* Lay the scratch arrays of s out in `memory` (doubles) and `integers` (int64, 3 N + 2 m of them) and set the covering
+ * vector to ones; with memory NULL, only count. Returns the doubles used. */
+static size_t lay_out(Split *s, double *memory, int64_t *integers) {
+    const Py_ssize_t m = s->m, n = s->n, f = s->f, K = s->K, t = s->d - 1, N = s->N, S = n + 3 * m;
+    size_t used = 0;
+#define TAKE(field, count) (s->field = memory ? memory + used : NULL, used += (size_t)(count))
+    TAKE(Jn, m * n), TAKE(bn, m), TAKE(Jt, f * t * n), TAKE(bt, f * t), TAKE(mu_f, f), TAKE(offsets, f), TAKE(edges, f * K * t);
+    TAKE(M, N * N), TAKE(qv, N), TAKE(ones, N), TAKE(z, N), TAKE(work, N * (N + 3)), TAKE(A, N * N), TAKE(rhs, N);
+    TAKE(U, N > S ? N * N : S * S), TAKE(solution, N);
+    TAKE(x, S), TAKE(trial, S), TAKE(residual, S), TAKE(jacobian, S * S), TAKE(r_trial, S), TAKE(j_trial, S * S);
+    TAKE(forces, 3 * m), TAKE(f_trial, 3 * m), TAKE(normal, S * S), TAKE(gradient, S), TAKE(step, S), TAKE(newton_q, n);
+#undef TAKE
+    if (memory == NULL) return used + 1; /* + 1: never a request for no bytes */
+    s->basis = integers, s->rows = integers + N, s->basic = integers + 2 * N, s->kind = integers + 3 * N, s->column = integers + 3 * N + m;
+    for (Py_ssize_t i = 0; i < N; i++) s->ones[i] = 1.0;
+    return used;
+}
+
 /* Take argument `index` as a float, into *value (-1 with the exception set when it is not one). */
 static int take_double(PyObject *const *args, int index, double *value) {
     *value = PyFloat_AsDouble(args[index]);
     return *value == -1.0 && PyErr_Occurred() ? -1 : 0;
+}
+
+/* The flags, counts and tolerances of solve_split_lcp's arguments into s (-1 with the exception set). */
+static int take_options(PyObject *const *args, Split *s, int *exact, long long *max_realignments) {
+    *exact = PyObject_IsTrue(args[6]);
+    *max_realignments = PyLong_AsLongLong(args[7]);
+    const long long pivots_per_row = PyLong_AsLongLong(args[12]);
+    if (*exact < 0 || ((*max_realignments == -1 || pivots_per_row == -1) && PyErr_Occurred())) return -1;
+    s->pivots_per_row = pivots_per_row;
+    if (take_double(args, 8, &s->dissipation_tol) || take_double(args, 9, &s->mode_tol) || take_double(args, 10, &s->pivot_tol) ||
+        take_double(args, 11, &s->feasibility_tol) || take_double(args, 13, &s->cone_roundoff) ||
+        take_double(args, 14, &s->newton_damping) || take_double(args, 15, &s->newton_stop))
+        return -1;
+    return 0;
+}
+
+/* The sizes m, d, n (from J), f (frictional) and K (base) into s; ValueError where J, frictional or base has the wrong
+ * number of dimensions, or exact cones are asked of 2-D contacts. */
+static int take_sizes(PyObject *const *args, Split *s, int exact) {
+    const int indices[3] = {0, 4, 5}, ndims[3] = {3, 1, 1};
+    Py_ssize_t shapes[3][3] = {{0}};
+    for (int k = 0; k < 3; k++) {
+        Py_buffer probe;
+        if (PyObject_GetBuffer(args[indices[k]], &probe, PyBUF_STRIDES) < 0) return -1;
+        const int right = probe.ndim == ndims[k];
+        for (int axis = 0; right && axis < ndims[k]; axis++) shapes[k][axis] = probe.shape[axis];
+        PyBuffer_Release(&probe);
+        if (!right) {
+            PyErr_SetString(PyExc_ValueError, k == 0 ? "J must have shape (m, d, n) with d = 2 or 3" : "frictional and base must be one-dimensional");
+            return -1;
+        }
+    }
+    s->m = shapes[0][0], s->d = shapes[0][1], s->n = shapes[0][2], s->f = shapes[1][0], s->K = shapes[2][0];
+    if (s->d < 2 || s->d > 3) {
+        PyErr_SetString(PyExc_ValueError, "J must have shape (m, d, n) with d = 2 or 3");
+        return -1;
+    }
+    if (exact && s->d != 3) {
+        PyErr_SetString(PyExc_ValueError, "exact cones need 3-D contacts (d = 3)");
+        return -1;
+    }
+    return 0;
 }
 
 static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
@@ -829,41 +891,11 @@ static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssi
     }
     Split s;
     memset(&s, 0, sizeof s);
-    const int exact = PyObject_IsTrue(args[6]);
-    const long long max_realignments = PyLong_AsLongLong(args[7]);
-    const long long pivots_per_row = PyLong_AsLongLong(args[12]);
-    if (exact < 0 || ((max_realignments == -1 || pivots_per_row == -1) && PyErr_Occurred())) return NULL;
-    if (take_double(args, 8, &s.dissipation_tol) || take_double(args, 9, &s.mode_tol) || take_double(args, 10, &s.pivot_tol) ||
-        take_double(args, 11, &s.feasibility_tol) || take_double(args, 13, &s.cone_roundoff) || take_double(args, 14, &s.newton_damping) ||
-        take_double(args, 15, &s.newton_stop))
-        return NULL;
-    s.pivots_per_row = pivots_per_row;
-    Py_buffer probe;
-    Py_ssize_t f = -1, K = -1;
-    for (int k = 0; k < 3; k++) {
-        const int index = k == 0 ? 0 : (k == 1 ? 4 : 5);
-        if (PyObject_GetBuffer(args[index], &probe, PyBUF_STRIDES) < 0) return NULL;
-        if (k == 0 && probe.ndim == 3) s.m = probe.shape[0], s.d = probe.shape[1], s.n = probe.shape[2];
-        if (k == 1 && probe.ndim == 1) f = probe.shape[0];
-        if (k == 2 && probe.ndim == 1) K = probe.shape[0];
-        const int ndim = probe.ndim;
-        PyBuffer_Release(&probe);
-        if (k == 0 && (ndim != 3 || s.d < 2 || s.d > 3)) {
-            PyErr_SetString(PyExc_ValueError, "J must have shape (m, d, n) with d = 2 or 3");
-            return NULL;
-        }
-    }
-    if (f < 0 || K < 0) {
-        PyErr_SetString(PyExc_ValueError, "frictional and base must be one-dimensional");
-        return NULL;
-    }
-    if (exact && s.d != 3) {
-        PyErr_SetString(PyExc_ValueError, "exact cones need 3-D contacts (d = 3)");
-        return NULL;
-    }
-    const Py_ssize_t m = s.m, d = s.d, n = s.n, t = d - 1;
-    s.f = f, s.K = K;
-    static const char *names[9] = {"J", "b", "mu", "g", "frictional", "base", "q", "c"};
+    int exact;
+    long long max_realignments;
+    if (take_options(args, &s, &exact, &max_realignments) < 0 || take_sizes(args, &s, exact) < 0) return NULL;
+    const Py_ssize_t m = s.m, d = s.d, n = s.n, f = s.f, K = s.K;
+    static const char *names[8] = {"J", "b", "mu", "g", "frictional", "base", "q", "c"};
     const int indices[8] = {0, 1, 2, 3, 4, 5, 16, 17};
     const int ndims[8] = {3, 2, 1, 1, 1, 1, 1, 2};
     const Py_ssize_t shapes[8][3] = {{m, d, n}, {m, d}, {m}, {n}, {f}, {K}, {n}, {m, d}};
@@ -883,31 +915,18 @@ static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssi
             goto done;
         }
     s.N = 2 * n + m + f * K + f;
-    const double N = (double)s.N, S = (double)(n + 3 * m);
-    const double doubles = 4 * N * N + 10 * N + 4 * S * S + 7 * S + (double)(m * n + m + 2 * f * t * n + 3 * f + f * K * t + 6 * m + n) + 8;
-    if (doubles * sizeof(double) > (double)PY_SSIZE_T_MAX / 2) {
+    if (s.N > LARGEST_SPLIT || n + 3 * m > LARGEST_SPLIT) { /* dense N x N blocks: callers refuse far smaller problems */
         PyErr_NoMemory();
         goto done;
     }
-    memory = PyMem_RawMalloc((size_t)doubles * sizeof(double));
+    const size_t doubles = lay_out(&s, NULL, NULL);
+    memory = PyMem_RawMalloc(doubles * sizeof(double));
     integers = PyMem_RawMalloc((size_t)(3 * s.N + 2 * m + 1) * sizeof(int64_t));
     if (memory == NULL || integers == NULL) {
         PyErr_NoMemory();
         goto done;
     }
-    {
-        const Py_ssize_t NN = s.N, SS = n + 3 * m, U = NN * NN > SS * SS ? NN * NN : SS * SS;
-        double *next = memory;
-#define TAKE(field, count) (s.field = next, next += (count))
-        TAKE(Jn, m * n), TAKE(bn, m), TAKE(Jt, f * t * n), TAKE(bt, f * t), TAKE(mu_f, f), TAKE(offsets, f), TAKE(edges, f * K * t);
-        TAKE(M, NN * NN), TAKE(qv, NN), TAKE(ones, NN), TAKE(z, NN), TAKE(work, NN * (NN + 3)), TAKE(A, NN * NN), TAKE(rhs, NN);
-        TAKE(U, U), TAKE(solution, NN), TAKE(x, SS), TAKE(trial, SS), TAKE(residual, SS), TAKE(jacobian, SS * SS), TAKE(r_trial, SS);
-        TAKE(j_trial, SS * SS), TAKE(forces, 3 * m), TAKE(f_trial, 3 * m), TAKE(normal, SS * SS), TAKE(gradient, SS), TAKE(step, SS);
-        TAKE(newton_q, n);
-#undef TAKE
-        s.basis = integers, s.rows = integers + NN, s.basic = integers + 2 * NN, s.kind = integers + 3 * NN, s.column = integers + 3 * NN + m;
-        for (Py_ssize_t i = 0; i < NN; i++) s.ones[i] = 1.0;
-    }
+    lay_out(&s, memory, integers);
     SplitResult out;
     Py_BEGIN_ALLOW_THREADS
     out = split_lcp(&s, exact, max_realignments, views[6].buf, views[7].buf);
