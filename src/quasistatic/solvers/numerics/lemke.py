@@ -13,8 +13,9 @@ in the extension ``quasistatic._lemke`` (:mod:`quasistatic.compiled`, built by
 ``pip install .``, making this kernel's choices pivot for pivot) and as a whole-array
 numpy twin. Which runs:
 
-- numba installed: :func:`lemke` is compiled and calls the C code by its address
-  (1.2-3.6x faster a pivot than numba's own compiled :func:`numba_lemke`); where the
+- numba installed: :func:`lemke` is compiled and calls the C code by the name of its
+  entry point (1.2-3.6x faster a pivot than numba's own compiled :func:`numba_lemke` on
+  dense LCPs, 4-6x a solve on the fast path's, whose columns are mostly zeros); where the
   extension was not built, it calls :func:`numba_lemke` the same way (a numba ``cfunc``),
   so that every compiled caller, cached on disk, finds the same C entry point either way;
 - no numba: :func:`lemke` is the extension's wrapper, or where it was not built (no
@@ -294,7 +295,7 @@ def _pivot(Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, row: int) -> None:
 
 # The C entry point quasistatic_lemke (src/quasistatic/_lemke.c), as kernels call it:
 # (n, M, q, d, max_pivots, tol, z, basis, pivots, work, rows) -> status; work: n (n + 3), rows: n scratch entries.
-C_LEMKE = "quasistatic_lemke"
+_C_LEMKE = "quasistatic_lemke"
 _C_SIGNATURE = (
     "int64(int64, CPointer(float64), CPointer(float64), CPointer(float64), int64, float64,"
     " CPointer(float64), CPointer(int64), CPointer(int64), CPointer(float64), CPointer(int64))"
@@ -320,7 +321,9 @@ def _numba_lemke_by_pointers(
 
 _c_lemke: Any = None  # the C entry point as kernels call it (numba installed)
 if HAVE_NUMBA:
-    _c_lemke = c_function(C_LEMKE, _C_SIGNATURE, LEMKE_ADDRESS if HAVE_EXTENSION else cfunc_address(_C_SIGNATURE, _numba_lemke_by_pointers))
+    _c_lemke = c_function(
+        _C_LEMKE, _C_SIGNATURE, LEMKE_ADDRESS if HAVE_EXTENSION else cfunc_address(_C_SIGNATURE, _numba_lemke_by_pointers)
+    )
 
 
 @njit(python=_PLAIN_LEMKE)
