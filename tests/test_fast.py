@@ -35,9 +35,10 @@ TOL = 1e-11
 # --------------------------------------------------------------------------- Lemke's method
 
 LEMKE_VARIANTS = [
-    pytest.param(lemke, id="compiled"),
-    pytest.param(getattr(lemke, "py_func", lemke), id="python"),
-    pytest.param(lemke_module._lemke_numpy, id="numpy-twin"),  # what runs without numba
+    pytest.param(lemke, id="compiled"),  # with numba: the extension's C (or numba's kernel) called from compiled code
+    pytest.param(lemke_module.numba_lemke, id="numba-kernel"),
+    pytest.param(getattr(lemke_module.numba_lemke, "py_func", lemke_module.numba_lemke), id="python"),
+    pytest.param(lemke_module._lemke_numpy, id="numpy-twin"),  # what runs without numba or a C compiler
 ]
 
 

@@ -1,19 +1,22 @@
 """The compiled extension ``quasistatic._lemke``: Lemke's method in C, pivot for pivot the numba kernel's.
 
-It runs wherever numba is missing (the default install), so it must make the
-kernel's choices exactly: the same status, pivot count and final basis, and the
-same point to round-off, on well-posed, degenerate (many ties), ray-ending and
-pivot-limited LCPs, and on the LCPs of the benchmark scenes. The reference is the
-numba kernel when numba is installed, else the numpy twin (itself checked
-against the kernel in ``test_fast.py``).
+It runs wherever it was built: called from Python where numba is missing (the
+default install), and from compiled kernels through its plain C entry point where
+numba is installed. So it must make the kernel's choices exactly: the same status,
+pivot count and final basis, and the same point to round-off, on well-posed,
+degenerate (many ties), ray-ending and pivot-limited LCPs, and on the LCPs of the
+benchmark scenes, by either door. The reference is numba's own kernel when numba
+is installed, else the numpy twin (itself checked against the kernel in ``test_fast.py``).
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 import subprocess
 import sys
 import textwrap
+import types
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -33,7 +36,11 @@ TOL = 1e-11
 NO_EXTENSION = "QUASISTATIC_NO_EXTENSION"  # set to 1 where an install without a C compiler is intended
 
 needs_extension = pytest.mark.skipif(not compiled.HAVE_EXTENSION, reason=f"built without the C extension ({NO_EXTENSION} set)")
-REFERENCE: Callable[..., Any] = lemke if HAVE_NUMBA else lemke_module._lemke_numpy
+REFERENCE: Callable[..., Any] = lemke_module.numba_lemke if HAVE_NUMBA else lemke_module._lemke_numpy
+# The extension's two doors: its Python function, and (numba installed) its C entry point called by compiled ``lemke``.
+DOORS = [pytest.param(compiled.lemke, id="python-api")]
+if HAVE_NUMBA:
+    DOORS.append(pytest.param(lemke, id="from-numba"))
 
 
 def test_the_extension_was_built() -> None:
@@ -47,6 +54,18 @@ def test_the_extension_was_built() -> None:
     if os.environ.get(NO_EXTENSION) == "1":
         pytest.skip(f"{NO_EXTENSION}=1: an install without the C extension is intended")
     assert compiled.HAVE_EXTENSION, "quasistatic._lemke did not build: is there a C compiler and the Python headers?"
+
+
+def test_an_extension_built_from_an_older_source_is_not_used(monkeypatch: pytest.MonkeyPatch) -> None:
+    """An editable install keeps the .so of an older ``_lemke.c`` until rebuilt: it is left unused, with a warning."""
+    monkeypatch.setitem(sys.modules, "quasistatic._lemke", types.ModuleType("quasistatic._lemke"))  # no api_version
+    try:
+        with pytest.warns(RuntimeWarning, match="built from an older source"):
+            importlib.reload(compiled)
+        assert not compiled.HAVE_EXTENSION and compiled.LEMKE_ADDRESS == 0
+    finally:
+        monkeypatch.undo()
+        importlib.reload(compiled)
 
 
 def _same_run(got: tuple, want: tuple) -> None:
@@ -75,25 +94,27 @@ def _random_lcps(rng: np.random.Generator, count: int) -> Iterator[tuple[str, np
 
 
 @needs_extension
-def test_the_extension_pivots_as_the_kernel_on_random_lcps() -> None:
+@pytest.mark.parametrize("door", DOORS)
+def test_the_extension_pivots_as_the_kernel_on_random_lcps(door: Callable[..., Any]) -> None:
     rng = np.random.default_rng(3)
     seen: set[int] = set()
     for _, M, q in _random_lcps(rng, 400):
         d = np.ones(q.shape[0])
         for max_pivots in (1000, 3):
             want = REFERENCE(M, q, d, max_pivots, TOL)
-            _same_run(compiled.lemke(M, q, d, max_pivots, TOL), want)
+            _same_run(door(M, q, d, max_pivots, TOL), want)
             seen.add(int(want[0]))
     assert seen == {SOLUTION, RAY, PIVOT_LIMIT}  # every ending was met
 
 
 @needs_extension
+@pytest.mark.parametrize("door", DOORS)
 @pytest.mark.parametrize("n", [0, 1])
-def test_the_extension_on_the_smallest_lcps(n: int) -> None:
+def test_the_extension_on_the_smallest_lcps(n: int, door: Callable[..., Any]) -> None:
     for q in ([], [2.0]) if n == 0 else ([-2.0], [2.0], [0.0]):
         for M in (np.full((n, n), 3.0), np.full((n, n), -1.0)):
             args = (M, np.array(q[:n], float), np.full(n, 0.5), 10, TOL)
-            _same_run(compiled.lemke(*args), REFERENCE(*args))
+            _same_run(door(*args), REFERENCE(*args))
 
 
 def test_the_numpy_twins_tie_break_is_the_kernels() -> None:
@@ -129,11 +150,12 @@ def _bench_lcps() -> Iterator[tuple[str, np.ndarray, np.ndarray]]:
 
 
 @needs_extension
-def test_the_extension_pivots_as_the_kernel_on_the_bench_lcps() -> None:
+@pytest.mark.parametrize("door", DOORS)
+def test_the_extension_pivots_as_the_kernel_on_the_bench_lcps(door: Callable[..., Any]) -> None:
     for name, M, q in _bench_lcps():
         d = np.ones(q.shape[0])
         cap = lcp.PIVOTS_PER_ROW * q.shape[0]
-        got, want = compiled.lemke(M, q, d, cap, TOL), REFERENCE(M, q, d, cap, TOL)
+        got, want = door(M, q, d, cap, TOL), REFERENCE(M, q, d, cap, TOL)
         assert int(want[2]) > 0, name  # Lemke pivots on every one
         _same_run(got, want)
 
@@ -151,6 +173,14 @@ def test_the_extension_pivots_as_the_kernel_on_the_bench_lcps() -> None:
 def test_bad_shapes_raise(M: np.ndarray, q: np.ndarray, d: np.ndarray, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         compiled.lemke(M, q, d, 10, TOL)
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="the compiled door needs numba")
+@pytest.mark.parametrize(("M", "d"), [(np.zeros((3, 2)), np.ones(3)), (np.zeros((2, 3)), np.ones(3)), (np.zeros((3, 3)), np.ones(2))])
+def test_bad_shapes_raise_through_the_compiled_door(M: np.ndarray, d: np.ndarray) -> None:
+    """The C entry point trusts its sizes: the compiled ``lemke`` checks them first (never an out-of-bounds read)."""
+    with pytest.raises(ValueError, match=r"M must be \(n, n\) and d \(n,\)"):
+        lemke(M, -np.ones(3), d, 10, TOL)
 
 
 @needs_extension
@@ -176,9 +206,10 @@ def test_bad_output_buffers_raise() -> None:
 
 
 @needs_extension
+@pytest.mark.parametrize("door", DOORS)
 @pytest.mark.parametrize("where", ["M", "q", "d", "all"])
 @pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
-def test_nan_and_inf_end_within_the_pivot_limit(where: str, value: float) -> None:
+def test_nan_and_inf_end_within_the_pivot_limit(where: str, value: float, door: Callable[..., Any]) -> None:
     """Non-finite data give a meaningless but bounded run (callers audit every answer): no crash, no endless loop."""
     rng = np.random.default_rng(0)
     A = rng.normal(size=(6, 6))
@@ -189,7 +220,7 @@ def test_nan_and_inf_end_within_the_pivot_limit(where: str, value: float) -> Non
         q[1] = value
     if where in ("d", "all"):
         d[2] = value
-    status, z, pivots, basis = compiled.lemke(M, q, d, 40, TOL)
+    status, z, pivots, basis = door(M, q, d, 40, TOL)
     assert status in (SOLUTION, RAY, PIVOT_LIMIT) and 0 <= pivots <= 40
     assert z.shape == (6,) and set(basis.tolist()) <= set(range(13))  # w, z or z0 in every row
 
@@ -207,6 +238,35 @@ def test_without_numba_the_default_install_runs_the_extension() -> None:
         assert module.lemke is expected, module.lemke
         status, z, pivots, _ = module.lemke(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), np.ones(2), 10, 1e-11)
         assert status == module.SOLUTION and np.allclose(z, [4 / 3, 7 / 3])
+        """
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="numba's kernels only")
+def test_with_numba_but_no_extension_the_kernels_call_numbas_lemke() -> None:
+    """numba installed, the extension not built: compiled callers reach numba's own kernel through the same C name.
+
+    The kernels cached on disk by this session's processes (which call the extension) are loaded here with the
+    extension gone: the name must still be bound (to numba's kernel as a ``cfunc``), or loading them would crash.
+    """
+    code = textwrap.dedent(
+        """
+        import sys
+        sys.modules["quasistatic._lemke"] = None  # as if no C compiler had built it
+        import numpy as np
+        import quasistatic as qs
+        from quasistatic import compiled
+        from quasistatic.solvers.numerics import lemke as module
+        from quasistatic.tools.bench.families import grasp_2d
+        assert not compiled.HAVE_EXTENSION
+        rng = np.random.default_rng(1)
+        for n in (0, 3, 12):
+            A = rng.normal(size=(n, n))
+            args = (A @ A.T + np.eye(n), rng.normal(size=n), np.ones(n), 100, 1e-11)
+            got, want = module.lemke(*args), module.numba_lemke(*args)
+            assert (got[0], got[2]) == (want[0], want[2]) and (got[3] == want[3]).all() and (got[1] == want[1]).all()
+        assert qs.solve(qs.assemble(grasp_2d(4, 0)), method="fast").status == "solved"
         """
     )
     subprocess.run([sys.executable, "-c", code], check=True)
@@ -254,3 +314,80 @@ def test_the_extensions_fixed_mode_laws_check_their_arrays() -> None:
         compiled.fixed_mode_system(J, b, mu, g, x[: n + 1], np.full_like(kind, fixed_modes.ROLLING), column, n)
     with pytest.raises(ValueError, match="is not 0, 1 or 2"):
         compiled.fixed_mode_system(J, b, mu, g, x, np.full_like(kind, 7), column, n)
+
+
+# --------------------------------------------------------------------------- the fast path's whole kernel in C
+
+
+def _split_lcp_cases() -> Iterator[tuple[str, lcp.LemkeInputs]]:
+    """The fast kernel's inputs on the bench families (2-D, 3-D exact and pyramid cones, frictionless) and random 3-D scenes.
+
+    Among them every ending of the kernel: Lemke's first motion, a ray, Newton's method (first, and after a
+    re-alignment: random #28), a ray after re-alignment (grasp-3d 5 #2), and re-alignment run to its limit
+    without converging (grasp-3d 5 #4, random #287).
+    """
+    from random_scenes import random_scene
+
+    rows = [("grasp-2d", 2), ("grasp-2d", 4), ("grasp-2d", 8), ("grasp-3d", 4), ("grasp-3d", 6), ("grasp-3d", 8)]
+    rows += [("grasp-2d-nf", 8), ("box-push", 4), ("box-push-nf", 16), ("pile-nf", 10)]
+    cases = [(family, size, instance) for family, size in rows for instance in range(3)] + [("grasp-3d", 5, 2), ("grasp-3d", 5, 4)]
+    for family, size, instance in cases:
+        yield f"{family} {size} #{instance}", qs.assemble(FAMILIES[family].make(size, instance)).derived("fast", lcp.LemkeInputs)
+    for seed in [*range(30), 28, 287]:
+        friction = "exact" if seed % 3 else "pyramid:4"
+        yield f"random 3-D #{seed} {friction}", qs.assemble(random_scene(3, seed, friction)).derived("fast", lcp.LemkeInputs)
+
+
+def _kernel_arguments(data: lcp.LemkeInputs) -> tuple[Any, ...]:
+    tolerances = (lcp.FRICTION_ALIGNMENT, lcp.MODE_SPEED, lcp.PIVOT, lcp.BASIS_FEASIBILITY, lcp.PIVOTS_PER_ROW)
+    return (data.J, data.b, data.mu, data.g, data.frictional, data.base, data.exact, lcp.REALIGNMENTS, *tolerances)
+
+
+@needs_extension
+@pytest.mark.skipif(not HAVE_NUMBA, reason="the reference is the numba kernel")
+def test_the_extensions_split_lcp_kernel_is_the_numba_kernels() -> None:
+    """The same status, stage, pivots and re-alignments, and the same motion to 1e-9 relative, on every case; every stage met."""
+    stages: set[tuple[int, int]] = set()
+    for name, data in _split_lcp_cases():
+        arguments = _kernel_arguments(data)
+        got, want = lcp._solve_split_lcp_compiled(*arguments), lcp.solve_split_lcp(*arguments)
+        assert [int(v) for v in (got[0], got[1], got[4], got[5])] == [int(v) for v in (want[0], want[1], want[4], want[5])], name
+        for g, w in ((got[2], want[2]), (got[3], want[3])):
+            np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(w).max(initial=0.0))), err_msg=name)
+        stages.add((int(want[0]), int(want[1])))
+    assert {(SOLUTION, 0), (SOLUTION, 2), (RAY, 0), (RAY, 1), (lcp.NOT_CONVERGED, 2)} <= stages, stages
+
+
+@needs_extension
+def test_the_extensions_split_lcp_kernel_checks_its_arrays() -> None:
+    data = qs.assemble(FAMILIES["grasp-3d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
+    arguments = list(_kernel_arguments(data))
+    bad = {
+        0: (data.J[0], "J must have shape"),
+        1: (data.b[:-1], r"b must have shape"),
+        3: (data.g[:-1], r"g must have shape"),
+        4: (np.array([0, 99]), "is not a contact index"),
+        5: (data.base[None], "frictional and base must be one-dimensional"),
+    }
+    for index, (value, message) in bad.items():
+        with pytest.raises(ValueError, match=message):
+            lcp._solve_split_lcp_compiled(*arguments[:index], value, *arguments[index + 1 :])
+    planar = qs.assemble(FAMILIES["grasp-2d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
+    with pytest.raises(ValueError, match="exact cones need 3-D contacts"):
+        lcp._solve_split_lcp_compiled(*_kernel_arguments(planar)[:6], True, *_kernel_arguments(planar)[7:])
+
+
+@needs_extension
+@pytest.mark.parametrize("value", [np.nan, np.inf])
+def test_the_extensions_split_lcp_kernel_ends_on_non_finite_data(value: float) -> None:
+    """NaN or inf in the laws: a bounded run with some status (the caller audits every answer), never a hang or a crash."""
+    data = qs.assemble(FAMILIES["grasp-3d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
+    for field in ("J", "b", "g", "mu"):
+        arguments = list(_kernel_arguments(data))
+        index = ("J", "b", "mu", "g").index(field)
+        spoiled = arguments[index].copy()
+        spoiled.flat[1] = value
+        arguments[index] = spoiled
+        status, stage, q, c, pivots, realignments = lcp._solve_split_lcp_compiled(*arguments)
+        assert status in (SOLUTION, RAY, PIVOT_LIMIT, lcp.NOT_CONVERGED) and 0 <= realignments <= lcp.REALIGNMENTS
+        assert q.shape == (data.J.shape[2],) and c.shape == data.J.shape[:2]

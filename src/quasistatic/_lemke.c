@@ -1,10 +1,17 @@
-/* Compiled kernels for installs without numba, each making the numba kernel's choices:
+/* Compiled kernels, each making the numba kernel's choices:
  *
  *   lemke(M, q, d, max_pivots, tol, z, basis) -> (status, pivots)
- *       Lemke's method with lexicographic anti-cycling, solvers/numerics/lemke.py::lemke pivot for
- *       pivot. M: (n, n) float64, q and d: (n,) float64; z: (n,) float64 and basis: (n,) int64
- *       are filled. NaN never qualifies in a comparison, so NaN data end on a ray or at
+ *       Lemke's method with lexicographic anti-cycling, solvers/numerics/lemke.py's numba kernel
+ *       pivot for pivot. M: (n, n) float64, q and d: (n,) float64; z: (n,) float64 and basis: (n,)
+ *       int64 are filled. NaN never qualifies in a comparison, so NaN data end on a ray or at
  *       max_pivots, never in a loop or out of bounds.
+ *   solve_split_lcp(J, b, mu, g, frictional, base, exact, ..., q, c) -> (status, stage, pivots, realignments)
+ *       The fast path's whole kernel, solvers/numerics/lcp.py::solve_split_lcp step for step.
+ *   lemke_address
+ *       The address of quasistatic_lemke, the same method on raw pointers (no Python objects):
+ *       the numba install's kernels call it from compiled code.
+ *   api_version
+ *       2; quasistatic/compiled.py runs without a .so built from an older source.
  *   fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces) -> None
  *       The fixed-mode laws at x, laws/fixed_modes.py::system loop for loop (the 3-D fast
  *       path's Newton iterations call it); the last three arrays are filled.
@@ -30,13 +37,12 @@ typedef struct {
     Py_ssize_t n;
     const double *M, *q, *d;
     double *Binv, *xB, *col, *values;
-    int64_t *basis;
-    Py_ssize_t *rows;
+    int64_t *basis, *rows;
 } Lemke;
 
 /* Eliminate the entering column on `row`, in the kernel's arithmetic: the pivot row times the
  * reciprocal of the pivot, then every row minus its factor (the column, 0 on `row`) times it. */
-static void pivot(Lemke *s, Py_ssize_t row) {
+static void pivot(Lemke *s, int64_t row) {
     const Py_ssize_t n = s->n;
     const double scale = 1.0 / s->col[row];
     double *restrict factors = s->col; /* the column is not needed after this pivot */
@@ -44,7 +50,8 @@ static void pivot(Lemke *s, Py_ssize_t row) {
     for (Py_ssize_t j = 0; j < n; j++) {
         double *restrict column = s->Binv + j * n;
         const double value = column[row] * scale;
-        for (Py_ssize_t i = 0; i < n; i++) column[i] -= factors[i] * value;
+        if (value != 0.0) /* B^-1 fills in over the pivots: x - 0 y is x for finite y */
+            for (Py_ssize_t i = 0; i < n; i++) column[i] -= factors[i] * value;
         column[row] = value;
     }
     const double value = s->xB[row] * scale;
@@ -64,6 +71,7 @@ static void entering_column(Lemke *s, int64_t entering) {
     for (Py_ssize_t i = 0; i < n; i++) col[i] = 0.0;
     for (Py_ssize_t j = 0; j < n; j++) {
         const double a = entering < 2 * n ? s->M[j * n + (entering - n)] : s->d[j];
+        if (a == 0.0) continue; /* the split LCP's columns are mostly zeros; x + 0 y is x for finite y */
         const double *restrict column = s->Binv + j * n;
         for (Py_ssize_t i = 0; i < n; i++) col[i] += column[i] * a;
     }
@@ -78,7 +86,7 @@ static Py_ssize_t keep_smallest(Lemke *s, Py_ssize_t count, Py_ssize_t column, d
     const Py_ssize_t n = s->n;
     double smallest = INFINITY;
     for (Py_ssize_t k = 0; k < count; k++) {
-        const Py_ssize_t i = s->rows[k];
+        const int64_t i = s->rows[k];
         s->values[k] = (column < 0 ? s->xB[i] : s->Binv[column * n + i]) / s->col[i];
         if (s->values[k] < smallest) smallest = s->values[k];
     }
@@ -91,7 +99,7 @@ static Py_ssize_t keep_smallest(Lemke *s, Py_ssize_t count, Py_ssize_t column, d
 
 /* The leaving row by the lexicographic minimum ratio; -1 when no entry of the entering
  * column is above the pivot tolerance (relative to its largest magnitude). */
-static Py_ssize_t ratio_test(Lemke *s, int64_t artificial, double tol) {
+static int64_t ratio_test(Lemke *s, int64_t artificial, double tol) {
     const Py_ssize_t n = s->n;
     double largest = 1.0;
     for (Py_ssize_t i = 0; i < n; i++)
@@ -114,18 +122,18 @@ static Py_ssize_t ratio_test(Lemke *s, int64_t artificial, double tol) {
 
 /* The first pivot's row: z0 enters (column -d) and the row of the most negative q_i / d_i
  * leaves; ties go to the lexicographically smallest row of [q, I] / d, the largest index. */
-static Py_ssize_t first_row(const Lemke *s, double tol) {
+static int64_t first_row(const Lemke *s, double tol) {
     double smallest = INFINITY;
     for (Py_ssize_t i = 0; i < s->n; i++)
         if (s->q[i] / s->d[i] < smallest) smallest = s->q[i] / s->d[i];
-    Py_ssize_t row = 0;
+    int64_t row = 0;
     for (Py_ssize_t i = 0; i < s->n; i++)
         if (s->q[i] / s->d[i] <= smallest + tol * (1.0 + fabs(smallest))) row = i;
     return row;
 }
 
 /* Lemke's path from the artificial start; the state's basis and x_B hold the end point. */
-static int run(Lemke *s, long long max_pivots, double tol, long long *pivots) {
+static int run(Lemke *s, int64_t max_pivots, double tol, int64_t *pivots) {
     const Py_ssize_t n = s->n;
     const int64_t artificial = 2 * (int64_t)n;
     for (Py_ssize_t i = 0; i < n; i++) {
@@ -133,7 +141,7 @@ static int run(Lemke *s, long long max_pivots, double tol, long long *pivots) {
         s->xB[i] = s->q[i];
         s->col[i] = -s->d[i];
     }
-    Py_ssize_t row = first_row(s, tol);
+    int64_t row = first_row(s, tol);
     int64_t entering = artificial;
     *pivots = 0;
     for (;;) {
@@ -148,6 +156,27 @@ static int run(Lemke *s, long long max_pivots, double tol, long long *pivots) {
         row = ratio_test(s, artificial, tol);
         if (row < 0) return RAY;
     }
+}
+
+/* Lemke's method on raw arrays, no Python objects: the entry point numba kernels call (its address is the
+ * module's lemke_address). M (n, n) row-major, q and d (n,); fills z (n,), basis (n,) and *pivots; work
+ * (n (n + 3) doubles) and rows (n int64) are scratch space. The caller checks the sizes. Returns the status. */
+int64_t quasistatic_lemke(int64_t n, const double *M, const double *q, const double *d, int64_t max_pivots, double tol,
+                          double *z, int64_t *basis, int64_t *pivots, double *work, int64_t *rows) {
+    Lemke s = {(Py_ssize_t)n, M, q, d, work, work + n * n, work + n * n + n, work + n * n + 2 * n, basis, rows};
+    int status = SOLUTION;
+    int needs_pivots = 0;
+    *pivots = 0;
+    for (int64_t i = 0; i < n; i++) {
+        basis[i] = i;
+        z[i] = 0.0;
+        if (!(q[i] >= 0.0)) needs_pivots = 1; /* as np.min(q) >= 0 fails on NaN */
+    }
+    if (!needs_pivots) return status;
+    status = run(&s, max_pivots, tol, pivots);
+    for (int64_t i = 0; i < n; i++)
+        if (basis[i] >= n && basis[i] < 2 * n) z[basis[i] - n] = s.xB[i];
+    return status;
 }
 
 /* ---------------------------------------------------------------- buffers and the module */
@@ -224,34 +253,20 @@ static PyObject *lemke(PyObject *module, PyObject *const *args, Py_ssize_t nargs
         PyErr_NoMemory();
         goto done;
     }
-    const double *M = views[0].buf;
-    double *z = views[3].buf;
-    int64_t *basis = views[4].buf;
     /* B^-1, x_B, the column and the ratio values; +1 so that n = 0 asks for a byte */
     memory = PyMem_RawMalloc(((size_t)n * ((size_t)n + 3) + 1) * sizeof(double));
-    Py_ssize_t *rows = PyMem_RawMalloc(((size_t)n + 1) * sizeof(Py_ssize_t));
+    int64_t *rows = PyMem_RawMalloc(((size_t)n + 1) * sizeof(int64_t));
     if (memory == NULL || rows == NULL) {
         PyMem_RawFree(rows);
         PyErr_NoMemory();
         goto done;
     }
-    Lemke s = {n, M, views[1].buf, views[2].buf, memory, memory + n * n, memory + n * n + n, memory + n * n + 2 * n, basis, rows};
-    int status = SOLUTION;
-    long long pivots = 0;
+    int64_t status, pivots;
     Py_BEGIN_ALLOW_THREADS
-    int needs_pivots = 0;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        basis[i] = i;
-        if (!(s.q[i] >= 0.0)) needs_pivots = 1; /* as np.min(q) >= 0 fails on NaN */
-    }
-    if (needs_pivots) status = run(&s, max_pivots, tol, &pivots);
-    for (Py_ssize_t i = 0; i < n; i++) z[i] = 0.0;
-    if (needs_pivots)
-        for (Py_ssize_t i = 0; i < n; i++)
-            if (basis[i] >= n && basis[i] < 2 * (int64_t)n) z[basis[i] - n] = s.xB[i];
+    status = quasistatic_lemke(n, views[0].buf, views[1].buf, views[2].buf, max_pivots, tol, views[3].buf, views[4].buf, &pivots, memory, rows);
     Py_END_ALLOW_THREADS
     PyMem_RawFree(rows);
-    result = Py_BuildValue("(iL)", status, pivots);
+    result = Py_BuildValue("(LL)", (long long)status, (long long)pivots);
 done:
     PyMem_RawFree(memory);
     for (int k = 0; k < taken; k++) PyBuffer_Release(&views[k]);
@@ -400,6 +415,530 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- the split-twist LCP kernel */
+
+enum { NOT_CONVERGED = 3 };
+
+/* Python's max(a, b) as numba compiles it: b only when b > a, so a NaN in b is passed over and one in a kept. */
+static double py_max(double a, double b) { return b > a ? b : a; }
+
+/* The largest magnitude, NaN when any entry is NaN (as np.max(np.abs(r))). */
+static double largest_magnitude(Py_ssize_t count, const double *r) {
+    double largest = 0.0;
+    for (Py_ssize_t i = 0; i < count; i++) {
+        if (isnan(r[i])) return NAN;
+        if (fabs(r[i]) > largest) largest = fabs(r[i]);
+    }
+    return largest;
+}
+
+/* A x = rhs by Gaussian elimination with partial pivoting, lcp.py::_linear_solve step for step: A (k, k) row-major is
+ * copied into U; x holds the solution, or where a pivot is within 1e-14 of A's largest entry (the kernel's threshold)
+ * the partly eliminated right-hand side, and 0 is returned (singular). */
+static int linear_solve(Py_ssize_t k, const double *A, const double *rhs, double *U, double *x) {
+    double scale = 0.0;
+    for (Py_ssize_t i = 0; i < k * k; i++) {
+        U[i] = A[i];
+        scale = py_max(scale, fabs(A[i]));
+    }
+    for (Py_ssize_t i = 0; i < k; i++) x[i] = rhs[i];
+    const double tiny = 1e-14 * py_max(scale, 1e-300);
+    for (Py_ssize_t c = 0; c < k; c++) {
+        Py_ssize_t p = c;
+        for (Py_ssize_t i = c + 1; i < k; i++)
+            if (fabs(U[i * k + c]) > fabs(U[p * k + c])) p = i;
+        if (fabs(U[p * k + c]) <= tiny) return 0;
+        if (p != c) {
+            for (Py_ssize_t j = 0; j < k; j++) {
+                const double swap = U[c * k + j];
+                U[c * k + j] = U[p * k + j];
+                U[p * k + j] = swap;
+            }
+            const double swap = x[c];
+            x[c] = x[p];
+            x[p] = swap;
+        }
+        for (Py_ssize_t i = c + 1; i < k; i++) {
+            const double factor = U[i * k + c] / U[c * k + c];
+            if (factor != 0.0) {
+                for (Py_ssize_t j = c; j < k; j++) U[i * k + j] -= factor * U[c * k + j];
+                x[i] -= factor * x[c];
+            }
+        }
+    }
+    for (Py_ssize_t c = k - 1; c >= 0; c--) {
+        double total = x[c];
+        for (Py_ssize_t j = c + 1; j < k; j++) total -= U[c * k + j] * x[j];
+        x[c] = total / U[c * k + c];
+    }
+    return 1;
+}
+
+/* One problem's data and tolerances, and the scratch space of every step (sizes in split_lcp's allocation). */
+typedef struct {
+    Py_ssize_t m, d, n, f, K, N; /* contacts, contact dimension, twist size, frictional contacts, edges, LCP size */
+    const double *J, *b, *mu, *g, *base;
+    const int64_t *frictional;
+    double mode_tol, dissipation_tol, pivot_tol, feasibility_tol, cone_roundoff, newton_damping, newton_stop;
+    int64_t pivots_per_row;
+    /* the LCP */
+    double *Jn, *bn, *Jt, *bt, *mu_f, *offsets, *edges, *M, *qv, *ones, *z, *work, *A, *rhs, *U, *solution;
+    int64_t *basis, *rows, *basic;
+    /* Newton's method (sizes up to n + 3 m unknowns) */
+    double *x, *trial, *residual, *jacobian, *r_trial, *j_trial, *forces, *f_trial, *normal, *gradient, *step, *newton_q;
+    int64_t *kind, *column;
+} Split;
+
+/* Normal rows of every contact; tangent rows and mu of the frictional ones (lcp.py::_split_rows). */
+static void split_rows(Split *s) {
+    const Py_ssize_t d = s->d, n = s->n, t = d - 1;
+    for (Py_ssize_t i = 0; i < s->m; i++) {
+        s->bn[i] = s->b[i * d + t];
+        for (Py_ssize_t j = 0; j < n; j++) s->Jn[i * n + j] = s->J[(i * d + t) * n + j];
+    }
+    for (Py_ssize_t a = 0; a < s->f; a++) {
+        const int64_t i = s->frictional[a];
+        s->mu_f[a] = s->mu[i];
+        for (Py_ssize_t r = 0; r < t; r++) {
+            s->bt[a * t + r] = s->b[i * d + r];
+            for (Py_ssize_t j = 0; j < n; j++) s->Jt[(a * t + r) * n + j] = s->J[(i * d + r) * n + j];
+        }
+    }
+}
+
+/* Edge directions (f, K, t): the 2-D signs, or 3-D angles base + offset per contact (lcp.py::_edges). */
+static void edges(Split *s) {
+    const Py_ssize_t K = s->K, t = s->d - 1;
+    for (Py_ssize_t a = 0; a < s->f; a++)
+        for (Py_ssize_t k = 0; k < K; k++) {
+            double *e = s->edges + (a * K + k) * t;
+            if (t == 1) {
+                e[0] = s->base[k];
+            } else {
+                e[0] = cos(s->base[k] + s->offsets[a]);
+                e[1] = sin(s->base[k] + s->offsets[a]);
+            }
+        }
+}
+
+/* The LCP matrix M (N, N) and vector qv (N,) of the split-twist polyhedral laws (lcp.py::_assemble, loop for loop). */
+static void assemble(Split *s) {
+    const Py_ssize_t m = s->m, n = s->n, f = s->f, K = s->K, N = s->N, t = s->d - 1;
+    const Py_ssize_t cn0 = 2 * n, b0 = cn0 + m, l0 = b0 + f * K;
+    double *M = s->M, *q = s->qv;
+    for (Py_ssize_t i = 0; i < N * N; i++) M[i] = 0.0;
+    for (Py_ssize_t i = 0; i < N; i++) q[i] = 0.0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        q[i] = -s->g[i];
+        q[n + i] = s->g[i];
+    }
+    for (Py_ssize_t j = 0; j < m; j++) {
+        q[cn0 + j] = -s->bn[j];
+        for (Py_ssize_t i = 0; i < n; i++) {
+            const double a = s->Jn[j * n + i];
+            M[(cn0 + j) * N + i] = a;
+            M[(cn0 + j) * N + n + i] = -a;
+            M[i * N + cn0 + j] = -a;
+            M[(n + i) * N + cn0 + j] = a;
+        }
+    }
+    for (Py_ssize_t a = 0; a < f; a++) {
+        const Py_ssize_t row_l = l0 + a;
+        M[row_l * N + cn0 + s->frictional[a]] = s->mu_f[a];
+        for (Py_ssize_t k = 0; k < K; k++) {
+            const Py_ssize_t row = b0 + a * K + k;
+            const double *e = s->edges + (a * K + k) * t;
+            double rhs = 0.0;
+            for (Py_ssize_t r = 0; r < t; r++) rhs += e[r] * s->bt[a * t + r];
+            q[row] = -rhs;
+            for (Py_ssize_t i = 0; i < n; i++) {
+                double value = 0.0;
+                for (Py_ssize_t r = 0; r < t; r++) value += e[r] * s->Jt[(a * t + r) * n + i];
+                M[row * N + i] = value;
+                M[row * N + n + i] = -value;
+                M[i * N + row] = -value;
+                M[(n + i) * N + row] = value;
+            }
+            M[row * N + row_l] = 1.0;
+            M[row_l * N + row] = -1.0;
+        }
+    }
+}
+
+/* Lemke's method on the assembled LCP from the artificial start; fills z and basis, adds its pivots. */
+static int64_t split_lemke(Split *s, int64_t *pivots) {
+    int64_t more = 0;
+    const int64_t status = quasistatic_lemke(s->N, s->M, s->qv, s->ones, s->pivots_per_row * s->N, s->pivot_tol, s->z, s->basis, &more,
+                                             s->work, s->rows);
+    *pivots += more;
+    return status;
+}
+
+/* Twist q (n,) and contact-frame forces c (m, d) of z = [q+, q-, cn, beta, lam] (lcp.py::_motion). */
+static void motion(const Split *s, double *q, double *c) {
+    const Py_ssize_t m = s->m, d = s->d, n = s->n, K = s->K, t = d - 1;
+    for (Py_ssize_t j = 0; j < n; j++) q[j] = s->z[j] - s->z[n + j];
+    for (Py_ssize_t i = 0; i < m * d; i++) c[i] = 0.0;
+    for (Py_ssize_t i = 0; i < m; i++) c[i * d + t] = s->z[2 * n + i];
+    const Py_ssize_t start = 2 * n + m;
+    for (Py_ssize_t a = 0; a < s->f; a++)
+        for (Py_ssize_t k = 0; k < K; k++) {
+            const double beta = s->z[start + a * K + k];
+            for (Py_ssize_t r = 0; r < t; r++) c[s->frictional[a] * d + r] += beta * s->edges[(a * K + k) * t + r];
+        }
+}
+
+/* The LCP solution with the last complementary basis (M_SS z_S = -q_S) into z, and whether it is feasible
+ * (lcp.py::_basis_solution). */
+static int basis_solution(Split *s) {
+    const Py_ssize_t N = s->N;
+    Py_ssize_t count = 0;
+    for (Py_ssize_t i = 0; i < N; i++)
+        if (s->basis[i] >= N && s->basis[i] < 2 * N) s->basic[count++] = s->basis[i] - N;
+    for (Py_ssize_t i = 0; i < N; i++) s->z[i] = 0.0;
+    if (count) {
+        for (Py_ssize_t r = 0; r < count; r++) {
+            s->rhs[r] = -s->qv[s->basic[r]];
+            for (Py_ssize_t c = 0; c < count; c++) s->A[r * count + c] = s->M[s->basic[r] * N + s->basic[c]];
+        }
+        if (!linear_solve(count, s->A, s->rhs, s->U, s->solution)) return 0; /* the basis does not carry over */
+        for (Py_ssize_t r = 0; r < count; r++) {
+            if (s->solution[r] < -s->feasibility_tol) return 0;
+            s->z[s->basic[r]] = py_max(s->solution[r], 0.0);
+        }
+    }
+    for (Py_ssize_t i = 0; i < N; i++) {
+        double w = s->qv[i];
+        for (Py_ssize_t j = 0; j < N; j++) w += s->M[i * N + j] * s->z[j];
+        if (w < -s->feasibility_tol) return 0;
+    }
+    return 1;
+}
+
+/* Normal velocity and slip speed of 3-D contact i at twist q (lcp.py::_contact_speeds). */
+static void contact_speeds(const Split *s, const double *q, Py_ssize_t i, double *normal, double *speed) {
+    const Py_ssize_t n = s->n;
+    double u[3];
+    for (Py_ssize_t r = 0; r < 3; r++) {
+        u[r] = -s->b[i * 3 + r];
+        for (Py_ssize_t j = 0; j < n; j++) u[r] += s->J[(i * 3 + r) * n + j] * q[j];
+    }
+    *normal = u[2];
+    *speed = sqrt(u[0] * u[0] + u[1] * u[1]);
+}
+
+/* The fixed-mode laws at x into out (residual, Jacobian, forces), with the kind and columns of s. */
+static void laws_at(const Split *s, Py_ssize_t size, const double *x, double *residual, double *jacobian, double *forces) {
+    const Laws L = {s->m, 3, s->n, size, s->J, s->b, s->mu, s->g, x, s->kind, s->column, residual, jacobian, forces};
+    fixed_mode_laws(&L);
+}
+
+/* Newton step -(J^T J + lam I)^-1 J^T r into s->step (lcp.py::_newton_step, loop for loop). */
+static void newton_step(Split *s, Py_ssize_t size) {
+    const double *jac = s->jacobian, *res = s->residual;
+    double *normal = s->normal, *gradient = s->gradient;
+    for (Py_ssize_t i = 0; i < size * size; i++) normal[i] = 0.0;
+    double largest = 0.0;
+    for (Py_ssize_t i = 0; i < size; i++) {
+        gradient[i] = 0.0;
+        for (Py_ssize_t k = 0; k < size; k++) {
+            gradient[i] -= jac[k * size + i] * res[k];
+            for (Py_ssize_t j = 0; j < size; j++) normal[i * size + j] += jac[k * size + i] * jac[k * size + j];
+        }
+        largest = py_max(largest, normal[i * size + i]);
+    }
+    for (Py_ssize_t i = 0; i < size; i++) normal[i * size + i] += s->newton_damping * (1.0 + largest);
+    linear_solve(size, normal, gradient, s->U, s->step); /* singular or not, the kernel takes what comes out */
+}
+
+/* Damped Newton steps with step halving on the fixed-mode laws from s->x (lcp.py::_gauss_newton): s->x, s->residual,
+ * s->jacobian and s->forces end at the last accepted point; returns its largest residual. */
+static double gauss_newton(Split *s, Py_ssize_t size) {
+    laws_at(s, size, s->x, s->residual, s->jacobian, s->forces);
+    double norm = largest_magnitude(size, s->residual);
+    for (int iteration = 0; iteration < 50; iteration++) {
+        if (norm <= s->newton_stop) break;
+        newton_step(s, size);
+        double t = 1.0;
+        int improved = 0;
+        for (int halving = 0; halving < 30; halving++) {
+            for (Py_ssize_t i = 0; i < size; i++) s->trial[i] = s->x[i] + t * s->step[i];
+            laws_at(s, size, s->trial, s->r_trial, s->j_trial, s->f_trial);
+            const double n_trial = largest_magnitude(size, s->r_trial);
+            if (n_trial < norm) {
+                double *swap;
+                swap = s->x, s->x = s->trial, s->trial = swap;
+                swap = s->residual, s->residual = s->r_trial, s->r_trial = swap;
+                swap = s->jacobian, s->jacobian = s->j_trial, s->j_trial = swap;
+                swap = s->forces, s->forces = s->f_trial, s->f_trial = swap;
+                norm = n_trial;
+                improved = 1;
+                break;
+            }
+            t *= 0.5;
+        }
+        if (!improved) break;
+    }
+    return norm;
+}
+
+/* The exact 3-D laws with the contact modes of (q, c), by lcp.py::_newton's rules; the result in s->newton_q and
+ * s->forces (m, 3). Returns whether it converged with every mode and inequality kept. */
+static int newton(Split *s, const double *q, const double *c, double tol) {
+    const Py_ssize_t m = s->m, n = s->n;
+    double u_n, speed;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        contact_speeds(s, q, i, &u_n, &speed);
+        s->kind[i] = u_n <= s->mode_tol ? (s->mu[i] > 0.0 && speed <= s->mode_tol ? ROLLING : SLIDING) : SEPARATING;
+    }
+    for (Py_ssize_t i = 0; i < m * 3; i++) s->forces[i] = c[i];
+    for (Py_ssize_t j = 0; j < n; j++) s->newton_q[j] = q[j];
+    for (int round = 0; round < 8; round++) {
+        Py_ssize_t size = n;
+        for (Py_ssize_t i = 0; i < m; i++) {
+            s->column[i] = size;
+            size += s->kind[i] == SEPARATING ? 0 : (s->kind[i] == ROLLING ? 3 : 1);
+        }
+        for (Py_ssize_t r = 0; r < size; r++) s->x[r] = 0.0;
+        for (Py_ssize_t j = 0; j < n; j++) s->x[j] = s->newton_q[j];
+        for (Py_ssize_t i = 0; i < m; i++) {
+            const double *fi = s->forces + i * 3;
+            if (s->kind[i] != SEPARATING) s->x[s->column[i]] = py_max(fi[2], 0.0);
+            if (s->kind[i] == ROLLING) {
+                s->x[s->column[i] + 1] = fi[0];
+                s->x[s->column[i] + 2] = fi[1];
+            }
+        }
+        const double norm = gauss_newton(s, size);
+        for (Py_ssize_t j = 0; j < n; j++) s->newton_q[j] = s->x[j];
+        int changed = 0;
+        for (Py_ssize_t i = 0; i < m; i++) {
+            double *fi = s->forces + i * 3;
+            contact_speeds(s, s->newton_q, i, &u_n, &speed);
+            if (s->kind[i] == SEPARATING && u_n < 0.0) {
+                s->kind[i] = s->mu[i] > 0.0 && speed <= s->mode_tol ? ROLLING : SLIDING;
+                changed = 1;
+            } else if (s->kind[i] != SEPARATING && fi[2] < 0.0) {
+                s->kind[i] = SEPARATING;
+                fi[0] = fi[1] = fi[2] = 0.0;
+                changed = 1;
+            } else if (s->kind[i] == SLIDING && s->mu[i] > 0.0 && speed <= s->mode_tol) {
+                s->kind[i] = ROLLING;
+                changed = 1;
+            }
+        }
+        if (changed) continue;
+        int ok = norm <= tol;
+        for (Py_ssize_t i = 0; i < m; i++) {
+            const double *fi = s->forces + i * 3;
+            if (s->kind[i] == ROLLING) ok = ok && sqrt(fi[0] * fi[0] + fi[1] * fi[1]) <= s->mu[i] * fi[2] * (1.0 + s->cone_roundoff);
+        }
+        return ok;
+    }
+    return 0;
+}
+
+/* The largest distance of a sliding contact's friction from -mu cn slip/|slip| at (q, c), each such contact's edge offset
+ * turned opposite its slip (the loop at the top of lcp.py::solve_split_lcp's re-alignment). */
+static double misalignment(Split *s, const double *q, const double *c) {
+    const Py_ssize_t n = s->n;
+    double error = 0.0;
+    for (Py_ssize_t a = 0; a < s->f; a++) {
+        const int64_t i = s->frictional[a];
+        double slip[2];
+        for (Py_ssize_t r = 0; r < 2; r++) {
+            slip[r] = -s->bt[a * 2 + r];
+            for (Py_ssize_t j = 0; j < n; j++) slip[r] += s->Jt[(a * 2 + r) * n + j] * q[j];
+        }
+        const double speed = sqrt(slip[0] * slip[0] + slip[1] * slip[1]);
+        if (speed > s->mode_tol) {
+            const double scale = s->mu_f[a] * c[i * 3 + 2] / speed;
+            const double x = c[i * 3] + scale * slip[0], y = c[i * 3 + 1] + scale * slip[1];
+            error = py_max(error, sqrt(x * x + y * y));
+            s->offsets[a] = atan2(-slip[1], -slip[0]);
+        }
+    }
+    return error;
+}
+
+typedef struct {
+    int64_t status, stage, pivots, realignments;
+} SplitResult;
+
+/* lcp.py::solve_split_lcp: Lemke on the split-twist LCP, then (exact 3-D cones) edge re-alignment and Newton's method;
+ * the twist into q (n,) and the contact-frame forces into c (m, d). */
+static SplitResult split_lcp(Split *s, int exact, int64_t max_realignments, double *q, double *c) {
+    SplitResult out = {0, 0, 0, 0};
+    split_rows(s);
+    for (Py_ssize_t a = 0; a < s->f; a++) s->offsets[a] = 0.0;
+    edges(s);
+    assemble(s);
+    out.status = split_lemke(s, &out.pivots);
+    motion(s, q, c);
+    if (out.status != SOLUTION || !exact) return out;
+    double previous = INFINITY;
+    for (;;) {
+        const double error = misalignment(s, q, c);
+        if (error <= s->dissipation_tol) {
+            out.stage = out.realignments < 1 ? out.realignments : 1;
+            return out;
+        }
+        if (out.realignments == 0 || out.realignments == max_realignments || error > 0.5 * previous) {
+            /* First, and whenever re-alignment stalls: the exact laws with these contact modes. */
+            if (newton(s, q, c, s->dissipation_tol)) {
+                for (Py_ssize_t j = 0; j < s->n; j++) q[j] = s->newton_q[j];
+                for (Py_ssize_t i = 0; i < s->m * 3; i++) c[i] = s->forces[i];
+                out.stage = 2;
+                return out;
+            }
+            if (out.realignments == max_realignments) {
+                out.status = NOT_CONVERGED;
+                out.stage = 2;
+                return out;
+            }
+        }
+        previous = error;
+        out.realignments += 1;
+        edges(s);
+        assemble(s);
+        if (!basis_solution(s)) {
+            out.status = split_lemke(s, &out.pivots);
+            if (out.status != SOLUTION) {
+                motion(s, q, c);
+                out.stage = 1;
+                return out;
+            }
+        }
+        motion(s, q, c);
+    }
+}
+
+enum { LARGEST_SPLIT = 1 << 20 }; /* LCP rows and Newton unknowns at most: keeps every size below in size_t */
+
+/* Lay the scratch arrays of s out in `memory` (doubles) and `integers` (int64, 3 N + 2 m of them) and set the covering
+ * vector to ones; with memory NULL, only count. Returns the doubles used. */
+static size_t lay_out(Split *s, double *memory, int64_t *integers) {
+    const Py_ssize_t m = s->m, n = s->n, f = s->f, K = s->K, t = s->d - 1, N = s->N, S = n + 3 * m;
+    size_t used = 0;
+#define TAKE(field, count) (s->field = memory ? memory + used : NULL, used += (size_t)(count))
+    TAKE(Jn, m * n), TAKE(bn, m), TAKE(Jt, f * t * n), TAKE(bt, f * t), TAKE(mu_f, f), TAKE(offsets, f), TAKE(edges, f * K * t);
+    TAKE(M, N * N), TAKE(qv, N), TAKE(ones, N), TAKE(z, N), TAKE(work, N * (N + 3)), TAKE(A, N * N), TAKE(rhs, N);
+    TAKE(U, N > S ? N * N : S * S), TAKE(solution, N);
+    TAKE(x, S), TAKE(trial, S), TAKE(residual, S), TAKE(jacobian, S * S), TAKE(r_trial, S), TAKE(j_trial, S * S);
+    TAKE(forces, 3 * m), TAKE(f_trial, 3 * m), TAKE(normal, S * S), TAKE(gradient, S), TAKE(step, S), TAKE(newton_q, n);
+#undef TAKE
+    if (memory == NULL) return used + 1; /* + 1: never a request for no bytes */
+    s->basis = integers, s->rows = integers + N, s->basic = integers + 2 * N, s->kind = integers + 3 * N, s->column = integers + 3 * N + m;
+    for (Py_ssize_t i = 0; i < N; i++) s->ones[i] = 1.0;
+    return used;
+}
+
+/* Take argument `index` as a float, into *value (-1 with the exception set when it is not one). */
+static int take_double(PyObject *const *args, int index, double *value) {
+    *value = PyFloat_AsDouble(args[index]);
+    return *value == -1.0 && PyErr_Occurred() ? -1 : 0;
+}
+
+/* The flags, counts and tolerances of solve_split_lcp's arguments into s (-1 with the exception set). */
+static int take_options(PyObject *const *args, Split *s, int *exact, long long *max_realignments) {
+    *exact = PyObject_IsTrue(args[6]);
+    *max_realignments = PyLong_AsLongLong(args[7]);
+    const long long pivots_per_row = PyLong_AsLongLong(args[12]);
+    if (*exact < 0 || ((*max_realignments == -1 || pivots_per_row == -1) && PyErr_Occurred())) return -1;
+    s->pivots_per_row = pivots_per_row;
+    if (take_double(args, 8, &s->dissipation_tol) || take_double(args, 9, &s->mode_tol) || take_double(args, 10, &s->pivot_tol) ||
+        take_double(args, 11, &s->feasibility_tol) || take_double(args, 13, &s->cone_roundoff) ||
+        take_double(args, 14, &s->newton_damping) || take_double(args, 15, &s->newton_stop))
+        return -1;
+    return 0;
+}
+
+/* The sizes m, d, n (from J), f (frictional) and K (base) into s; ValueError where J, frictional or base has the wrong
+ * number of dimensions, or exact cones are asked of 2-D contacts. */
+static int take_sizes(PyObject *const *args, Split *s, int exact) {
+    const int indices[3] = {0, 4, 5}, ndims[3] = {3, 1, 1};
+    Py_ssize_t shapes[3][3] = {{0}};
+    for (int k = 0; k < 3; k++) {
+        Py_buffer probe;
+        if (PyObject_GetBuffer(args[indices[k]], &probe, PyBUF_STRIDES) < 0) return -1;
+        const int right = probe.ndim == ndims[k];
+        for (int axis = 0; right && axis < ndims[k]; axis++) shapes[k][axis] = probe.shape[axis];
+        PyBuffer_Release(&probe);
+        if (!right) {
+            PyErr_SetString(PyExc_ValueError, k == 0 ? "J must have shape (m, d, n) with d = 2 or 3" : "frictional and base must be one-dimensional");
+            return -1;
+        }
+    }
+    s->m = shapes[0][0], s->d = shapes[0][1], s->n = shapes[0][2], s->f = shapes[1][0], s->K = shapes[2][0];
+    if (s->d < 2 || s->d > 3) {
+        PyErr_SetString(PyExc_ValueError, "J must have shape (m, d, n) with d = 2 or 3");
+        return -1;
+    }
+    if (exact && s->d != 3) {
+        PyErr_SetString(PyExc_ValueError, "exact cones need 3-D contacts (d = 3)");
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 18) {
+        PyErr_SetString(PyExc_TypeError,
+                        "solve_split_lcp(J, b, mu, g, frictional, base, exact, max_realignments, dissipation_tol, mode_tol, pivot_tol,"
+                        " feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) takes 18 arguments");
+        return NULL;
+    }
+    Split s;
+    memset(&s, 0, sizeof s);
+    int exact;
+    long long max_realignments;
+    if (take_options(args, &s, &exact, &max_realignments) < 0 || take_sizes(args, &s, exact) < 0) return NULL;
+    const Py_ssize_t m = s.m, d = s.d, n = s.n, f = s.f, K = s.K;
+    static const char *names[8] = {"J", "b", "mu", "g", "frictional", "base", "q", "c"};
+    const int indices[8] = {0, 1, 2, 3, 4, 5, 16, 17};
+    const int ndims[8] = {3, 2, 1, 1, 1, 1, 1, 2};
+    const Py_ssize_t shapes[8][3] = {{m, d, n}, {m, d}, {m}, {n}, {f}, {K}, {n}, {m, d}};
+    Py_buffer views[8];
+    int taken = 0;
+    PyObject *result = NULL;
+    double *memory = NULL;
+    int64_t *integers = NULL;
+    for (; taken < 8; taken++) {
+        const char *codes = taken == 4 ? "ql" : "d";
+        if (take_buffer(args[indices[taken]], &views[taken], names[taken], codes, taken >= 6, ndims[taken], shapes[taken]) < 0) goto done;
+    }
+    s.J = views[0].buf, s.b = views[1].buf, s.mu = views[2].buf, s.g = views[3].buf, s.frictional = views[4].buf, s.base = views[5].buf;
+    for (Py_ssize_t a = 0; a < f; a++)
+        if (s.frictional[a] < 0 || s.frictional[a] >= m) {
+            PyErr_Format(PyExc_ValueError, "frictional[%zd] = %lld is not a contact index", a, (long long)s.frictional[a]);
+            goto done;
+        }
+    s.N = 2 * n + m + f * K + f;
+    if (s.N > LARGEST_SPLIT || n + 3 * m > LARGEST_SPLIT) { /* dense N x N blocks: callers refuse far smaller problems */
+        PyErr_NoMemory();
+        goto done;
+    }
+    const size_t doubles = lay_out(&s, NULL, NULL);
+    memory = PyMem_RawMalloc(doubles * sizeof(double));
+    integers = PyMem_RawMalloc((size_t)(3 * s.N + 2 * m + 1) * sizeof(int64_t));
+    if (memory == NULL || integers == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    lay_out(&s, memory, integers);
+    SplitResult out;
+    Py_BEGIN_ALLOW_THREADS
+    out = split_lcp(&s, exact, max_realignments, views[6].buf, views[7].buf);
+    Py_END_ALLOW_THREADS
+    result = Py_BuildValue("(LLLL)", (long long)out.status, (long long)out.stage, (long long)out.pivots, (long long)out.realignments);
+done:
+    PyMem_RawFree(memory);
+    PyMem_RawFree(integers);
+    for (int k = 0; k < taken; k++) PyBuffer_Release(&views[k]);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"lemke", (PyCFunction)(void (*)(void))lemke, METH_FASTCALL,
      "lemke(M, q, d, max_pivots, tol, z, basis) -> (status, pivots): Lemke's method, the numba kernel's rules;\n"
@@ -407,6 +946,10 @@ static PyMethodDef methods[] = {
     {"fixed_mode_system", (PyCFunction)(void (*)(void))fixed_mode_system, METH_FASTCALL,
      "fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces): the fixed-mode laws at x,\n"
      "the numba kernel's loops; fills residual (N,), jacobian (N, N) and forces (m, d). See quasistatic.laws.fixed_modes."},
+    {"solve_split_lcp", (PyCFunction)(void (*)(void))solve_split_lcp, METH_FASTCALL,
+     "solve_split_lcp(J, b, mu, g, frictional, base, exact, max_realignments, dissipation_tol, mode_tol, pivot_tol,\n"
+     "feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) -> (status, stage, pivots, realignments):\n"
+     "the fast path's kernel, the numba kernel's steps; fills q (n,) and c (m, d). See quasistatic.solvers.numerics.lcp."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -414,4 +957,19 @@ static struct PyModuleDef module_definition = {
     PyModuleDef_HEAD_INIT, "quasistatic._lemke", "Lemke's method and the fixed-mode laws compiled (no numpy headers): see quasistatic.compiled.", -1, methods, NULL, NULL, NULL, NULL,
 };
 
-PyMODINIT_FUNC PyInit__lemke(void) { return PyModule_Create(&module_definition); }
+PyMODINIT_FUNC PyInit__lemke(void) {
+    PyObject *module = PyModule_Create(&module_definition);
+    if (module == NULL) return NULL;
+    PyObject *address = PyLong_FromVoidPtr((void *)quasistatic_lemke);
+    if (address == NULL || PyModule_AddObject(module, "lemke_address", address) < 0) {
+        Py_XDECREF(address);
+        Py_DECREF(module);
+        return NULL;
+    }
+    /* what quasistatic/compiled.py checks: a .so built from an older source is not used */
+    if (PyModule_AddIntConstant(module, "api_version", 2) < 0) {
+        Py_DECREF(module);
+        return NULL;
+    }
+    return module;
+}

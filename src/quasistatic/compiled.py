@@ -10,15 +10,20 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
 ``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``). Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
-kernels' choices in the kernels' order of arithmetic.
+kernels' choices in the kernels' order of arithmetic. ``_lemke`` also runs the fast path's whole kernel
+(:func:`solve_split_lcp`), and ``LEMKE_ADDRESS`` is where its Lemke's method starts as a plain C function on raw
+pointers, which the numba install's kernels call (``solvers/numerics/lemke.py``).
 """
 
 from __future__ import annotations
 
 import importlib
-from typing import Any
+import warnings
+from typing import Any, NamedTuple
 
 import numpy as np
+
+API_VERSION = 2  # the _lemke.c these wrappers call (its module attribute api_version)
 
 
 def _load(name: str) -> Any:
@@ -31,12 +36,20 @@ def _load(name: str) -> Any:
 
 extension: Any = _load("quasistatic._lemke")
 kernels: Any = _load("quasistatic._kernels")
+if extension is not None and getattr(extension, "api_version", 1) != API_VERSION:
+    # An editable install keeps the .so of an older _lemke.c until it is built again: run without it, and say so.
+    message = "quasistatic._lemke was built from an older source; run `pip install -e .` again to rebuild it"
+    warnings.warn(message, RuntimeWarning, stacklevel=1)
+    extension = None
 
 __all__ = [
     "HAVE_EXTENSION",
     "HAVE_KERNELS",
+    "LEMKE_ADDRESS",
     "lemke",
     "fixed_mode_system",
+    "solve_split_lcp",
+    "NewtonTolerances",
     "audit_laws",
     "analyse_frictionless",
     "to_world",
@@ -45,6 +58,8 @@ __all__ = [
 
 HAVE_EXTENSION = extension is not None
 HAVE_KERNELS = kernels is not None
+# quasistatic_lemke(n, M, q, d, max_pivots, tol, z, basis, pivots, work, rows) -> status; 0 when not built
+LEMKE_ADDRESS: int = extension.lemke_address if HAVE_EXTENSION else 0
 
 
 def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
@@ -104,6 +119,62 @@ def fixed_mode_system(
         forces,
     )
     return residual, jacobian, forces
+
+
+class NewtonTolerances(NamedTuple):
+    """The tolerances of the fast path's Newton iterations (``quasistatic.tolerances``' values, passed in by the caller)."""
+
+    cone_roundoff: float
+    damping: float
+    stop: float
+
+
+def solve_split_lcp(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    frictional: np.ndarray,
+    base: np.ndarray,
+    exact: bool,
+    max_realignments: int,
+    dissipation_tol: float,
+    mode_tol: float,
+    pivot_tol: float,
+    feasibility_tol: float,
+    pivots_per_row: int,
+    newton: NewtonTolerances,
+) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
+    """The fast path's kernel in C: ``(status, stage, q, c, pivots, realignments)`` as ``solvers/numerics/lcp.py::solve_split_lcp``.
+
+    Arguments as there (``J`` (m, d, n), ``b`` (m, d), ``mu`` (m,), ``g`` (n,), ``frictional`` (f,) int,
+    ``base`` (K,)), and the Newton iterations' tolerances.
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree, a frictional index is not a contact's, or ``exact`` is asked of 2-D contacts.
+    """
+    if J.ndim != 3:
+        raise ValueError(f"J must have shape (m, d, n), not {J.shape}")
+    m, d, n = J.shape
+    q, c = np.empty(n), np.empty((m, d))
+    status, stage, pivots, realignments = extension.solve_split_lcp(
+        *(np.ascontiguousarray(a, np.float64) for a in (J, b, mu, g)),
+        np.ascontiguousarray(frictional, np.int64),
+        np.ascontiguousarray(base, np.float64),
+        exact,
+        max_realignments,
+        dissipation_tol,
+        mode_tol,
+        pivot_tol,
+        feasibility_tol,
+        pivots_per_row,
+        *newton,
+        q,
+        c,
+    )
+    return status, stage, q, c, pivots, realignments
 
 
 def audit_laws(

@@ -24,6 +24,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.lapack import dgesv
 
+from ...compiled import HAVE_EXTENSION, NewtonTolerances
+from ...compiled import solve_split_lcp as compiled_split_lcp
 from ...jit import njit
 from ...laws import Problem
 from ...laws.fixed_modes import columns, system
@@ -104,7 +106,29 @@ def exact_newton(problem: Problem, q: np.ndarray, c: np.ndarray) -> tuple[bool, 
     return _newton(data.J, data.b, data.mu, data.g, q, c, MODE_SPEED, FRICTION_ALIGNMENT)
 
 
-@njit
+def _solve_split_lcp_compiled(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    frictional: np.ndarray,
+    base: np.ndarray,
+    exact: bool,
+    max_realignments: int,
+    dissipation_tol: float,
+    mode_tol: float,
+    pivot_tol: float,
+    feasibility_tol: float,
+    pivots_per_row: int,
+) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
+    """:func:`solve_split_lcp` in the extension's C, step for step (what runs without numba where it was built)."""
+    newton = NewtonTolerances(CONE_ROUNDOFF, NEWTON_DAMPING, NEWTON_STOP)
+    args = (max_realignments, dissipation_tol, mode_tol, pivot_tol, feasibility_tol, pivots_per_row, newton)
+    return compiled_split_lcp(J, b, mu, g, frictional, base, exact, *args)
+
+
+# Without numba: the extension's C where it was built, else this kernel as plain Python (with its steps' numpy twins).
+@njit(python=_solve_split_lcp_compiled if HAVE_EXTENSION else None)
 def solve_split_lcp(
     J: np.ndarray,
     b: np.ndarray,

@@ -8,13 +8,19 @@ from the artificial start ``w = q + d z0`` with a positive covering vector ``d``
 basis inverse is kept dense and updated by one elimination per pivot; ties in
 the ratio test are broken by the lexicographic rule on the rows of
 ``[x_B, B^-1]``, which is equivalent to perturbing ``q`` by ``(eps, eps^2, ...)``
-and so cannot cycle on degenerate problems. The kernel is compiled with numba
-when it is installed; its steps are whole-array numpy operations, which numba
-compiles as fast as loops (measured). Without numba the compiled extension
-``quasistatic._lemke`` (:mod:`quasistatic.compiled`: C by the kernel's rules, built
-by ``pip install .``) runs instead, and where it was not built (no C compiler) the
-whole-array twin :func:`_lemke_numpy`: the same pivots in fewer, BLAS-backed numpy
-calls (12 us a pivot against the kernel's 33 us as plain Python; 1.5-3 us compiled).
+and so cannot cycle on degenerate problems. The method is written twice more: in C
+in the extension ``quasistatic._lemke`` (:mod:`quasistatic.compiled`, built by
+``pip install .``, making this kernel's choices pivot for pivot) and as a whole-array
+numpy twin. Which runs:
+
+- numba installed: :func:`lemke` is compiled and calls the C code by the name of its
+  entry point (1.2-3.6x faster a pivot than numba's own compiled :func:`numba_lemke` on
+  dense LCPs, 4-6x a solve on the fast path's, whose columns are mostly zeros); where the
+  extension was not built, it calls :func:`numba_lemke` the same way (a numba ``cfunc``),
+  so that every compiled caller, cached on disk, finds the same C entry point either way;
+- no numba: :func:`lemke` is the extension's wrapper, or where it was not built (no
+  C compiler) :func:`_lemke_numpy`: the same pivots in fewer, BLAS-backed numpy calls
+  (12 us a pivot against the kernel's 33 us as plain Python; 0.4-5 us in C).
 
 Lemke's path from its primary ray ends at a solution of index +1 (``sgn det M_SS``
 of its support) or on a secondary ray, for every covering vector ``d > 0``: an LCP
@@ -26,14 +32,16 @@ Variable numbering in ``basis``: ``0..n-1`` are ``w``, ``n..2n-1`` are ``z``,
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from scipy.linalg.blas import dger
 
-from ...compiled import HAVE_EXTENSION
+from ...compiled import HAVE_EXTENSION, LEMKE_ADDRESS
 from ...compiled import lemke as compiled_lemke
-from ...jit import njit
+from ...jit import HAVE_NUMBA, c_function, cfunc_address, njit
 
-__all__ = ["lemke", "SOLUTION", "RAY", "PIVOT_LIMIT", "STATUS_NAMES"]
+__all__ = ["lemke", "numba_lemke", "SOLUTION", "RAY", "PIVOT_LIMIT", "STATUS_NAMES"]
 
 SOLUTION = 0  # z0 left the basis: a complementary solution
 RAY = 1  # the entering column has no positive entry: Lemke ended on a secondary ray
@@ -161,9 +169,11 @@ def _basic_z_numpy(basis: np.ndarray, xB: np.ndarray) -> np.ndarray:
 _PLAIN_LEMKE = compiled_lemke if HAVE_EXTENSION else _lemke_numpy
 
 
-@njit(python=_PLAIN_LEMKE)
-def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
-    """Solve ``w = M z + q, z >= 0, w >= 0, z . w = 0`` by Lemke's method.
+@njit
+def numba_lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
+    """Solve ``w = M z + q, z >= 0, w >= 0, z . w = 0`` by Lemke's method: the kernel whose choices the others make.
+
+    numba compiles it; :func:`lemke` runs the extension's C instead where it was built.
 
     Parameters
     ----------
@@ -281,3 +291,57 @@ def _pivot(Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, row: int) -> None:
     factors[row] = 0.0
     Binv -= np.outer(factors, Binv[row])
     xB -= factors * xB[row]
+
+
+# The C entry point quasistatic_lemke (src/quasistatic/_lemke.c), as kernels call it:
+# (n, M, q, d, max_pivots, tol, z, basis, pivots, work, rows) -> status; work: n (n + 3), rows: n scratch entries.
+_C_LEMKE = "quasistatic_lemke"
+_C_SIGNATURE = (
+    "int64(int64, CPointer(float64), CPointer(float64), CPointer(float64), int64, float64,"
+    " CPointer(float64), CPointer(int64), CPointer(int64), CPointer(float64), CPointer(int64))"
+)
+
+
+def _numba_lemke_by_pointers(
+    n: int, M: Any, q: Any, d: Any, max_pivots: int, tol: float, z: Any, basis: Any, pivots: Any, work: Any, rows: Any
+) -> int:
+    """:func:`numba_lemke` behind the C entry point's signature (pointers; ``work`` and ``rows`` unused): where numba is
+    installed but the extension was not built, the kernels call this instead, by the same name."""
+    M_, q_, d_ = np.empty((n, n)), np.empty(n), np.empty(n)
+    for i in range(n):
+        q_[i], d_[i] = q[i], d[i]
+        for j in range(n):
+            M_[i, j] = M[i * n + j]
+    status, z_, pivots_, basis_ = numba_lemke(M_, q_, d_, max_pivots, tol)
+    for i in range(n):
+        z[i], basis[i] = z_[i], basis_[i]
+    pivots[0] = pivots_
+    return status
+
+
+_c_lemke: Any = None  # the C entry point as kernels call it (numba installed)
+if HAVE_NUMBA:
+    _c_lemke = c_function(
+        _C_LEMKE, _C_SIGNATURE, LEMKE_ADDRESS if HAVE_EXTENSION else cfunc_address(_C_SIGNATURE, _numba_lemke_by_pointers)
+    )
+
+
+@njit(python=_PLAIN_LEMKE)
+def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
+    """Solve ``w = M z + q, z >= 0, w >= 0, z . w = 0`` by Lemke's method: :func:`numba_lemke`'s pivots, in C where built.
+
+    Arguments and results as :func:`numba_lemke`'s.
+
+    Raises
+    ------
+    ValueError
+        When ``M`` is not (n, n) or ``d`` not (n,) for ``q`` (n,).
+    """
+    n = q.shape[0]
+    if M.shape[0] != n or M.shape[1] != n or d.shape[0] != n:
+        raise ValueError("lemke: M must be (n, n) and d (n,) for q (n,)")
+    M, q, d = np.ascontiguousarray(M), np.ascontiguousarray(q), np.ascontiguousarray(d)
+    z, basis, pivots = np.empty(n), np.empty(n, dtype=np.int64), np.zeros(1, dtype=np.int64)
+    work, rows = np.empty(n * (n + 3)), np.empty(n, dtype=np.int64)
+    status = _c_lemke(n, M.ctypes, q.ctypes, d.ctypes, max_pivots, tol, z.ctypes, basis.ctypes, pivots.ctypes, work.ctypes, rows.ctypes)
+    return status, z, pivots[0], basis
