@@ -8,8 +8,37 @@
 Dask and pyarrow are the ``sweeps`` extra; a serial or joblib sweep without a chunk folder needs neither.
 """
 
-from .params import SweepParam, parse_param_spec, parse_path
-from .result import SWEEPS_INSTALL_HINT, PhaseMap, SweepPoint, SweepResult
-from .run import sweep
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .params import SweepParam, parse_param_spec, parse_path
+    from .result import SWEEPS_INSTALL_HINT, PhaseMap, SweepPoint, SweepResult
+    from .run import sweep
+
+# Each public name and the module (relative to this package) that defines it, imported when first read (PEP 562):
+# the CLI checks ``--param`` with ``params`` before ``run`` loads the solvers.
+_MODULES: dict[str, tuple[str, ...]] = {
+    "params": ("SweepParam", "parse_param_spec", "parse_path"),
+    "result": ("SWEEPS_INSTALL_HINT", "PhaseMap", "SweepPoint", "SweepResult"),
+    "run": ("sweep",),
+}
+_EXPORTS = {name: module for module, names in _MODULES.items() for name in names}
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value  # imported once; later reads are plain attribute reads
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))
+
 
 __all__ = ["SWEEPS_INSTALL_HINT", "PhaseMap", "SweepParam", "SweepPoint", "SweepResult", "parse_param_spec", "parse_path", "sweep"]
