@@ -27,9 +27,8 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from .animation import animate
     from .chart import summary_png
+    from .choices import ANIMATION_FORMATS, VIEWS, animation_output
     from .figures import MAX_PANELS, plot
-    from .geometry import VIEWS
-    from .outputs import ANIMATION_FORMATS, animation_output
     from .phase import STATUS_COLOURS, phase_diagram
     from .scene3d import ArrowScales, DrawnFrame, draw_frame, draw_state
     from .style import FORCE_COLOUR, MODE_COLOURS, NO_MOTION_COLOUR, SLIP_COLOUR, TWIST_COLOUR, require_matplotlib, save
@@ -42,8 +41,7 @@ _MODULES: dict[str, tuple[str, ...]] = {
     "animation": ("animate",),
     "chart": ("summary_png",),
     "figures": ("MAX_PANELS", "plot"),
-    "geometry": ("VIEWS",),
-    "outputs": ("ANIMATION_FORMATS", "animation_output"),
+    "choices": ("ANIMATION_FORMATS", "VIEWS", "animation_output"),
     "phase": ("STATUS_COLOURS", "phase_diagram"),
     "scene3d": ("ArrowScales", "DrawnFrame", "draw_frame", "draw_state"),
     "style": ("FORCE_COLOUR", "MODE_COLOURS", "NO_MOTION_COLOUR", "SLIP_COLOUR", "TWIST_COLOUR", "require_matplotlib", "save"),

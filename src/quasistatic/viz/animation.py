@@ -20,8 +20,8 @@ from ..adapters import AnyWorld, Halfspace, PlanarWorld, World
 from ..errors import SceneError
 from ..sim.state import State
 from ..sim.step import StepResult
+from .choices import ANIMATION_FORMATS, animation_output
 from .geometry import Projection, plane_patch, shape_outline
-from .outputs import ANIMATION_FORMATS, animation_output
 from .planar import draw_planar_parts
 from .style import BODY_FILL, EDGE_COLOUR, FORCE_COLOUR, MODE_COLOURS, MOVER_FILL, NO_MOTION_COLOUR, ROBOT_FILL, require_matplotlib, styled
 
