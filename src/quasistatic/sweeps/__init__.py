@@ -10,8 +10,9 @@ Dask and pyarrow are the ``sweeps`` extra; a serial or joblib sweep without a ch
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from ..lazy import lazy_exports
 
 if TYPE_CHECKING:
     from .params import SweepParam, parse_param_spec, parse_path
@@ -25,20 +26,7 @@ _MODULES: dict[str, tuple[str, ...]] = {
     "result": ("SWEEPS_INSTALL_HINT", "PhaseMap", "SweepPoint", "SweepResult"),
     "run": ("sweep",),
 }
-_EXPORTS = {name: module for module, names in _MODULES.items() for name in names}
-
-
-def __getattr__(name: str) -> Any:
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{module}", __name__), name)
-    globals()[name] = value  # imported once; later reads are plain attribute reads
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_EXPORTS))
+__getattr__, __dir__ = lazy_exports(__name__, _MODULES)
 
 
 __all__ = ["SWEEPS_INSTALL_HINT", "PhaseMap", "SweepParam", "SweepPoint", "SweepResult", "parse_param_spec", "parse_path", "sweep"]
