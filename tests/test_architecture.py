@@ -23,6 +23,7 @@ LEAVES = {
     "quasistatic.solution",
     "quasistatic.stdio",
     "quasistatic.compiled",
+    "quasistatic.lazy",
 }
 
 # Stage -> the stages it may import (besides itself and the leaves).

@@ -360,7 +360,8 @@ def test_the_command_line_names_the_library_methods() -> None:
 def test_importing_the_package_and_its_cli_loads_no_solver() -> None:
     """A bad scene file or ``--help`` answers without SciPy, HiGHS, SCIP or numba (the package root is lazy)."""
     heavy = ("scipy", "highspy", "pyscipopt", "numba", "pinocchio", "coal", "matplotlib")
-    code = f"import sys, quasistatic, quasistatic.cli; print(' '.join(m for m in {heavy!r} if m in sys.modules))"
+    # a None entry blocks an import (how tests simulate an install without numba): not loaded
+    code = f"import sys, quasistatic, quasistatic.cli; print(' '.join(m for m in {heavy!r} if sys.modules.get(m) is not None))"
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert loaded == []
 
@@ -375,3 +376,35 @@ def test_submodules_named_like_functions_leave_the_functions_in_place() -> None:
         "print('ok')"
     )
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip() == "ok"
+
+
+# Run in one subprocess, in this order: each command's argv, then what it may not have loaded (cumulative, so the
+# commands that load less come first). A module-level import that brings one back fails here, with no timing.
+_HEAVY = ("scipy", "numba", "matplotlib", "viser", "pyarrow", "dask", "quasistatic.solvers", "quasistatic.sim")
+_LIGHT_COMMANDS: tuple[tuple[tuple[str, ...], tuple[str, ...]], ...] = (
+    (("check", "examples/squeeze.yaml"), _HEAVY),
+    (("solve", "examples/squeeze.yaml", "--max-solutions", "0"), _HEAVY),
+    (("simulate", "examples/sim/tip_box.yaml", "--duration", "1", "--ambiguous", "x"), _HEAVY),
+    (("sweep", "examples/box_push_3d.yaml", "--param", "mu"), (*_HEAVY, "quasistatic.sweeps.run")),
+    (("sweep", "examples/box_push_3d.yaml", "--param", "contacts[9].mu=0:1:3"), (*_HEAVY, "quasistatic.sweeps.run")),
+    (("plot", "examples/squeeze.yaml", "-o", "x.bmp"), (*_HEAVY, "quasistatic.viz.figures")),
+    (("plot", "examples/squeeze.yaml", "-o", "x.png", "--view", "top"), (*_HEAVY, "quasistatic.viz.figures")),
+    (("view", "examples/squeeze.yaml", "--view", "top"), (*_HEAVY, "quasistatic.viz.viewer")),
+    (("animate", "run.npz", "-o", "x.avi"), (*_HEAVY, "quasistatic.viz.animation")),
+    (("solve", "examples/two_finger_lift.yaml", "--json"), ("scipy.optimize", "matplotlib", "quasistatic.sim", "quasistatic.viz.figures")),
+)
+
+
+def test_commands_check_their_input_before_the_heavy_imports() -> None:
+    """Bad options are refused before SciPy, matplotlib, sim/ or the solvers load; a plain solve needs no scipy.optimize."""
+    code = (
+        "import sys\nfrom quasistatic.cli import main\n"
+        f"for argv, absent in {_LIGHT_COMMANDS!r}:\n"
+        "    sys.argv = ['quasistatic', *argv]\n"
+        "    try:\n        main()\n    except SystemExit as exc:\n        code = exc.code\n"
+        "    print(code, *argv[:1], *(m for m in absent if sys.modules.get(m) is not None), file=sys.stderr)\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    lines = [line for line in result.stderr.splitlines() if not line.startswith("error:")]
+    expected = ["0 check", *(f"2 {argv[0]}" for argv, _ in _LIGHT_COMMANDS[1:-1]), "0 solve"]
+    assert lines == expected, result.stderr

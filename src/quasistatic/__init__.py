@@ -10,10 +10,11 @@ file or ``--help`` without first loading SciPy, HiGHS, SCIP and numba.
 
 from __future__ import annotations
 
-import importlib
 import sys
 import types
 from typing import TYPE_CHECKING, Any
+
+from .lazy import lazy_exports
 
 if TYPE_CHECKING:
     from .adapters import (
@@ -88,19 +89,7 @@ _MODULES: dict[str, tuple[str, ...]] = {
     "viz": ("plot", "view"),
 }
 _EXPORTS = {name: module for module, names in _MODULES.items() for name in names}
-
-
-def __getattr__(name: str) -> Any:
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{module}", __name__), name)
-    globals()[name] = value  # imported once; later reads are plain attribute reads
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_EXPORTS))
+__getattr__, __dir__ = lazy_exports(__name__, _MODULES)
 
 
 class _Package(types.ModuleType):

@@ -30,7 +30,7 @@ from rich.status import Status
 from .errors import QuasistaticError, SolverError
 from .loading import load_scene, load_world
 from .model import Scene
-from .model.io import scene_to_dict
+from .model.io import read_scene_data, scene_to_dict
 from .report import make_console, render_contacts, render_solution, render_trajectory
 from .solution import Mode, Solution
 
@@ -180,13 +180,15 @@ def plot(
     view: Annotated[str, typer.Option(help="How a 3-D scene is seen: iso, xy, xz or yz (a 2-D one: its plane).")] = "iso",
 ) -> None:
     """Solve a scene file and draw the answer: contact modes, forces and slips to scale, the twist (docs/pictures.md)."""
-    from .viz import VIEWS, require_matplotlib, save
-    from .viz import plot as draw
+    from .viz import VIEWS
 
     if output.suffix.lower() not in _PICTURE_FORMATS:
         _fail(f"--output {str(output)!r}: the extension must be one of {', '.join(_PICTURE_FORMATS)}")
     if view not in VIEWS:
         _fail(f"--view {view!r} is not one of {', '.join(VIEWS)}")
+    from .viz import plot as draw  # matplotlib and the solvers load once the options are known to be good
+    from .viz import require_matplotlib, save
+
     _guarded(require_matplotlib)
     scene, detection, world = _loaded_world(scene_file)
     solution = _solved(scene, detection, method=method)
@@ -218,7 +220,7 @@ def sweep_command(
     time_limit: Annotated[float, typer.Option(help="Seconds each point's certified search may take.")] = 60.0,
 ) -> None:
     """Solve a scene over a grid of parameter values (docs/planning.md#sweeps): a table, a phase diagram."""
-    from .sweeps import parse_param_spec, sweep
+    from .sweeps.params import parse_param_spec, sweep_params
 
     if out is not None and out.suffix.lower() not in (".parquet", ".csv"):
         _fail(f"--out {str(out)!r}: the extension must be .parquet or .csv")
@@ -233,6 +235,9 @@ def sweep_command(
 
         _guarded(require_matplotlib)
     grid = dict(_guarded(lambda: [parse_param_spec(text) for text in param]))
+    _guarded(lambda: sweep_params(read_scene_data(scene_file), grid))  # a bad file or path, refused as sweep() would
+    from .sweeps import sweep  # the solvers (and pyarrow, dask where asked for) load once the options are known to be good
+
     bar = _SweepBar()
     try:
         result = _guarded(
@@ -318,14 +323,14 @@ def simulate(
     ] = True,
 ) -> None:
     """Follow a scene of shapes or URDF robots over time: contacts found again and a certified solve at every step (docs/simulation.md)."""
-    from .sim import simulate as run
-
     policies = {"stop": "stop", "min-power": "min_power", "min_power": "min_power"}
     if ambiguous not in policies:
         _fail(f"--ambiguous {ambiguous!r} is not one of stop, min-power")
     if out is not None and out.suffix not in (".npz", ".jsonl"):
         _fail(f"--out {str(out)!r}: a trajectory is saved as .npz or .jsonl")
     world = _guarded(lambda: load_world(scene_file))
+    from .sim import simulate as run  # the solvers load once the options and the scene are known to be good
+
     console = make_console()
     with _progress_bar(console, duration) as advance:
         trajectory: Trajectory = _guarded(
@@ -350,12 +355,15 @@ def animate(
     fps: Annotated[int, typer.Option(help="Frames per second.", min=1, max=120)] = 20,
 ) -> None:
     """Draw a simulated trajectory as an animation: shapes, robot links, contacts by mode, forces to scale."""
-    from .sim import Trajectory
-    from .viz import VIEWS, require_matplotlib
-    from .viz import animate as draw
+    from .viz import VIEWS, animation_output
 
     if view not in VIEWS:
         _fail(f"--view {view!r} is not one of {', '.join(VIEWS)}")
+    output = _guarded(lambda: animation_output(output))
+    from .sim import Trajectory  # matplotlib, sim/ and the solvers load once the options are known to be good
+    from .viz import animate as draw
+    from .viz import require_matplotlib
+
     _guarded(require_matplotlib)
     trajectory = _guarded(lambda: Trajectory.load(trajectory_file))
     world = _run_world(trajectory_file, trajectory, scene)
@@ -401,8 +409,7 @@ def view(
 
     Given a trajectory, a timeline (with play/pause) scrubs its states: nothing is solved, everything drawn was recorded.
     """
-    from .viz import VIEWS, require_viser
-    from .viz import view as show
+    from .viz import VIEWS
 
     if view not in VIEWS:
         _fail(f"--view {view!r} is not one of {', '.join(VIEWS)}")
@@ -410,6 +417,9 @@ def view(
         _fail(f"--export {str(export)!r}: the file must end in .html")
     if not 0 <= port <= 65535:
         _fail(f"--port {port}: not a port number (0 to 65535)")
+    from .viz import require_viser  # viser and the solvers load once the options are known to be good
+    from .viz import view as show
+
     _guarded(require_viser)
     if scene_file.suffix.lower() in _TRAJECTORY_FORMATS:
         if method != "auto":

@@ -19,15 +19,38 @@ Rules:
   ``Solution._repr_png_`` calls ``chart`` (which imports nothing of the package but the style).
 """
 
-from .animation import ANIMATION_FORMATS, animate
-from .chart import summary_png
-from .figures import MAX_PANELS, plot
-from .geometry import VIEWS
-from .phase import STATUS_COLOURS, phase_diagram
-from .scene3d import ArrowScales, DrawnFrame, draw_frame, draw_state
-from .style import FORCE_COLOUR, MODE_COLOURS, NO_MOTION_COLOUR, SLIP_COLOUR, TWIST_COLOUR, require_matplotlib, save
-from .timeline import TrajectoryViewer, view_trajectory
-from .viewer import VIEWER_INSTALL_HINT, Velocities, Viewer, require_viser, view
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ..lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from .animation import animate
+    from .chart import summary_png
+    from .choices import ANIMATION_FORMATS, VIEWS, animation_output
+    from .figures import MAX_PANELS, plot
+    from .phase import STATUS_COLOURS, phase_diagram
+    from .scene3d import ArrowScales, DrawnFrame, draw_frame, draw_state
+    from .style import FORCE_COLOUR, MODE_COLOURS, NO_MOTION_COLOUR, SLIP_COLOUR, TWIST_COLOUR, require_matplotlib, save
+    from .timeline import TrajectoryViewer, view_trajectory
+    from .viewer import VIEWER_INSTALL_HINT, Velocities, Viewer, require_viser, view
+
+# Each public name and the module (relative to this package) that defines it, imported when first read (PEP 562):
+# the CLI checks ``--view`` against VIEWS, or a picture's suffix, before matplotlib, sim/ and the solvers load.
+_MODULES: dict[str, tuple[str, ...]] = {
+    "animation": ("animate",),
+    "chart": ("summary_png",),
+    "figures": ("MAX_PANELS", "plot"),
+    "choices": ("ANIMATION_FORMATS", "VIEWS", "animation_output"),
+    "phase": ("STATUS_COLOURS", "phase_diagram"),
+    "scene3d": ("ArrowScales", "DrawnFrame", "draw_frame", "draw_state"),
+    "style": ("FORCE_COLOUR", "MODE_COLOURS", "NO_MOTION_COLOUR", "SLIP_COLOUR", "TWIST_COLOUR", "require_matplotlib", "save"),
+    "timeline": ("TrajectoryViewer", "view_trajectory"),
+    "viewer": ("VIEWER_INSTALL_HINT", "Velocities", "Viewer", "require_viser", "view"),
+}
+__getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+
 
 __all__ = [
     "ANIMATION_FORMATS",
@@ -42,6 +65,7 @@ __all__ = [
     "TWIST_COLOUR",
     "VIEWER_INSTALL_HINT",
     "VIEWS",
+    "animation_output",
     "animate",
     "Velocities",
     "Viewer",

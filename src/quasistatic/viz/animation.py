@@ -9,7 +9,6 @@ scale for the whole run. The camera is fixed over the run.
 from __future__ import annotations
 
 import math
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
@@ -21,6 +20,7 @@ from ..adapters import AnyWorld, Halfspace, PlanarWorld, World
 from ..errors import SceneError
 from ..sim.state import State
 from ..sim.step import StepResult
+from .choices import ANIMATION_FORMATS, animation_output
 from .geometry import Projection, plane_patch, shape_outline
 from .planar import draw_planar_parts
 from .style import BODY_FILL, EDGE_COLOUR, FORCE_COLOUR, MODE_COLOURS, MOVER_FILL, NO_MOTION_COLOUR, ROBOT_FILL, require_matplotlib, styled
@@ -31,7 +31,6 @@ if TYPE_CHECKING:
 __all__ = ["animate", "ANIMATION_FORMATS", "MAX_FRAMES", "Run", "check_run_names", "frame_indices"]
 
 FloatArray = npt.NDArray[np.float64]
-ANIMATION_FORMATS = (".gif", ".mp4")
 MAX_FRAMES = 240  # a longer run is sampled at even times: a picture, not a record (the file holds every step)
 FORCE_LENGTH = 0.3  # the largest force of the run is drawn this fraction of the largest body's size
 
@@ -66,12 +65,7 @@ def animate(
     the PATH. A run of more than ``max_frames`` states is drawn at that many even times. A planar world is drawn in
     its plane (``view`` is for 3-D worlds)."""
     require_matplotlib()
-    output = Path(output)
-    suffix = output.suffix.lower()
-    if suffix not in ANIMATION_FORMATS:
-        raise SceneError("output", str(output), f"an animation is written as {' or '.join(ANIMATION_FORMATS)}")
-    if suffix == ".mp4" and shutil.which("ffmpeg") is None:
-        raise SceneError("output", str(output), "an .mp4 needs ffmpeg on the PATH (apt-get install ffmpeg); write a .gif instead")
+    output = animation_output(output)
     check_run_names(trajectory, world)
     frames = frame_indices(trajectory, max_frames)
     camera = _camera(trajectory, world, Projection.of(world.dimension, view))

@@ -15,20 +15,12 @@ import numpy as np
 import numpy.typing as npt
 
 from ..adapters import Box, Capsule, Convex, Cylinder, Halfspace, Mesh, Pose, Shape, Sphere
+from .choices import VIEWS
 
 __all__ = ["VIEWS", "Projection", "convex_hull", "shape_outline", "plane_patch"]
 
 FloatArray = npt.NDArray[np.float64]
 
-_ISO_RIGHT = np.array([1.0, 1.0, 0.0]) / math.sqrt(2.0)
-_ISO_UP = np.array([-1.0, 1.0, 2.0]) / math.sqrt(6.0)
-# Page axes (right, up) of each view, world coordinates; "iso" looks from (1, -1, 1) with z up.
-VIEWS: dict[str, tuple[FloatArray, FloatArray]] = {
-    "iso": (_ISO_RIGHT, _ISO_UP),
-    "xy": (np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])),
-    "xz": (np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])),
-    "yz": (np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])),
-}
 _CIRCLE_POINTS = 48
 
 

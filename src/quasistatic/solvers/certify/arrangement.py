@@ -141,7 +141,6 @@ from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
-from scipy.optimize import nnls
 
 from ...laws.polyhedral import LCPForm
 from ...tolerances import ARRANGEMENT_CONTACTS, ARRANGEMENT_ROUNDOFF, DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, ZERO
@@ -453,6 +452,8 @@ class _Exclusions:
         otherwise (the caller's LP decides), as the branch and bound's root says it."""
         if self.every_load():
             return False
+        from scipy.optimize import nnls  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
+
         _, residual = nnls(self.loads, -self.g)
         return True if residual <= _margin(self.g) else None
 
@@ -488,6 +489,8 @@ def _vertex_point(form: LCPForm, planes: _Planes, vertices: _Vertices, held: np.
     mask = int(_load_masks(planes, vertices.signs[best : best + 1])[0])
     allowed = np.array([(mask >> k) & 1 for k in range(planes.loads.shape[1])], dtype=bool)
     fit = np.zeros(allowed.size)
+    from scipy.optimize import nnls  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
+
     fit[allowed], _ = nnls(planes.loads[:, allowed], -form.problem.g)
     m = planes.m
     per_edge = fit.reshape(m, 2)

@@ -31,7 +31,6 @@ import itertools
 from collections.abc import Iterator
 
 import numpy as np
-import scipy.optimize
 
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes, slips
 from ...laws.fixed_modes import FixedModeLaws
@@ -389,6 +388,8 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     laws = FixedModeLaws(problem, masks)
     x0 = laws.start(motion.q, motion.c)
     options = {"xtol": LEAST_SQUARES_STEP, "ftol": LEAST_SQUARES_STEP, "gtol": LEAST_SQUARES_STEP, "max_nfev": evaluations * x0.size}
+    import scipy.optimize  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
+
     fit = scipy.optimize.least_squares(laws.residual, x0, jac=laws.jacobian, bounds=(laws.lower_bounds(), np.inf), method="trf", **options)
     if np.max(np.abs(fit.fun), initial=0.0) > FIXED_MODE_RESIDUAL:
         # The bounded trust region can stall where unbounded Levenberg-Marquardt converges (a random

@@ -75,7 +75,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import scipy.optimize
 
 from ...laws import ModeMasks, Problem, RawMotion
 from ...laws.fixed_modes import FixedModeLaws
@@ -177,6 +176,8 @@ def _refine(problem: Problem, q: np.ndarray, c: np.ndarray) -> np.ndarray | None
     if laws.size > POLISH_MAX:
         return None
     x0 = laws.start(q, c, nonnegative=False)
+    import scipy.optimize  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
+
     fit = scipy.optimize.least_squares(
         laws.residual,
         x0,

@@ -23,7 +23,6 @@ from functools import cached_property, partial
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import nnls
 
 from ...laws import ForceSet, ModeMasks, Problem, slips
 from ...laws.polyhedral import ForcePolytope, aligned_edges, dense_force_matrix, force_polytope
@@ -514,6 +513,8 @@ def _positive_point(A: np.ndarray, forces: ForcesAtTwist, mu: np.ndarray) -> tup
     if columns.size == 0 or floor <= 0.0:
         return None
     free = A[:, columns]
+    from scipy.optimize import nnls  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
+
     y, _ = nnls(free, forces.rhs - floor * free.sum(axis=1))
     x = np.zeros(forces.fixed.size)
     x[columns] = y + floor
@@ -611,6 +612,8 @@ def farkas_excludes(forces: ForcesAtTwist, g: np.ndarray) -> bool:
     if not G.shape[1]:
         y = -g
     else:
+        from scipy.optimize import nnls  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
+
         weights, _ = nnls(G, -g)
         y = -(G @ weights + g)
     reserve = -float(g @ y) - margin * float(np.linalg.norm(y))
