@@ -31,6 +31,7 @@ from ..laws.fixed_modes import ROLLING, SEPARATING, SLIDING, columns, system
 from ..model import FloatArray
 from ..tolerances import FIXED_MODE_RESIDUAL, PLAN_COST
 from .numerics.highs import INF, solve_lp, solve_qp
+from .numerics.optimize import minimize
 
 __all__ = ["PlanModes", "PlannedInputs", "plan_inputs"]
 
@@ -247,12 +248,10 @@ def _spatial(setup: _Setup) -> PlannedInputs:
     start = _spatial_start(setup)
     if start is None:
         return _infeasible(setup, "no start: the inputs or the forces cannot meet the modes' linear conditions")
-    import scipy.optimize  # here, not at module level: it costs every `import quasistatic` 0.2-0.6 s otherwise
-
     nlp = _SpatialNLP(setup)
     z0 = nlp.pack(*start)
     scale = abs(nlp.cost(z0)) or 1.0  # SLSQP's stopping rule is absolute: the cost in units of its start
-    result = scipy.optimize.minimize(
+    result = minimize(
         lambda z: nlp.cost(z) / scale,
         z0,
         jac=lambda z: nlp.cost_gradient(z) / scale,

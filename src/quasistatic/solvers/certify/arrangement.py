@@ -144,6 +144,7 @@ import numpy as np
 
 from ...laws.polyhedral import LCPForm
 from ...tolerances import ARRANGEMENT_CONTACTS, ARRANGEMENT_ROUNDOFF, DISTINCT_TWIST, FORCE_CEILING, LP_FEASIBILITY, ZERO
+from ..numerics.optimize import nnls
 from .arrangement_floats import CLAIMS, EDGE_BIT_VALUES, seed_is_only_motion
 from .cheap import satisfies_form
 from .diagnose import admits_no_multipliers
@@ -452,8 +453,6 @@ class _Exclusions:
         otherwise (the caller's LP decides), as the branch and bound's root says it."""
         if self.every_load():
             return False
-        from scipy.optimize import nnls  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
-
         _, residual = nnls(self.loads, -self.g)
         return True if residual <= _margin(self.g) else None
 
@@ -489,8 +488,6 @@ def _vertex_point(form: LCPForm, planes: _Planes, vertices: _Vertices, held: np.
     mask = int(_load_masks(planes, vertices.signs[best : best + 1])[0])
     allowed = np.array([(mask >> k) & 1 for k in range(planes.loads.shape[1])], dtype=bool)
     fit = np.zeros(allowed.size)
-    from scipy.optimize import nnls  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
-
     fit[allowed], _ = nnls(planes.loads[:, allowed], -form.problem.g)
     m = planes.m
     per_edge = fit.reshape(m, 2)

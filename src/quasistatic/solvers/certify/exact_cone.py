@@ -49,6 +49,7 @@ from ...tolerances import (
 )
 from ..numerics.forces import least_normal_forces
 from ..numerics.highs import solve_lp
+from ..numerics.optimize import least_squares
 from ..result import BackendResult, Options
 from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
@@ -388,13 +389,11 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     laws = FixedModeLaws(problem, masks)
     x0 = laws.start(motion.q, motion.c)
     options = {"xtol": LEAST_SQUARES_STEP, "ftol": LEAST_SQUARES_STEP, "gtol": LEAST_SQUARES_STEP, "max_nfev": evaluations * x0.size}
-    import scipy.optimize  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
-
-    fit = scipy.optimize.least_squares(laws.residual, x0, jac=laws.jacobian, bounds=(laws.lower_bounds(), np.inf), method="trf", **options)
+    fit = least_squares(laws.residual, x0, jac=laws.jacobian, bounds=(laws.lower_bounds(), np.inf), method="trf", **options)
     if np.max(np.abs(fit.fun), initial=0.0) > FIXED_MODE_RESIDUAL:
         # The bounded trust region can stall where unbounded Levenberg-Marquardt converges (a random
         # 6-contact grasp); a negative normal force is then caught below, where forces are recovered by LP.
-        fit = scipy.optimize.least_squares(laws.residual, x0, jac=laws.jacobian, method="lm", **options)
+        fit = least_squares(laws.residual, x0, jac=laws.jacobian, method="lm", **options)
     q, c = laws.motion(fit.x)
     # A sliding contact may come to rest (its force then sits on the cone): still a solution.
     new_modes = np.array(contact_modes(problem, q))

@@ -80,6 +80,7 @@ from ...laws import ModeMasks, Problem, RawMotion
 from ...laws.fixed_modes import FixedModeLaws
 from ...solution import Certificate, CertificateKind, Diagnosis
 from ...tolerances import LEAST_SQUARES_STEP, MODE_SPEED, POLISHED_RESIDUAL, POWER_GAP, RECOVERED_POWER_GAP
+from ..numerics.optimize import least_squares
 from ..numerics.scip_model import new_model, optimize
 from ..result import BackendResult, Options
 from .diagnose import kinematic_certificate, no_motion
@@ -176,9 +177,7 @@ def _refine(problem: Problem, q: np.ndarray, c: np.ndarray) -> np.ndarray | None
     if laws.size > POLISH_MAX:
         return None
     x0 = laws.start(q, c, nonnegative=False)
-    import scipy.optimize  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
-
-    fit = scipy.optimize.least_squares(
+    fit = least_squares(
         laws.residual,
         x0,
         jac=laws.jacobian,

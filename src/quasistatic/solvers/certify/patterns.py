@@ -151,6 +151,7 @@ from ...tolerances import (
 )
 from ..numerics.highs import WarmLP, solve_lp
 from ..numerics.line_extent import AxisExtents, line_axis_extents
+from ..numerics.optimize import nnls
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
@@ -1064,8 +1065,6 @@ def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
     G = rows.loads[:, index]
     lam = np.zeros(index.size)
     if G.shape[1]:
-        from scipy.optimize import nnls  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
-
         lam[index], residual = nnls(G, -rows.g)
     else:
         residual = float(np.linalg.norm(rows.g))

@@ -29,6 +29,7 @@ from ...laws.polyhedral import ForcePolytope, aligned_edges, dense_force_matrix,
 from ...tolerances import FORCE_CEILING, FORCE_INTERIOR, FORCE_RANK, LP_FEASIBILITY, MOVING, ZERO
 from ..result import Range
 from .highs import solve_lp
+from .optimize import nnls
 from .ranges import Bounds, linear_ranges, null_space, ranges_are_wide, rows_feasible, rows_in_row_space, value_ranges
 from .rank import DENSE_MAX, full_column_rank
 
@@ -513,8 +514,6 @@ def _positive_point(A: np.ndarray, forces: ForcesAtTwist, mu: np.ndarray) -> tup
     if columns.size == 0 or floor <= 0.0:
         return None
     free = A[:, columns]
-    from scipy.optimize import nnls  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
-
     y, _ = nnls(free, forces.rhs - floor * free.sum(axis=1))
     x = np.zeros(forces.fixed.size)
     x[columns] = y + floor
@@ -612,8 +611,6 @@ def farkas_excludes(forces: ForcesAtTwist, g: np.ndarray) -> bool:
     if not G.shape[1]:
         y = -g
     else:
-        from scipy.optimize import nnls  # here, not at module level: scipy.optimize costs every solve's start-up ~0.2 s of CPU
-
         weights, _ = nnls(G, -g)
         y = -(G @ weights + g)
     reserve = -float(g @ y) - margin * float(np.linalg.norm(y))
