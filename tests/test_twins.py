@@ -122,14 +122,16 @@ def test_analysis_twin_of_a_non_finite_pair_or_no_contacts() -> None:
 
 @pytest.mark.parametrize("family", ["grasp-2d-nf", "grasp-3d-nf", "box-push-nf", "pile-nf"])
 def test_lemke_pair_twin_equals_the_kernel_on_bench_scenes(family: str) -> None:
-    """Lemke's pair and its analysis on the frictionless bench families, as the frictionless default runs them."""
+    """Lemke's pair and its analysis on the frictionless bench families, as the frictionless default runs them: the
+    kernel's body as plain Python (what runs without numba) against the kernel."""
+    plain = getattr(lp._lemke_pair, "py_func", lp._lemke_pair)
     make = FAMILIES[family].make
     for size in FAMILIES[family].quick_sizes[:2]:
         for instance in range(2):
             data = lp._Frictionless(qs.assemble(make(size, instance)))
             args = (data.J, data.b, data.mu, data.g, data.frictional, data.base, data.Jn, data.bn)
             tolerances = (MODE_SPEED, PIVOT, PIVOTS_PER_ROW, ZERO, MOTION_RANK, FORCE_RANK)
-            status, q, c, analysis = lp._lemke_pair_numpy(*args, *tolerances)
+            status, q, c, analysis = plain(*args, *tolerances)
             want = lp._lemke_pair(*args, *tolerances)
             assert status == want[0]
             np.testing.assert_allclose(q, want[1], rtol=1e-12, atol=1e-14)

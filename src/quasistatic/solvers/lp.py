@@ -94,31 +94,7 @@ class _Frictionless:
         self.lemke = 2 * problem.n_dof + problem.n_contacts <= LEMKE_MAX_ROWS
 
 
-def _lemke_pair_numpy(
-    J: np.ndarray,
-    b: np.ndarray,
-    mu: np.ndarray,
-    g: np.ndarray,
-    frictional: np.ndarray,
-    base: np.ndarray,
-    Jn: np.ndarray,
-    bn: np.ndarray,
-    mode_tol: float,
-    pivot_tol: float,
-    pivots_per_row: int,
-    zero: float,
-    motion_rank: float,
-    force_rank: float,
-) -> tuple[int, np.ndarray, np.ndarray, tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, int]]:
-    """:func:`_lemke_pair` in whole-array numpy calls (what runs without numba)."""
-    status, _, q, c, _, _ = solve_split_lcp(J, b, mu, g, frictional, base, False, 0, 0.0, mode_tol, pivot_tol, 0.0, pivots_per_row)
-    normal = c[:, -1].copy()
-    analysis = _analyse(Jn, bn, g, q, normal, zero, motion_rank, force_rank)
-    c[:, -1] = np.maximum(normal, 0.0)
-    return status, q, c, analysis
-
-
-@njit(python=_lemke_pair_numpy)
+@njit
 def _lemke_pair(
     J: np.ndarray,
     b: np.ndarray,
@@ -144,8 +120,7 @@ def _lemke_pair(
     last = c.shape[1] - 1
     normal = c[:, last].copy()
     analysis = _analyse(Jn, bn, g, q, normal, zero, motion_rank, force_rank)
-    for i in range(c.shape[0]):
-        c[i, last] = max(normal[i], 0.0)
+    c[:, last] = np.maximum(normal, 0.0)  # whole-array: the same body runs as plain Python without numba
     return status, q, c, analysis
 
 
