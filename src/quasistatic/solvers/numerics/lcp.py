@@ -106,6 +106,9 @@ def exact_newton(problem: Problem, q: np.ndarray, c: np.ndarray) -> tuple[bool, 
     return _newton(data.J, data.b, data.mu, data.g, q, c, MODE_SPEED, FRICTION_ALIGNMENT)
 
 
+_NEWTON = NewtonTolerances(CONE_ROUNDOFF, NEWTON_DAMPING, NEWTON_STOP)  # the C kernel's Newton iterations, built once
+
+
 def _solve_split_lcp_compiled(
     J: np.ndarray,
     b: np.ndarray,
@@ -122,8 +125,7 @@ def _solve_split_lcp_compiled(
     pivots_per_row: int,
 ) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
     """:func:`solve_split_lcp` in the extension's C, step for step (what runs without numba where it was built)."""
-    newton = NewtonTolerances(CONE_ROUNDOFF, NEWTON_DAMPING, NEWTON_STOP)
-    args = (max_realignments, dissipation_tol, mode_tol, pivot_tol, feasibility_tol, pivots_per_row, newton)
+    args = (max_realignments, dissipation_tol, mode_tol, pivot_tol, feasibility_tol, pivots_per_row, _NEWTON)
     return compiled_split_lcp(J, b, mu, g, frictional, base, exact, *args)
 
 
