@@ -28,6 +28,7 @@ import numpy.typing as npt
 
 from ..compiled import HAVE_EXTENSION
 from ..compiled import fixed_mode_system as compiled_fixed_mode_system
+from ..interval import Interval, matmul, point
 from ..jit import njit
 from ..model import FloatArray
 from .assemble import Problem
@@ -249,3 +250,50 @@ class FixedModeLaws:
     def motion(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Twist (n,) and contact-frame forces (m, d) at ``x``."""
         return x[: self.n].copy(), self._system(x)[2]
+
+    def enclosure(self, box: Interval) -> tuple[Interval, Interval] | None:
+        """Intervals holding the residual (N,) and the Jacobian (N, N) at every ``x`` in ``box`` (rounded outwards,
+        :mod:`quasistatic.interval`); None where a sliding contact's slip may vanish in the box (the laws are not
+        smooth there). The same equations as :func:`system`, written once more for intervals."""
+        n, t, J, b = self.n, self.t, self.J, self.b
+        q = box[:n]
+        lo, hi = np.zeros(self.size), np.zeros(self.size)
+        jac_lo, jac_hi = np.zeros((self.size, self.size)), np.zeros((self.size, self.size))
+
+        def put(rows: slice, cols: int | slice, value: Interval) -> None:
+            jac_lo[rows, cols], jac_hi[rows, cols] = value.lo, value.hi
+
+        equilibrium = point(self.g)
+        twist_block = Interval(np.zeros((n, n)), np.zeros((n, n)))
+        for i in np.flatnonzero(self.kind != SEPARATING):
+            col = int(self.column[i])
+            cn = box[col]
+            gap = matmul(J[i, t][None, :], q)[0] - b[i, t]
+            lo[col], hi[col] = gap.lo, gap.hi
+            jac_lo[col, :n] = jac_hi[col, :n] = J[i, t]
+            normal_column = point(J[i, t])
+            equilibrium = equilibrium + normal_column * cn
+            slip = matmul(J[i, :t], q) - b[i, :t]
+            if self.kind[i] == ROLLING:
+                tangential = box[col + 1 : col + 1 + t]
+                lo[col + 1 : col + 1 + t], hi[col + 1 : col + 1 + t] = slip.lo, slip.hi
+                jac_lo[col + 1 : col + 1 + t, :n] = jac_hi[col + 1 : col + 1 + t, :n] = J[i, :t]
+                jac_lo[:n, col + 1 : col + 1 + t] = jac_hi[:n, col + 1 : col + 1 + t] = J[i, :t].T
+                equilibrium = equilibrium + matmul(J[i, :t].T, tangential)
+            elif self.mu[i] > 0.0:
+                squared = slip.square().sum()
+                if squared.lo <= 0.0:
+                    return None
+                inverse_speed = squared.sqrt().reciprocal()
+                e = slip * inverse_speed  # the slip direction
+                along = matmul(J[i, :t].T, e)  # T^T e (n,)
+                mu = float(self.mu[i])
+                normal_column = normal_column - along * mu
+                equilibrium = equilibrium - along * (cn * mu)
+                k = -(cn * inverse_speed) * mu
+                projector = point(J[i, :t].T @ J[i, :t]) - along[:, None] * along[None, :]
+                twist_block = twist_block + projector * k
+            put(slice(0, n), col, normal_column)
+        put(slice(0, n), slice(0, n), twist_block)
+        lo[:n], hi[:n] = equilibrium.lo, equilibrium.hi
+        return Interval(lo, hi), Interval(jac_lo, jac_hi)

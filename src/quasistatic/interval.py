@@ -1,0 +1,164 @@
+"""Interval arithmetic on numpy arrays, rounded outwards, and Krawczyk's test for a unique zero in a box.
+
+Every operation rounds to nearest and then widens each end by one unit in the
+last place (``np.nextafter``), so the true result of the operation on any
+points of its operands lies inside (IEEE arithmetic errs by at most half a
+unit). Products of a point matrix with an interval vector or matrix
+(:func:`matmul`) work in midpoint-radius form and add a bound on the
+rounding of the sums.
+
+Only what the exact-cone certificate needs is here (:mod:`quasistatic.laws.fixed_modes`
+encloses its laws over a box with it): no library for interval arithmetic is a
+dependency of the project, and this much is short.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["Interval", "point", "matmul", "krawczyk", "KrawczykTest"]
+
+FloatArray = npt.NDArray[np.float64]
+_EPS = float(np.finfo(float).eps)
+
+
+def _down(x: FloatArray) -> FloatArray:
+    return np.nextafter(x, -np.inf)
+
+
+def _up(x: FloatArray) -> FloatArray:
+    return np.nextafter(x, np.inf)
+
+
+@dataclass(frozen=True)
+class Interval:
+    """Arrays of lower and upper ends (same shape), ``lo <= hi`` entrywise."""
+
+    lo: FloatArray
+    hi: FloatArray
+
+    @property
+    def mid(self) -> FloatArray:
+        return 0.5 * (self.lo + self.hi)
+
+    @property
+    def rad(self) -> FloatArray:
+        """Half-widths, rounded up: ``[mid - rad, mid + rad]`` holds the interval."""
+        return _up(np.maximum(self.hi - self.mid, self.mid - self.lo))
+
+    def __getitem__(self, key: Any) -> Interval:
+        return Interval(self.lo[key], self.hi[key])
+
+    def __add__(self, other: Interval | FloatArray | float) -> Interval:
+        lo, hi = _ends(other)
+        return Interval(_down(self.lo + lo), _up(self.hi + hi))
+
+    __radd__ = __add__
+
+    def __neg__(self) -> Interval:
+        return Interval(-self.hi, -self.lo)
+
+    def __sub__(self, other: Interval | FloatArray | float) -> Interval:
+        lo, hi = _ends(other)
+        return Interval(_down(self.lo - hi), _up(self.hi - lo))
+
+    def __rsub__(self, other: FloatArray | float) -> Interval:
+        return -self + other
+
+    def __mul__(self, other: Interval | FloatArray | float) -> Interval:
+        lo, hi = _ends(other)
+        products = np.stack(np.broadcast_arrays(self.lo * lo, self.lo * hi, self.hi * lo, self.hi * hi))
+        return Interval(_down(products.min(axis=0)), _up(products.max(axis=0)))
+
+    __rmul__ = __mul__
+
+    def square(self) -> Interval:
+        """``x**2`` (tighter than ``x * x``: never negative)."""
+        low, high = self.lo * self.lo, self.hi * self.hi
+        straddles = (self.lo < 0.0) & (self.hi > 0.0)
+        return Interval(np.where(straddles, 0.0, _down(np.minimum(low, high))), _up(np.maximum(low, high)))
+
+    def sqrt(self) -> Interval:
+        """Square root of a non-negative interval (negative lower ends are taken as 0)."""
+        return Interval(_down(np.sqrt(np.maximum(self.lo, 0.0))), _up(np.sqrt(np.maximum(self.hi, 0.0))))
+
+    def reciprocal(self) -> Interval:
+        """``1 / x`` of an interval that excludes 0 (the caller checks)."""
+        if np.any((self.lo <= 0.0) & (self.hi >= 0.0)):
+            raise ZeroDivisionError("interval reciprocal of an interval holding 0")
+        return Interval(_down(1.0 / self.hi), _up(1.0 / self.lo))
+
+    def sum(self, axis: int | None = None) -> Interval:
+        return Interval(_down(self.lo.sum(axis=axis)) - _sum_error(self.lo, axis), _up(self.hi.sum(axis=axis)) + _sum_error(self.hi, axis))
+
+    def inside(self, other: Interval) -> bool:
+        """Whether this interval lies in the interior of ``other`` (every entry)."""
+        return bool(np.all(self.lo > other.lo) and np.all(self.hi < other.hi))
+
+
+def point(x: FloatArray) -> Interval:
+    """The degenerate interval ``[x, x]``."""
+    x = np.asarray(x, dtype=float)
+    return Interval(x, x.copy())
+
+
+def _ends(value: Interval | FloatArray | float) -> tuple[FloatArray | float, FloatArray | float]:
+    if isinstance(value, Interval):
+        return value.lo, value.hi
+    return value, value
+
+
+def _sum_error(terms: FloatArray, axis: int | None) -> FloatArray:
+    """A bound on the rounding error of a floating-point sum of ``terms`` (Higham: (k - 1) eps sum |t|)."""
+    count = terms.size if axis is None else terms.shape[axis]
+    return _up(1.01 * count * _EPS * np.abs(terms).sum(axis=axis))
+
+
+def matmul(A: npt.NDArray[np.floating[Any]] | Interval, x: Interval) -> Interval:
+    """An enclosure of ``A @ x`` for a point or interval matrix ``A`` and an interval vector or matrix ``x``."""
+    if isinstance(A, Interval):
+        Am, Ar = A.mid, A.rad
+    else:
+        Am, Ar = np.asarray(A, dtype=float), np.zeros(np.shape(A))
+    xm, xr = x.mid, x.rad
+    centre = Am @ xm
+    spread = np.abs(Am) @ xr + Ar @ (np.abs(xm) + xr)
+    k = Am.shape[-1]
+    rounding = 1.01 * (k + 2) * _EPS * (np.abs(Am) @ np.abs(xm) + spread) + np.finfo(float).tiny
+    radius = _up(spread + rounding)
+    return Interval(_down(centre - radius), _up(centre + radius))
+
+
+@dataclass(frozen=True)
+class KrawczykTest:
+    """Krawczyk's verdict (``unique``: exactly one zero in the box, proven) and the row-sum norm of
+    ``|I - Y F'(box)|``, which must be below 1 for the test to pass: a box that fails shrinks by about it."""
+
+    unique: bool
+    contraction: float
+
+
+def krawczyk(center: FloatArray, box: Interval, residual: Interval, jacobian: Interval) -> KrawczykTest:
+    """Krawczyk's test for a unique zero of ``F`` in ``box``.
+
+    ``residual`` encloses ``F(center)`` (``center`` a point of ``box``) and ``jacobian`` encloses ``F'`` over the
+    whole box. With ``Y`` an approximate inverse of the Jacobian at the centre, the operator
+    ``K = center - Y F(center) + (I - Y F'(box)) (box - center)`` holds every zero of ``F`` in the box, and
+    ``K`` inside the box's interior proves there is one, and only one (Krawczyk 1969; Moore, Kearfott and
+    Cloud, *Introduction to Interval Analysis*, section 8.2).
+    """
+    try:
+        Y = np.linalg.inv(jacobian.mid)
+    except np.linalg.LinAlgError:
+        return KrawczykTest(False, np.inf)
+    if not np.all(np.isfinite(Y)):
+        return KrawczykTest(False, np.inf)
+    identity = np.eye(center.size)
+    contraction = Interval(identity, identity.copy()) - matmul(Y, jacobian)
+    norm = float(np.max(np.maximum(np.abs(contraction.lo), np.abs(contraction.hi)).sum(axis=1), initial=0.0))
+    K = point(center) - matmul(Y, residual) + matmul(contraction, box - center)
+    return KrawczykTest(K.inside(box), norm)
