@@ -53,6 +53,7 @@ from ..numerics.optimize import least_squares
 from ..result import BackendResult, Options
 from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
+from .exact_unique import EXACT_UNIQUENESS_PROOF, prove_unique_exact
 from .min_power import solve_min_power
 from .patterns import ENUMERATION_PROOF, NO_MOTION_PROOF, PATTERN_PROOF, PatternVerdict, prove_by_patterns
 from .search import enumerate_motions, summarise
@@ -230,11 +231,40 @@ def _refined_result(problem: Problem, motions: list[RawMotion], complete: bool, 
 
 def _summary(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, note: str) -> BackendResult:
     """Exact motions refined from a pyramid search. Completeness holds for the pyramid only, so: one motion is
-    ``solved`` (certified) only once the exact cones are proven to allow no other; a list is marked incomplete."""
+    ``solved`` (certified) only once the exact cones are proven to allow no other (:mod:`.exact_unique`); a
+    list is marked incomplete."""
     range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motions[0].q)))
     if len(motions) == 1 and not motions[0].continuum and complete:
-        return _unique_for_the_pyramid(summarise(range_form, motions, True, options)).with_notes(exact_cone=note)
+        return _proven_unique(problem, motions[0], options, note)
     return summarise(range_form, motions, False, options).with_notes(exact_cone=note)
+
+
+def _proven_unique(problem: Problem, motion: RawMotion, options: Options, note: str) -> BackendResult:
+    """The pyramid's only motion, refined: ``solved`` and certified once the exact cones are proven to hold no
+    other; ``ambiguous`` (an incomplete list) when the proof meets another exact motion; else uncertified."""
+    uniqueness = prove_unique_exact(problem, motion, options, lambda q: _exact_forces(problem, q) is not None)
+    if uniqueness.proven:
+        return unique_exact_motion(problem, motion, options, EXACT_UNIQUENESS_PROOF).with_notes(pyramid=note)
+    other = _other_motion(problem, motion, uniqueness.other, options)
+    range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motion.q)))
+    if other is not None:
+        note += "; the exact-cone uniqueness proof met a second exact motion, which the pyramid misses: the list is incomplete"
+        return summarise(range_form, [motion, other], False, options).with_notes(exact_cone=note)
+    return _unique_for_the_pyramid(summarise(range_form, [motion], True, options)).with_notes(
+        exact_cone=note, uniqueness=f"not proven for the exact cones: {uniqueness.reason}"
+    )
+
+
+def _other_motion(problem: Problem, motion: RawMotion, q: np.ndarray | None, options: Options) -> RawMotion | None:
+    """The exact motion at twist ``q`` (refined by Newton's method), if it is one, distinct from ``motion`` and
+    with the prescribed modes; else None."""
+    forces = None if q is None else _exact_forces(problem, q)
+    if q is None or forces is None:
+        return None
+    other = _refine(problem, RawMotion(q, forces), _Necessary(problem))
+    if other is None or _same_exact(problem, other, motion) or not _keeps_prescribed(problem, other, options):
+        return None
+    return other
 
 
 def unique_exact_motion(problem: Problem, motion: RawMotion, options: Options, proof: str) -> BackendResult:

@@ -165,6 +165,8 @@ __all__ = [
     "RelaxationProof",
     "relaxation_excluded",
     "ROLLING_POLYGON",
+    "CLOSED_LEAF",
+    "SEPARATING_LEAF",
 ]
 
 PATTERN_PROOF = "every contact-mode pattern excluded or holding the found twist alone (mode branch and bound, LPs and Farkas vectors)"
@@ -260,6 +262,7 @@ class _Rows:
     width: int = 2  # load columns per contact
     survivor: _Node | None = None  # the sector relaxation's leaf whose twists and forces were not excluded
     survivor_twist: np.ndarray | None = None  # a twist of it (None: its LP did not answer)
+    covered: Callable[[_Node], bool] | None = None  # sector relaxation leaves the caller proves by other means
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
 
     @classmethod
@@ -449,10 +452,10 @@ def _tree_depth(mode: _Mode) -> int:
 class RelaxationProof:
     """The mode branch and bound on the sector relaxation of exact cones (:func:`relaxation_excluded`).
 
-    ``excluded``: no pattern holds a point of the relaxation (then no exact motion exists). Otherwise
-    ``sectors`` names, per contact, the sector a surviving pattern slides in (-1: rolling, separating or
-    frictionless), with a twist ``q`` of it; ``sectors`` is None when the search gave no answer (budget, time,
-    an LP that did not answer).
+    ``excluded``: no pattern holds a point of the relaxation (then no exact motion exists), but those the
+    caller ``covered``. Otherwise ``sectors`` names, per contact, the sector a surviving pattern slides in
+    (:data:`CLOSED_LEAF`: rolling, or closed and frictionless; :data:`SEPARATING_LEAF`), with a twist ``q`` of it;
+    ``sectors`` is None when the search gave no answer (budget, time, an LP that did not answer).
     """
 
     excluded: bool
@@ -462,9 +465,15 @@ class RelaxationProof:
 
 
 ROLLING_POLYGON = 16  # tangents of the circle bounding a rolling contact's force in the sector relaxation
+CLOSED_LEAF, SEPARATING_LEAF = -1, -2  # a sector relaxation's leaf mode that slides in no sector (RelaxationProof)
 
 
-def relaxation_excluded(problem: Problem, sectors: list[np.ndarray], remaining: Callable[[], float] | None = None) -> RelaxationProof:
+def relaxation_excluded(
+    problem: Problem,
+    sectors: list[np.ndarray],
+    remaining: Callable[[], float] | None = None,
+    covered: Callable[[tuple[int, ...]], bool] | None = None,
+) -> RelaxationProof:
     """Whether the sector relaxation of the exact 3-D laws (:mod:`.wedge`) has no point, by the mode branch and bound.
 
     ``sectors``: per contact, the increasing angles ``theta_0 < ... < theta_S = theta_0 + 2 pi`` that split its
@@ -476,11 +485,18 @@ def relaxation_excluded(problem: Problem, sectors: list[np.ndarray], remaining: 
     chord and tangents, which holds the arc). With the modes fixed the twist and the forces share no unknown,
     as in the pyramid's search: a pattern is excluded by a checked Farkas vector, by its twist rows (every row
     loosened by ``LP_FEASIBILITY``), or at a leaf by a HiGHS LP on its twist rows. A leaf that survives is
-    returned (its sectors, and a twist of it): the caller refines them.
+    returned (its sectors, and a twist of it): the caller refines them. A leaf whose modes (as
+    :attr:`RelaxationProof.sectors` names them) ``covered`` accepts is passed over: the caller proves what it
+    holds by other means.
     """
     layout, sector_of = _sector_layout(problem, sectors)
     width = layout.loads.shape[1] // problem.n_contacts
-    rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=None, form=None, remaining=remaining)
+
+    def leaf(node: _Node) -> tuple[int, ...]:
+        return tuple(SEPARATING_LEAF if mode.separating else sector_of.get(id(mode), CLOSED_LEAF) for mode in node.modes)
+
+    skip = None if covered is None else lambda node: covered(leaf(node))
+    rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=None, form=None, remaining=remaining, covered=skip)
     m = problem.n_contacts
     every = (1 << layout.loads.shape[1]) - 1
     root_columns = functools.reduce(lambda bits, mode: bits & ~mode.removes, layout.roots, every)  # no padding
@@ -493,7 +509,7 @@ def relaxation_excluded(problem: Problem, sectors: list[np.ndarray], remaining: 
     survivor, q = rows.survivor, rows.survivor_twist
     if survivor is None or q is None:
         return RelaxationProof(False, nodes=nodes)  # out of nodes or time, or an LP that did not answer
-    return RelaxationProof(False, tuple(sector_of.get(id(mode), -1) for mode in survivor.modes), q, nodes)
+    return RelaxationProof(False, leaf(survivor), q, nodes)
 
 
 def _relaxed_twist(rows: _Rows, node: _Node) -> tuple[str, np.ndarray]:
@@ -738,6 +754,8 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
         if child.depth == leaf and rows.form is None:  # the sector relaxation: a leaf with a twist is a point of it
+            if rows.covered is not None and rows.covered(child):
+                continue
             status, q = _relaxed_twist(rows, child)
             if status == "infeasible":
                 continue

@@ -1,0 +1,327 @@
+"""A proof, on the exact circular cones, that a 3-D motion is the only one.
+
+The certified search is complete for an inscribed pyramid; a motion refined
+from it satisfies the exact laws, but the circle may hold others. This
+module proves there are none, in two parts that together cover every twist.
+
+Near the motion. Fix its contact modes; then the exact laws are smooth square
+equations (:mod:`quasistatic.laws.fixed_modes`). Around each sliding
+contact's slip angle take an arc of half-width ``r``. Every exact solution
+with these modes whose slips lie in the arcs has its twist in a polyhedron
+(closed contacts shut, rolling ones still, sliding ones' slips inside their
+arcs, separating ones open) and its forces in another (each sliding
+contact's friction inside the polygon of its arc's chord and tangents,
+rolling forces inside the circumscribed 16-gon, equilibrium): LPs bound both
+by a box. Krawczyk's test (:func:`quasistatic.interval.krawczyk_unique`,
+interval arithmetic rounded outwards) proves the equations have exactly one
+zero in that box, which is the motion. ``r`` is halved until the test passes
+(the box must be small where the sliding contacts' friction turns fast).
+
+Everywhere else. Every exact solution lies in some leaf of the sector
+relaxation of :mod:`.wedge` (per contact: separating, rolling, or sliding
+with its slip in one sector). The sectors of each sliding contact start with
+its arc as one sector; the mode branch and bound of
+:func:`~.patterns.relaxation_excluded` then excludes every leaf but those
+inside the arcs with the motion's modes (covered above), halving the sectors
+of a leaf that survives, as the wedge proof does. A surviving leaf whose
+twist is an exact motion ends the proof: a second motion exists.
+
+Both parts hold to the tolerances of their LPs (``LP_FEASIBILITY``, which
+the boxes are widened by) and of the branch and bound's checked Farkas
+vectors; the arithmetic of Krawczyk's test is rigorous.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...interval import Interval, krawczyk, point
+from ...laws import ModeMasks, Problem, RawMotion, contact_modes
+from ...laws.fixed_modes import FixedModeLaws
+from ...tolerances import DISTINCT_TWIST, LP_FEASIBILITY
+from ..numerics.highs import optimise_each
+from ..result import Options
+from .patterns import CLOSED_LEAF, ROLLING_POLYGON, SEPARATING_LEAF, relaxation_excluded
+
+__all__ = ["Uniqueness", "prove_unique_exact", "EXACT_UNIQUENESS_PROOF"]
+
+EXACT_UNIQUENESS_PROOF = (
+    "Krawczyk's interval test near the motion, and a sector relaxation of the exact laws excluding every other "
+    "mode pattern and slip direction (mode branch and bound, LPs and Farkas vectors)"
+)
+FIRST_ARC = 2.0**-6  # half-width [rad] of the first arc tried around each sliding contact's slip
+LAST_ARC = 2.0**-24  # the narrowest arc tried before the near part gives up
+FAR_SECTOR = np.pi / 4  # widest sector outside the arcs (the relaxation needs each narrower than a half-turn)
+FINEST_FRACTION = 1.0 / 64  # a sector is not halved below this fraction of the arc
+FAR_ROUNDS = 16  # most refinements of the sectors (measured: a proof takes 1-3; a leaf surviving 16 survives the finest)
+
+
+@dataclass(frozen=True)
+class Uniqueness:
+    """Whether the motion was proven the only one; if not, another exact motion's twist when one was met, and why."""
+
+    proven: bool
+    other: np.ndarray | None = None
+    reason: str = ""
+    rounds: int = 0
+
+
+def prove_unique_exact(problem: Problem, motion: RawMotion, options: Options, is_motion: Callable[[np.ndarray], bool]) -> Uniqueness:
+    """Prove that ``motion`` (an exact 3-D motion, checked by the caller) is the only one, within ``options``' clock.
+
+    ``is_motion`` tells whether a twist is an exact motion (it is asked of a surviving leaf's twist).
+    """
+    modes = np.array(contact_modes(problem, motion.q), dtype=object)
+    masks = ModeMasks.of(problem, modes)
+    laws = FixedModeLaws(problem, masks)
+    x = laws.start(motion.q, motion.c, nonnegative=False)
+    slips = problem.velocities(motion.q)[:, :2]
+    angles = np.arctan2(slips[:, 1], slips[:, 0])
+    arc = _near_arc(problem, laws, masks, x, angles)
+    if arc is None:
+        return Uniqueness(False, reason="the fixed-mode equations are not proven to have one zero near the motion")
+    return _far(problem, motion.q, masks, angles, arc, options, is_motion)
+
+
+def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.ndarray, angles: np.ndarray) -> float | None:
+    """The widest arc tried (from :data:`FIRST_ARC`) whose box holds only the motion; None if none does.
+
+    The box holds one twist when the rows pin it (every contact rolling or separating, say: the forces may
+    still be indeterminate); otherwise Krawczyk's test decides, and a box that fails is shrunk by its
+    contraction norm (twice it, at least halved) before the next try.
+    """
+    residual = laws.enclosure(point(x))
+    arc = FIRST_ARC
+    while arc >= LAST_ARC:
+        box = _local_box(problem, laws, masks, angles, arc)
+        if box is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
+            arc /= 2.0
+            continue
+        twist_width = box.hi[: problem.n_dof] - box.lo[: problem.n_dof]
+        if np.max(twist_width) <= DISTINCT_TWIST:
+            return arc  # one twist (the forces need not be unique)
+        enclosure = laws.enclosure(box)
+        if residual is None or enclosure is None:
+            arc /= 2.0
+            continue
+        test = krawczyk(x, box, residual[0], enclosure[1])
+        if test.unique:
+            return arc
+        arc /= max(2.0, 2.0 * min(test.contraction, 1e6))
+    return None
+
+
+def _local_box(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, angles: np.ndarray, arc: float) -> Interval | None:
+    """A box (in the fixed-mode unknowns) holding every exact solution with these modes and slips in the arcs."""
+    twist = _twist_box(problem, masks, angles, arc)
+    forces = _force_box(problem, laws, masks, angles, arc)
+    if twist is None or forces is None:
+        return None
+    lo, hi = np.concatenate([twist[0], forces[0]]), np.concatenate([twist[1], forces[1]])
+    margin = LP_FEASIBILITY * (1.0 + np.maximum(np.abs(lo), np.abs(hi)))
+    return Interval(lo - margin, hi + margin)
+
+
+Extents = tuple[np.ndarray, np.ndarray]  # least and greatest values, one entry per unknown
+
+
+def _extents(A: np.ndarray, lower: np.ndarray, upper: np.ndarray, count: int, col_lower: np.ndarray | None = None) -> Extents | None:
+    """Least and greatest value of each of the first ``count`` unknowns over ``lower <= A x <= upper``; None if unbounded or empty."""
+    units = np.eye(A.shape[1])[:count]
+    results = optimise_each([(u, maximize) for u in units for maximize in (False, True)], A, lower, upper, col_lower)
+    if any(r.status != "optimal" for r in results):
+        return None
+    values = np.array([r.objective for r in results]).reshape(count, 2)
+    return values[:, 0], values[:, 1]
+
+
+def _twist_box(problem: Problem, masks: ModeMasks, angles: np.ndarray, arc: float) -> Extents | None:
+    """Twist extents: closed contacts shut, rolling ones still, separating ones open, sliding slips in their arcs."""
+    rows, lower, upper = [], [], []
+    for i in range(problem.n_contacts):
+        Jn, bn, Jt, bt = problem.Jn[i], float(problem.bn[i]), problem.Jt[i], problem.bt[i]
+        rows.append(Jn)
+        lower.append(bn)
+        upper.append(bn if masks.closed[i] else np.inf)
+        if masks.rolling[i]:
+            rows += [Jt[0], Jt[1]]
+            lower += [bt[0], bt[1]]
+            upper += [bt[0], bt[1]]
+        elif masks.sliding[i]:
+            for row, value in _between_rays(Jt, bt, float(angles[i]) - arc, float(angles[i]) + arc):
+                rows.append(row)
+                lower.append(value)
+                upper.append(np.inf)
+    return _extents(np.array(rows), np.array(lower), np.array(upper), problem.n_dof)
+
+
+def _between_rays(Jt: np.ndarray, bt: np.ndarray, lo: float, hi: float) -> list[tuple[np.ndarray, float]]:
+    """Rows ``row . q >= value`` saying the slip ``Jt q - bt`` lies between the rays at angles ``lo`` and ``hi``."""
+    after_lo = np.array([-np.sin(lo), np.cos(lo)])  # a(lo) x v >= 0
+    before_hi = np.array([np.sin(hi), -np.cos(hi)])  # v x a(hi) >= 0
+    return [(side @ Jt, float(side @ bt)) for side in (after_lo, before_hi)]
+
+
+def _force_box(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, angles: np.ndarray, arc: float) -> Extents | None:
+    """Extents of the fixed-mode force unknowns (per closed contact its normal force, then a rolling one's c_t)
+    over the forces that balance the load: sliding friction in its arc's polygon, rolling forces in the 16-gon."""
+    closed = np.flatnonzero(masks.closed)
+    normal = {int(i): laws.column[i] - problem.n_dof for i in closed}  # the LP's columns: the laws' force unknowns first
+    spare = laws.size - problem.n_dof
+    tangential = {}
+    for i in closed:
+        if masks.rolling[i]:
+            tangential[int(i)] = [normal[int(i)] + 1, normal[int(i)] + 2]
+        else:
+            tangential[int(i)] = [spare, spare + 1]
+            spare += 2
+    equilibrium = np.zeros((problem.n_dof, spare))
+    limits = np.zeros((0, spare))
+    for i in closed:
+        equilibrium[:, normal[int(i)]] = problem.Jn[i]
+        equilibrium[:, tangential[int(i)]] = problem.Jt[i].T
+        mu = float(problem.mu[i])
+        polygon = _arc_polygon(mu, float(angles[i]), arc) if masks.sliding[i] else _circumscribed(mu)
+        rows = np.zeros((len(polygon), spare))
+        rows[:, tangential[int(i)]] = -polygon[:, :2]  # direction . (-c_t) >= at_least c_n
+        rows[:, normal[int(i)]] = -polygon[:, 2]
+        limits = np.vstack([limits, rows])
+    A = np.vstack([equilibrium, limits])
+    lower = np.concatenate([-problem.g, np.zeros(len(limits))])
+    upper = np.concatenate([-problem.g, np.full(len(limits), np.inf)])
+    col_lower = np.full(spare, -np.inf)
+    col_lower[list(normal.values())] = 0.0
+    return _extents(A, lower, upper, laws.size - problem.n_dof, col_lower)
+
+
+def _arc_polygon(mu: float, angle: float, arc: float) -> np.ndarray:
+    """Rows ``(d0, d1, a)``: ``d . p >= a c_n`` for the friction ``p = -c_t`` of a slip in the arc (``p`` on the
+    circle's arc): between its rays, beyond its chord, inside the tangents at its ends and middle."""
+    lo, hi = angle - arc, angle + arc
+    rays = [(-np.sin(lo), np.cos(lo), 0.0), (np.sin(hi), -np.cos(hi), 0.0)]
+    chord = [(np.cos(angle), np.sin(angle), mu * np.cos(arc))]
+    tangents = [(-np.cos(a), -np.sin(a), -mu) for a in (lo, angle, hi)]
+    return np.array(rays + chord + tangents)
+
+
+def _circumscribed(mu: float) -> np.ndarray:
+    """Rows as in :func:`_arc_polygon` for a force inside the circle: the circumscribed 16-gon (no friction: none)."""
+    if mu <= 0.0:
+        return np.array([(1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, -1.0, 0.0)])
+    corners = 2.0 * np.pi * np.arange(ROLLING_POLYGON) / ROLLING_POLYGON
+    return np.stack([np.cos(corners), np.sin(corners), np.full(ROLLING_POLYGON, -mu)], axis=1)
+
+
+def _far(
+    problem: Problem,
+    q: np.ndarray,
+    masks: ModeMasks,
+    angles: np.ndarray,
+    arc: float,
+    options: Options,
+    is_motion: Callable[[np.ndarray], bool],
+) -> Uniqueness:
+    """Every leaf of the sector relaxation outside the arcs (or with other modes) excluded, refining the sectors.
+
+    A surviving leaf whose twists are all the motion's (its rows pin them: a rolling contact whose force may
+    reach the circle, say) holds no other motion; it is passed over from then on.
+    """
+    sectors = [_first_sectors(float(angles[i]), arc) if masks.sliding[i] else _even_sectors() for i in range(problem.n_contacts)]
+    wanted = np.where(masks.closed, CLOSED_LEAF, SEPARATING_LEAF)
+    pinned: dict[tuple[object, ...], bool] = {}
+
+    def near(leaf: tuple[int, ...]) -> bool:
+        for i, k in enumerate(leaf):
+            if masks.sliding[i]:
+                if k < 0 or sectors[i][k + 1] > sectors[i][0] + 2.0 * arc * (1.0 + 1e-12):
+                    return False
+            elif k != wanted[i]:
+                return False
+        return True
+
+    def covered(leaf: tuple[int, ...]) -> bool:
+        if near(leaf):
+            return True
+        key = _key(sectors, leaf)
+        if key not in pinned:
+            pinned[key] = _only_twist(problem, sectors, leaf, q)
+        return pinned[key]
+
+    rounds = 0
+    while options.remaining() > 0.0 and rounds < FAR_ROUNDS:
+        rounds += 1
+        proof = relaxation_excluded(problem, sectors, options.remaining, covered)
+        if proof.excluded:
+            return Uniqueness(True, rounds=rounds)
+        if proof.sectors is None or proof.q is None:
+            return Uniqueness(False, reason="the sector relaxation's branch and bound gave no answer", rounds=rounds)
+        if np.max(np.abs(proof.q - q)) > DISTINCT_TWIST and is_motion(proof.q):
+            return Uniqueness(False, other=proof.q, reason="another exact motion exists", rounds=rounds)
+        if not _split(sectors, proof.sectors, FINEST_FRACTION * arc):
+            return Uniqueness(False, reason="a leaf of the sector relaxation survives at the finest sectors", rounds=rounds)
+    return Uniqueness(False, reason=f"out of time or of refinements ({rounds})", rounds=rounds)
+
+
+def _key(sectors: list[np.ndarray], leaf: tuple[int, ...]) -> tuple[object, ...]:
+    """A leaf's modes by value (a sector by its bounds, which stay as sectors are split)."""
+    return tuple(k if k < 0 else (float(sectors[i][k]), float(sectors[i][k + 1])) for i, k in enumerate(leaf))
+
+
+def _only_twist(problem: Problem, sectors: list[np.ndarray], leaf: tuple[int, ...], q: np.ndarray) -> bool:
+    """Whether every twist meeting the leaf's rows is within ``DISTINCT_TWIST`` of ``q`` (LPs on its extents,
+    once ``q`` is seen to meet them)."""
+    A, lower, upper = _leaf_rows(problem, sectors, leaf)
+    values = A @ q
+    if np.any(values < lower - LP_FEASIBILITY) or np.any(values > upper + LP_FEASIBILITY):
+        return False
+    extents = _extents(A, lower, upper, problem.n_dof)
+    return extents is not None and bool(np.max(np.abs(np.concatenate(extents) - np.tile(q, 2))) <= DISTINCT_TWIST)
+
+
+def _leaf_rows(problem: Problem, sectors: list[np.ndarray], leaf: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A leaf's twist rows ``lower <= A q <= upper``: its contacts shut or open, still, or slipping in a sector."""
+    rows, lower, upper = [], [], []
+    for i, k in enumerate(leaf):
+        Jn, bn, Jt, bt = problem.Jn[i], float(problem.bn[i]), problem.Jt[i], problem.bt[i]
+        rows.append(Jn)
+        lower.append(bn)
+        upper.append(np.inf if k == SEPARATING_LEAF else bn)
+        if k == CLOSED_LEAF and problem.mu[i] > 0:
+            rows += [Jt[0], Jt[1]]
+            lower += [bt[0], bt[1]]
+            upper += [bt[0], bt[1]]
+        elif k >= 0:
+            lo, hi = sectors[i][k], sectors[i][k + 1]
+            for row, value in _between_rays(Jt, bt, float(lo), float(hi)):
+                rows.append(row)
+                lower.append(value)
+                upper.append(np.inf)
+    return np.array(rows), np.array(lower), np.array(upper)
+
+
+def _first_sectors(angle: float, arc: float) -> np.ndarray:
+    """Sector bounds from ``angle - arc``: the arc as one sector, the rest of the turn in sectors of at most 45 degrees."""
+    rest = int(np.ceil((2.0 * np.pi - 2.0 * arc) / FAR_SECTOR))
+    start = angle - arc
+    return np.concatenate([[start], start + 2.0 * arc + (2.0 * np.pi - 2.0 * arc) * np.arange(rest + 1) / rest])
+
+
+def _even_sectors() -> np.ndarray:
+    count = int(round(2.0 * np.pi / FAR_SECTOR))
+    return 2.0 * np.pi * np.arange(count + 1) / count
+
+
+def _split(sectors: list[np.ndarray], active: tuple[int, ...], finest: float) -> bool:
+    """Halve each sector a surviving leaf slides in; False when every one is already at the finest."""
+    changed = False
+    for i, k in enumerate(active):
+        if k < 0:
+            continue
+        lo, hi = sectors[i][k], sectors[i][k + 1]
+        if hi - lo > 2.0 * finest:
+            sectors[i] = np.insert(sectors[i], k + 1, 0.5 * (lo + hi))
+            changed = True
+    return changed
