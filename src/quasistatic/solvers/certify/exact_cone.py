@@ -18,8 +18,10 @@ What is proven: ``unstable`` (no equilibrium even in a pyramid circumscribing
 the exact cone), kinematic ``jammed`` (a Farkas certificate), wedged
 ``jammed`` and "no motion with these modes" (a sector relaxation of the exact
 laws is infeasible, :mod:`.wedge`; failing that, the paper's exact program
-solved globally), and ``ambiguous`` (two distinct audited exact motions).
-The list of motions is complete for the pyramid; each reported motion
+solved globally), ``ambiguous`` (two distinct audited exact motions), and
+``solved`` once :mod:`.exact_unique` proves the one refined motion the only
+one on the circles (else it is marked uncertified, and the details say why).
+A list of several motions is complete for the pyramid; each reported motion
 satisfies the exact laws (the audit checks it), but motions of the exact cone
 that the pyramid misses are not excluded by proof, and the details say so.
 """

@@ -254,6 +254,7 @@ def _far(
     while options.remaining() > 0.0 and rounds < FAR_ROUNDS:
         rounds += 1
         proof = relaxation_excluded(problem, sectors, options.remaining, covered)
+        options.report(1, proof.nodes)  # a long proof shows on the CLI's status line
         if proof.excluded:
             return Uniqueness(True, rounds=rounds)
         if proof.sectors is None or proof.q is None:
