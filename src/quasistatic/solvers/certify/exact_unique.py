@@ -304,10 +304,21 @@ def _leaf_rows(problem: Problem, sectors: list[np.ndarray], leaf: tuple[int, ...
 
 
 def _first_sectors(angle: float, arc: float) -> np.ndarray:
-    """Sector bounds from ``angle - arc``: the arc as one sector, the rest of the turn in sectors of at most 45 degrees."""
-    rest = int(np.ceil((2.0 * np.pi - 2.0 * arc) / FAR_SECTOR))
-    start = angle - arc
-    return np.concatenate([[start], start + 2.0 * arc + (2.0 * np.pi - 2.0 * arc) * np.arange(rest + 1) / rest])
+    """Sector bounds from ``angle - arc``: the arc as one sector, then on either side sectors 4x wider each step
+    up to :data:`FAR_SECTOR`, and the rest of the turn in sectors of at most that (a leaf next to the arc is the
+    last to be excluded: graded sectors save the rounds that halving would take, measured 1-2 fewer)."""
+    steps = []
+    width = 2.0 * arc
+    while (width := min(4.0 * width, FAR_SECTOR)) < FAR_SECTOR:
+        steps.append(width)
+    rest = 2.0 * np.pi - 2.0 * arc - 2.0 * sum(steps)
+    if rest < FAR_SECTOR:
+        steps, rest = [], 2.0 * np.pi - 2.0 * arc
+    count = int(np.ceil(rest / FAR_SECTOR))
+    widths = [2.0 * arc, *steps, *([rest / count] * count), *reversed(steps)]
+    bounds = angle - arc + np.concatenate([[0.0], np.cumsum(widths)])
+    bounds[-1] = bounds[0] + 2.0 * np.pi  # the whole turn, whatever the rounding of the sum
+    return bounds
 
 
 def _even_sectors() -> np.ndarray:
