@@ -41,8 +41,8 @@ import numpy as np
 from ...interval import Interval, krawczyk, point
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes
 from ...laws.fixed_modes import FixedModeLaws
-from ...tolerances import DISTINCT_TWIST, LP_FEASIBILITY
-from ..numerics.highs import optimise_each
+from ...tolerances import DISTINCT_TWIST, LP_FEASIBILITY, MOTION_RANK
+from ..numerics.highs import optimise_each, solve_lp
 from ..result import Options
 from .patterns import CLOSED_LEAF, ROLLING_POLYGON, SEPARATING_LEAF, relaxation_excluded
 
@@ -54,9 +54,12 @@ EXACT_UNIQUENESS_PROOF = (
 )
 FIRST_ARC = 2.0**-6  # half-width [rad] of the first arc tried around each sliding contact's slip
 LAST_ARC = 2.0**-24  # the narrowest arc tried before the near part gives up
-FAR_SECTOR = np.pi / 4  # widest sector outside the arcs (the relaxation needs each narrower than a half-turn)
+FAR_SECTOR = np.pi / 3  # widest sector outside the arcs (narrower than a half-turn; measured against pi/2, pi/4 and pi/6: fastest)
 FINEST_FRACTION = 1.0 / 64  # a sector is not halved below this fraction of the arc
 FAR_ROUNDS = 16  # most refinements of the sectors (measured: a proof takes 1-3; a leaf surviving 16 survives the finest)
+
+
+Extents = tuple[np.ndarray, np.ndarray]  # least and greatest values, one entry per unknown
 
 
 @dataclass(frozen=True)
@@ -90,42 +93,39 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
     """The widest arc tried (from :data:`FIRST_ARC`) whose box holds only the motion; None if none does.
 
     The box holds one twist when the rows pin it (every contact rolling or separating, say: the forces may
-    still be indeterminate); otherwise Krawczyk's test decides, and a box that fails is shrunk by its
-    contraction norm (twice it, at least halved) before the next try.
+    still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and a box that fails is shrunk
+    by its contraction norm (four times it, at least halved) before the next try.
     """
     residual = laws.enclosure(point(x))
     arc = FIRST_ARC
     while arc >= LAST_ARC:
-        box = _local_box(problem, laws, masks, angles, arc)
-        if box is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
+        twist = _twist_box(problem, masks, angles, arc)
+        if twist is not None and np.max(twist[1] - twist[0]) <= DISTINCT_TWIST:
+            return arc  # one twist (the forces need not be unique)
+        box = None if twist is None else _local_box(problem, laws, masks, angles, arc, twist)
+        if box is None or residual is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
             arc /= 2.0
             continue
-        twist_width = box.hi[: problem.n_dof] - box.lo[: problem.n_dof]
-        if np.max(twist_width) <= DISTINCT_TWIST:
-            return arc  # one twist (the forces need not be unique)
         enclosure = laws.enclosure(box)
-        if residual is None or enclosure is None:
+        if enclosure is None:
             arc /= 2.0
             continue
         test = krawczyk(x, box, residual[0], enclosure[1])
         if test.unique:
             return arc
-        arc /= max(2.0, 2.0 * min(test.contraction, 1e6))
+        arc /= max(2.0, 4.0 * min(test.contraction, 1e6))
     return None
 
 
-def _local_box(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, angles: np.ndarray, arc: float) -> Interval | None:
-    """A box (in the fixed-mode unknowns) holding every exact solution with these modes and slips in the arcs."""
-    twist = _twist_box(problem, masks, angles, arc)
+def _local_box(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, angles: np.ndarray, arc: float, twist: Extents) -> Interval | None:
+    """A box (in the fixed-mode unknowns) holding every exact solution with these modes and slips in the arcs,
+    given the box of their twists; None where the forces are unbounded."""
     forces = _force_box(problem, laws, masks, angles, arc)
-    if twist is None or forces is None:
+    if forces is None:
         return None
     lo, hi = np.concatenate([twist[0], forces[0]]), np.concatenate([twist[1], forces[1]])
     margin = LP_FEASIBILITY * (1.0 + np.maximum(np.abs(lo), np.abs(hi)))
     return Interval(lo - margin, hi + margin)
-
-
-Extents = tuple[np.ndarray, np.ndarray]  # least and greatest values, one entry per unknown
 
 
 def _extents(A: np.ndarray, lower: np.ndarray, upper: np.ndarray, count: int, col_lower: np.ndarray | None = None) -> Extents | None:
@@ -253,7 +253,7 @@ def _far(
     rounds = 0
     while options.remaining() > 0.0 and rounds < FAR_ROUNDS:
         rounds += 1
-        proof = relaxation_excluded(problem, sectors, options.remaining, covered)
+        proof = relaxation_excluded(problem, sectors, options.remaining, covered, twist=q)
         options.report(1, proof.nodes)  # a long proof shows on the CLI's status line
         if proof.excluded:
             return Uniqueness(True, rounds=rounds)
@@ -272,14 +272,33 @@ def _key(sectors: list[np.ndarray], leaf: tuple[int, ...]) -> tuple[object, ...]
 
 
 def _only_twist(problem: Problem, sectors: list[np.ndarray], leaf: tuple[int, ...], q: np.ndarray) -> bool:
-    """Whether every twist meeting the leaf's rows is within ``DISTINCT_TWIST`` of ``q`` (LPs on its extents,
-    once ``q`` is seen to meet them)."""
+    """Whether ``q`` is the only twist meeting the leaf's rows: it meets them, and no direction leaves it
+    (the rows it meets with equality have full rank, and an LP finds no direction into the others)."""
     A, lower, upper = _leaf_rows(problem, sectors, leaf)
     values = A @ q
-    if np.any(values < lower - LP_FEASIBILITY) or np.any(values > upper + LP_FEASIBILITY):
+    slack = LP_FEASIBILITY * (1.0 + np.abs(lower))
+    if np.any(values < lower - slack) or np.any(values > upper + slack):
         return False
-    extents = _extents(A, lower, upper, problem.n_dof)
-    return extents is not None and bool(np.max(np.abs(np.concatenate(extents) - np.tile(q, 2))) <= DISTINCT_TWIST)
+    equal = lower == upper
+    active = ~equal & (values - lower <= slack)
+    tight = A[equal | active]
+    if tight.shape[0] < problem.n_dof:
+        return False
+    sigma = np.linalg.svd(tight, compute_uv=False)
+    if sigma[-1] <= MOTION_RANK * sigma[0]:
+        return False  # a direction that meets every tight row with equality (conservative: no LP asked)
+    if not active.any():
+        return True
+    # Directions d with A_eq d = 0 and A_act d >= 0 are the twists' directions from q: with full rank none but
+    # d = 0 has A_act d = 0, so one exists iff some A_act d can be made 1 (an optimum of 0, else of at least 1).
+    n_active = int(active.sum())
+    lp = solve_lp(
+        -A[active].sum(axis=0),
+        np.vstack([A[equal], A[active]]),
+        np.concatenate([np.zeros(int(equal.sum())), np.zeros(n_active)]),
+        np.concatenate([np.zeros(int(equal.sum())), np.ones(n_active)]),
+    )
+    return lp.status == "optimal" and -lp.objective < 0.5
 
 
 def _leaf_rows(problem: Problem, sectors: list[np.ndarray], leaf: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

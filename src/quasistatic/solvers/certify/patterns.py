@@ -473,6 +473,7 @@ def relaxation_excluded(
     sectors: list[np.ndarray],
     remaining: Callable[[], float] | None = None,
     covered: Callable[[tuple[int, ...]], bool] | None = None,
+    twist: np.ndarray | None = None,
 ) -> RelaxationProof:
     """Whether the sector relaxation of the exact 3-D laws (:mod:`.wedge`) has no point, by the mode branch and bound.
 
@@ -487,7 +488,8 @@ def relaxation_excluded(
     loosened by ``LP_FEASIBILITY``), or at a leaf by a HiGHS LP on its twist rows. A leaf that survives is
     returned (its sectors, and a twist of it): the caller refines them. A leaf whose modes (as
     :attr:`RelaxationProof.sectors` names them) ``covered`` accepts is passed over: the caller proves what it
-    holds by other means.
+    holds by other means. With ``twist`` (a motion's), a node whose rows leave that twist alone is passed over
+    as a seed's is in :func:`prove_by_patterns` (its leaves hold no other motion).
     """
     layout, sector_of = _sector_layout(problem, sectors)
     width = layout.loads.shape[1] // problem.n_contacts
@@ -496,7 +498,7 @@ def relaxation_excluded(
         return tuple(SEPARATING_LEAF if mode.separating else sector_of.get(id(mode), CLOSED_LEAF) for mode in node.modes)
 
     skip = None if covered is None else lambda node: covered(leaf(node))
-    rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=None, form=None, remaining=remaining, covered=skip)
+    rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=twist, form=None, remaining=remaining, covered=skip)
     m = problem.n_contacts
     every = (1 << layout.loads.shape[1]) - 1
     root_columns = functools.reduce(lambda bits, mode: bits & ~mode.removes, layout.roots, every)  # no padding
@@ -754,10 +756,8 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
         if child.depth == leaf and rows.form is None:  # the sector relaxation: a leaf with a twist is a point of it
-            if rows.covered is not None and rows.covered(child):
-                continue
             status, q = _relaxed_twist(rows, child)
-            if status == "infeasible":
+            if status == "infeasible" or (rows.covered is not None and rows.covered(child)):
                 continue
             rows.survivor, rows.survivor_twist = child, (q if status == "optimal" else None)
             return False
