@@ -5,8 +5,8 @@ For a certified answer (``solved`` proven unique, ``ambiguous`` with a complete 
 with each of the 3^m patterns prescribed (rolling, sliding or separating per contact) must give either
 no motion, or motions the certified answer already lists. This is an independent check: a prescribed
 pattern is solved by the fixed-mode laws, not by the search that produced the certificate. Exact 3-D
-cones included: their certified answers come from the kinematic bound or the rest proof, whose claims
-hold on the circles themselves.
+cones included: their certified answers come from the kinematic bound, the rest proof or the exact-cone
+uniqueness proof (Krawczyk's test and the sector relaxation), whose claims hold on the circles themselves.
 """
 
 from __future__ import annotations
@@ -73,4 +73,4 @@ def test_certified_answers_survive_every_mode_pattern(dimension: int, seed: int,
 @pytest.mark.parametrize(("dimension", "seed"), [(d, s) for d in (2, 3) for s in range(40)])
 def test_random_certified_answers_survive_every_mode_pattern(dimension: int, seed: int) -> None:
     if check_every_pattern(random_scene(dimension, seed)) == 0:
-        pytest.skip("the answer is not certified (exact 3-D cones with moving fingers): nothing is claimed to check")
+        pytest.skip("the answer is not certified (an exact-cone motion whose uniqueness proof did not close): nothing is claimed to check")
