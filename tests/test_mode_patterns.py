@@ -70,7 +70,7 @@ def test_certified_answers_survive_every_mode_pattern(dimension: int, seed: int,
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("dimension", "seed"), [(d, s) for d in (2, 3) for s in range(40)])
+@pytest.mark.parametrize(("dimension", "seed"), [(2, s) for s in range(40)] + [(3, s) for s in range(200)])
 def test_random_certified_answers_survive_every_mode_pattern(dimension: int, seed: int) -> None:
     if check_every_pattern(random_scene(dimension, seed)) == 0:
         pytest.skip("the answer is not certified (an exact-cone motion whose uniqueness proof did not close): nothing is claimed to check")
