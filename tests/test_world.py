@@ -267,12 +267,13 @@ def test_panda_gripper_holds_the_box_with_indeterminate_forces() -> None:
 
 
 def test_allegro_example_turns_the_ball_and_holds_it_when_still(tmp_path: Path) -> None:
-    """The Allegro example: its index finger opening turns the ball (thumb and middle rolling, index sliding), with
-    uniqueness proven for the pyramid only; with every joint still, rest is certified on the exact cones."""
+    """The Allegro example: its index finger opening turns the ball (thumb and middle rolling, index sliding),
+    proven the only motion on the exact cones; with every joint still, rest is certified on them too."""
     pytest.importorskip("pinocchio")
     allegro = EXAMPLES / "robots" / "allegro_ball.yaml"
     data = _solved_json(allegro)
-    assert data["status"] == "solved" and data["certified"] is False
+    assert data["status"] == "solved" and data["certified"] is True
+    assert "unique for the exact cones" in data["message"]
     assert [c["mode"] for c in data["contacts"]] == ["rolling", "sliding", "rolling"]
     assert np.allclose(data["bodies"]["ball"]["twist"][3:], [-0.438498, -0.131465, -0.0237766], atol=1e-5)
     import yaml
