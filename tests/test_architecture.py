@@ -24,6 +24,7 @@ LEAVES = {
     "quasistatic.stdio",
     "quasistatic.compiled",
     "quasistatic.lazy",
+    "quasistatic.interval",
 }
 
 # Stage -> the stages it may import (besides itself and the leaves).
