@@ -20,9 +20,9 @@ import quasistatic as qs
 from quasistatic import Motion
 from quasistatic.laws import RawMotion
 from quasistatic.laws.polyhedral import LCPForm, aligned_edges, polyhedral_form
+from quasistatic.solvers import fast
 from quasistatic.solvers.certify.arrangement import motion_vertex
 from quasistatic.solvers.certify.cheap import lemke_point, satisfies_form
-from quasistatic.solvers import fast
 from quasistatic.solvers.certify.patterns import PatternVerdict, prove_by_patterns
 from quasistatic.solvers.numerics.lcp import lemke_motion
 from quasistatic.solvers.numerics.lemke import RAY
