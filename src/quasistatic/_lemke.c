@@ -836,6 +836,24 @@ static size_t lay_out(Split *s, double *memory, int64_t *integers) {
     return used;
 }
 
+/* The scratch space of s (its sizes set) laid out in new memory, which the caller frees with PyMem_RawFree (NULL where
+ * none was allocated); -1 with MemoryError where the sizes are too large or an allocation fails. */
+static int allocate(Split *s, double **memory, int64_t **integers) {
+    if (s->N > LARGEST_SPLIT || s->n + 3 * s->m > LARGEST_SPLIT) { /* dense N x N blocks: callers refuse far smaller problems */
+        PyErr_NoMemory();
+        return -1;
+    }
+    const size_t doubles = lay_out(s, NULL, NULL);
+    *memory = PyMem_RawMalloc(doubles * sizeof(double));
+    *integers = PyMem_RawMalloc((size_t)(3 * s->N + 2 * s->m + 1) * sizeof(int64_t));
+    if (*memory == NULL || *integers == NULL) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    lay_out(s, *memory, *integers);
+    return 0;
+}
+
 /* Take argument `index` as a float, into *value (-1 with the exception set when it is not one). */
 static int take_double(PyObject *const *args, int index, double *value) {
     *value = PyFloat_AsDouble(args[index]);
@@ -918,18 +936,7 @@ static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssi
             goto done;
         }
     s.N = 2 * n + m + f * K + f;
-    if (s.N > LARGEST_SPLIT || n + 3 * m > LARGEST_SPLIT) { /* dense N x N blocks: callers refuse far smaller problems */
-        PyErr_NoMemory();
-        goto done;
-    }
-    const size_t doubles = lay_out(&s, NULL, NULL);
-    memory = PyMem_RawMalloc(doubles * sizeof(double));
-    integers = PyMem_RawMalloc((size_t)(3 * s.N + 2 * m + 1) * sizeof(int64_t));
-    if (memory == NULL || integers == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    lay_out(&s, memory, integers);
+    if (allocate(&s, &memory, &integers) < 0) goto done;
     SplitResult out;
     Py_BEGIN_ALLOW_THREADS
     out = split_lcp(&s, exact, max_realignments, views[6].buf, views[7].buf);
@@ -978,18 +985,7 @@ static PyObject *exact_newton(PyObject *module, PyObject *const *args, Py_ssize_
         if (take_buffer(args[indices[taken]], &views[taken], names[taken], "d", taken >= 6, ndims[taken], shapes[taken]) < 0) goto done;
     s.J = views[0].buf, s.b = views[1].buf, s.mu = views[2].buf, s.g = views[3].buf;
     s.N = 2 * n + m; /* no edges: the LCP's arrays, which Newton's method does not use, at their smallest */
-    if (n + 3 * m > LARGEST_SPLIT) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    const size_t doubles = lay_out(&s, NULL, NULL);
-    memory = PyMem_RawMalloc(doubles * sizeof(double));
-    integers = PyMem_RawMalloc((size_t)(3 * s.N + 2 * m + 1) * sizeof(int64_t));
-    if (memory == NULL || integers == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    lay_out(&s, memory, integers);
+    if (allocate(&s, &memory, &integers) < 0) goto done;
     int converged;
     Py_BEGIN_ALLOW_THREADS
     converged = newton(&s, views[4].buf, views[5].buf, tol);
