@@ -201,7 +201,12 @@ def test_fast_on_the_validation_cases_and_their_3d_extrusions(case: Any) -> None
         return
     assert expected in ("solved", "ambiguous"), f"fast found a motion where the case expects {expected}"
     assert fast.audit is not None and fast.audit.passed, fast.audit
-    if expected == "solved":
+    if expected == "solved" and case.known is not None:
+        # A documented disagreement (the Whitney pegs' 3-D twins also slide out of the plane, cases.yaml's known_3d):
+        # the fast path's one motion may be that other one, checked from the scene alone.
+        assert fast.motion is not None
+        laws_hold(problem.scene, fast.motion)
+    elif expected == "solved":
         for body, twist in case.expect.get("twists", {}).items():
             want = [twist[0], twist[1], 0.0, 0.0, 0.0, twist[2]] if case.depth is not None else twist
             assert fast.twists[body] == pytest.approx(want, abs=case.tolerance["twist"])

@@ -20,9 +20,11 @@ import quasistatic as qs
 from quasistatic import Motion
 from quasistatic.laws import RawMotion
 from quasistatic.laws.polyhedral import LCPForm, aligned_edges, polyhedral_form
+from quasistatic.solvers import fast
 from quasistatic.solvers.certify.arrangement import motion_vertex
 from quasistatic.solvers.certify.cheap import lemke_point, satisfies_form
 from quasistatic.solvers.certify.patterns import PatternVerdict, prove_by_patterns
+from quasistatic.solvers.numerics.lcp import lemke_motion
 from quasistatic.solvers.numerics.lemke import RAY
 from quasistatic.tools.bench.families import FAMILIES
 from random_scenes import random_scene
@@ -98,10 +100,7 @@ def test_fast_answers_the_bench_grasps_where_lemke_ends_on_a_ray(family: str, si
     """Issue 11's target: these five bench scenes have motions, which Lemke's path cannot reach."""
     scene = FAMILIES[family].make(size, instance)
     problem = qs.assemble(scene)
-    from quasistatic.solvers.numerics.lcp import lemke_motion
-    from quasistatic.solvers.numerics.lemke import SOLUTION
-
-    assert lemke_motion(problem)[0] != SOLUTION  # the fallback is what answers
+    assert lemke_motion(problem)[0] == RAY  # the fallback is what answers
     fast, scip = _agrees_with_scip(scene)
     assert (fast, scip) == ("solved", certified_status)
     answer = qs.solve(problem, method="fast")
@@ -220,10 +219,12 @@ def test_past_the_node_budget_scips_search_finds_the_motion(monkeypatch: pytest.
     ("seed", "method"),
     [pytest.param(7128, "sector relaxation", marks=pytest.mark.slow), (7040, "(32 edges)"), (7339, "(32 edges)")],  # 7128: 18 s
 )
-def test_exact_motions_the_8_edge_pyramid_misses(seed: int, method: str) -> None:
+def test_exact_motions_the_8_edge_pyramid_misses(seed: int, method: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """Random 3-D scenes where the 8-edge pyramid has no motion that Newton's method carries to the exact cones
     (7339), or none at all (7128: a wedge of the pyramid, not of the circles; 7040: no equilibrium in it): a point
-    of the exact cones' sector relaxation, or the 32-edge pyramid, gives the motion, one of SCIP's."""
+    of the exact cones' sector relaxation, or the 32-edge pyramid, gives the motion, one of SCIP's. (Newton's
+    method from where Lemke's paths ended, which answers 7128 and 7040 first, is held off.)"""
+    monkeypatch.setattr(fast, "_from_lemke_end", lambda *args: None)
     scene = random_scene(3, seed)
     answer = qs.solve(scene, method="fast")
     assert answer.status == "solved" and method in dict(answer.notes)["method"], answer.message
@@ -254,3 +255,47 @@ def test_frictionless_3d_no_motion_is_proven_without_a_search(chunk: int) -> Non
         assert fast.status == lp.status and fast.certified, f"fast: {fast.message}; lp: {lp.message}"
         proven_alone += "without friction either proves" in str(dict(fast.notes).get("certificate"))
     assert proven_alone > 0
+
+
+# --------------------------------------------------------------------------- Newton's method from where Lemke's path ended
+
+FROM_LEMKE_END = "Newton's method from where Lemke's path ended"
+
+
+def _without_lemke_end_starts(scene: qs.Scene, monkeypatch: pytest.MonkeyPatch) -> qs.Solution:
+    """The fast answer as before these starts (the complete fallback alone)."""
+    with monkeypatch.context() as patch:
+        patch.setattr(fast, "_from_lemke_end", lambda *args: None)
+        return qs.solve(scene, method="fast")
+
+
+def test_newton_from_the_rays_last_point_answers_grasp_3d_6_3(monkeypatch: pytest.MonkeyPatch) -> None:
+    """grasp-3d 6 #3: Lemke ends on a ray, and Newton's method from the ray's last point reaches the exact motion
+    (the one the default solve finds) that the sector relaxation's point gave before, ~100x slower."""
+    scene = FAMILIES["grasp-3d"].make(6, 3)
+    problem = qs.assemble(scene)
+    assert lemke_motion(problem)[0] == RAY
+    answer = qs.solve(problem, method="fast")
+    notes = dict(answer.notes)
+    assert answer.status == "solved" and notes["method"] == FROM_LEMKE_END and "secondary ray" in notes["lemke"]
+    assert answer.motion is not None and answer.motion.audit.passed and not answer.certified
+    before = _without_lemke_end_starts(scene, monkeypatch)
+    assert before.status == "solved" and dict(before.notes)["method"] == "sector relaxation"
+    default = qs.solve(problem)
+    assert default.status == "solved"
+    twist = _twist(problem, answer.twists)
+    for other in (before, default):
+        assert np.allclose(twist, _twist(problem, other.twists), rtol=0.0, atol=1e-9 * np.abs(twist).max())
+
+
+@pytest.mark.parametrize(("seed", "edges"), [(7111, 8), (7040, 32)])
+def test_newton_from_a_finer_pyramids_lemke_point(seed: int, edges: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Random 3-D scenes where Newton's method from the 6-edge ray's last point fails, but from where Lemke's path
+    ended on the fallback's 8-edge pyramid (7111), or on the 32-edge one (7040: no equilibrium in the 8-edge
+    pyramid), it converges before the branch and bound: a motion SCIP lists; before, the tree gave it."""
+    scene = random_scene(3, seed)
+    answer = qs.solve(scene, method="fast")
+    assert answer.status == "solved" and dict(answer.notes)["method"] == f"{FROM_LEMKE_END} ({edges} edges)", answer.message
+    assert _agrees_with_scip(scene)[0] == "solved"
+    before = _without_lemke_end_starts(scene, monkeypatch)
+    assert dict(before.notes)["method"] == f"mode branch and bound ({edges} edges)"

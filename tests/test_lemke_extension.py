@@ -378,6 +378,61 @@ def test_the_extensions_split_lcp_kernel_checks_its_arrays() -> None:
         lcp._solve_split_lcp_compiled(*_kernel_arguments(planar)[:6], True, *_kernel_arguments(planar)[7:])
 
 
+# --------------------------------------------------------------------------- Newton's method on the exact cones alone, in C
+
+
+def _newton_starts() -> Iterator[tuple[str, lcp.LemkeInputs, np.ndarray, np.ndarray]]:
+    """Starts of Newton's method on the exact 3-D cases: where the fast kernel ended (a ray's last point, or its
+    motion), grasp-3d 6 #3's ray (from which Newton converges), and random points (from which it mostly fails)."""
+    rng = np.random.default_rng(11)
+    ray = ("grasp-3d 6 #3", qs.assemble(FAMILIES["grasp-3d"].make(6, 3)).derived("fast", lcp.LemkeInputs))
+    for name, data in [*_split_lcp_cases(), ray]:
+        if not data.exact:
+            continue
+        q, c = lcp.solve_split_lcp(*_kernel_arguments(data))[2:4]
+        yield name, data, q, c
+        yield f"{name}, a random start", data, rng.normal(size=q.shape), np.abs(rng.normal(size=c.shape))
+
+
+@needs_extension
+@pytest.mark.skipif(not HAVE_NUMBA, reason="the reference is the numba kernel")
+def test_the_extensions_newton_is_the_numba_kernels() -> None:
+    """The same verdict and the same point to 1e-9 relative (the same loops: in practice to the bit), converged or not."""
+    verdicts = set()
+    for name, data, q, c in _newton_starts():
+        arguments = (data.J, data.b, data.mu, data.g, q, c, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
+        got, want = lcp._newton_compiled(*arguments), lcp._newton(*arguments)
+        assert got[0] == want[0], name
+        for g, w in ((got[1], want[1]), (got[2], want[2])):
+            np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(w).max(initial=0.0))), err_msg=name)
+        verdicts.add(bool(want[0]))
+    assert verdicts == {True, False}
+
+
+@needs_extension
+def test_exact_newton_runs_the_extensions_newton(monkeypatch: pytest.MonkeyPatch) -> None:
+    """With the extension built (numba or not), the fast path's Newton starts outside the kernel run its C."""
+    calls: list[int] = []
+    c_newton = lcp._newton_compiled
+    monkeypatch.setattr(lcp, "_newton_compiled", lambda *arguments: calls.append(1) or c_newton(*arguments))
+    problem = qs.assemble(FAMILIES["grasp-3d"].make(6, 3))
+    status, _, q, c, _, _ = lcp.lemke_motion(problem)
+    assert status == RAY and lcp.exact_newton(problem, q, c)[0] and calls == [1]
+
+
+@needs_extension
+def test_the_extensions_newton_checks_its_arrays() -> None:
+    data = qs.assemble(FAMILIES["grasp-3d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
+    q, c = np.zeros(data.J.shape[2]), np.zeros(data.J.shape[:2])
+    tolerances = (lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
+    with pytest.raises(ValueError, match=r"J must have shape \(m, 3, n\)"):
+        lcp._newton_compiled(data.J[:, 1:], data.b[:, 1:], data.mu, data.g, q, c[:, 1:], *tolerances)
+    with pytest.raises(ValueError, match="b must have shape"):
+        lcp._newton_compiled(data.J, data.b[:-1], data.mu, data.g, q, c, *tolerances)
+    with pytest.raises(ValueError, match="c must have shape"):
+        lcp._newton_compiled(data.J, data.b, data.mu, data.g, q, c[:-1], *tolerances)
+
+
 @needs_extension
 @pytest.mark.parametrize("value", [np.nan, np.inf])
 def test_the_extensions_split_lcp_kernel_ends_on_non_finite_data(value: float) -> None:

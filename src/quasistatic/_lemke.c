@@ -10,8 +10,11 @@
  *   lemke_address
  *       The address of quasistatic_lemke, the same method on raw pointers (no Python objects):
  *       the numba install's kernels call it from compiled code.
+ *   exact_newton(J, b, mu, g, q, c, mode_tol, tol, cone_roundoff, newton_damping, newton_stop, q_out, c_out) -> bool
+ *       Newton's method on the exact 3-D fixed-mode laws from (q, c), solvers/numerics/lcp.py::_newton step
+ *       for step (the kernel's own Newton, called alone); q_out (n,) and c_out (m, 3) are filled.
  *   api_version
- *       2; quasistatic/compiled.py runs without a .so built from an older source.
+ *       3; quasistatic/compiled.py runs without a .so built from an older source.
  *   fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces) -> None
  *       The fixed-mode laws at x, laws/fixed_modes.py::system loop for loop (the 3-D fast
  *       path's Newton iterations call it); the last three arrays are filled.
@@ -833,6 +836,24 @@ static size_t lay_out(Split *s, double *memory, int64_t *integers) {
     return used;
 }
 
+/* The scratch space of s (its sizes set) laid out in new memory, which the caller frees with PyMem_RawFree (NULL where
+ * none was allocated); -1 with MemoryError where the sizes are too large or an allocation fails. */
+static int allocate(Split *s, double **memory, int64_t **integers) {
+    if (s->N > LARGEST_SPLIT || s->n + 3 * s->m > LARGEST_SPLIT) { /* dense N x N blocks: callers refuse far smaller problems */
+        PyErr_NoMemory();
+        return -1;
+    }
+    const size_t doubles = lay_out(s, NULL, NULL);
+    *memory = PyMem_RawMalloc(doubles * sizeof(double));
+    *integers = PyMem_RawMalloc((size_t)(3 * s->N + 2 * s->m + 1) * sizeof(int64_t));
+    if (*memory == NULL || *integers == NULL) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    lay_out(s, *memory, *integers);
+    return 0;
+}
+
 /* Take argument `index` as a float, into *value (-1 with the exception set when it is not one). */
 static int take_double(PyObject *const *args, int index, double *value) {
     *value = PyFloat_AsDouble(args[index]);
@@ -915,23 +936,64 @@ static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssi
             goto done;
         }
     s.N = 2 * n + m + f * K + f;
-    if (s.N > LARGEST_SPLIT || n + 3 * m > LARGEST_SPLIT) { /* dense N x N blocks: callers refuse far smaller problems */
-        PyErr_NoMemory();
-        goto done;
-    }
-    const size_t doubles = lay_out(&s, NULL, NULL);
-    memory = PyMem_RawMalloc(doubles * sizeof(double));
-    integers = PyMem_RawMalloc((size_t)(3 * s.N + 2 * m + 1) * sizeof(int64_t));
-    if (memory == NULL || integers == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    lay_out(&s, memory, integers);
+    if (allocate(&s, &memory, &integers) < 0) goto done;
     SplitResult out;
     Py_BEGIN_ALLOW_THREADS
     out = split_lcp(&s, exact, max_realignments, views[6].buf, views[7].buf);
     Py_END_ALLOW_THREADS
     result = Py_BuildValue("(LLLL)", (long long)out.status, (long long)out.stage, (long long)out.pivots, (long long)out.realignments);
+done:
+    PyMem_RawFree(memory);
+    PyMem_RawFree(integers);
+    for (int k = 0; k < taken; k++) PyBuffer_Release(&views[k]);
+    return result;
+}
+
+static PyObject *exact_newton(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 13) {
+        PyErr_SetString(PyExc_TypeError, "exact_newton(J, b, mu, g, q, c, mode_tol, tol, cone_roundoff, newton_damping, newton_stop,"
+                                         " q_out, c_out) takes 13 arguments");
+        return NULL;
+    }
+    Split s;
+    memset(&s, 0, sizeof s);
+    double tol;
+    if (take_double(args, 6, &s.mode_tol) || take_double(args, 7, &tol) || take_double(args, 8, &s.cone_roundoff) ||
+        take_double(args, 9, &s.newton_damping) || take_double(args, 10, &s.newton_stop))
+        return NULL;
+    Py_buffer probe;
+    if (PyObject_GetBuffer(args[0], &probe, PyBUF_STRIDES) < 0) return NULL;
+    const int right = probe.ndim == 3 && probe.shape[1] == 3;
+    if (right) s.m = probe.shape[0], s.d = 3, s.n = probe.shape[2];
+    PyBuffer_Release(&probe);
+    if (!right) {
+        PyErr_SetString(PyExc_ValueError, "J must have shape (m, 3, n)");
+        return NULL;
+    }
+    const Py_ssize_t m = s.m, n = s.n;
+    static const char *names[8] = {"J", "b", "mu", "g", "q", "c", "q_out", "c_out"};
+    const int ndims[8] = {3, 2, 1, 1, 1, 2, 1, 2};
+    const Py_ssize_t shapes[8][3] = {{m, 3, n}, {m, 3}, {m}, {n}, {n}, {m, 3}, {n}, {m, 3}};
+    Py_buffer views[8];
+    int taken = 0;
+    PyObject *result = NULL;
+    double *memory = NULL;
+    int64_t *integers = NULL;
+    const int indices[8] = {0, 1, 2, 3, 4, 5, 11, 12};
+    for (; taken < 8; taken++)
+        if (take_buffer(args[indices[taken]], &views[taken], names[taken], "d", taken >= 6, ndims[taken], shapes[taken]) < 0) goto done;
+    s.J = views[0].buf, s.b = views[1].buf, s.mu = views[2].buf, s.g = views[3].buf;
+    s.N = 2 * n + m; /* no edges: the LCP's arrays, which Newton's method does not use, at their smallest */
+    if (allocate(&s, &memory, &integers) < 0) goto done;
+    int converged;
+    Py_BEGIN_ALLOW_THREADS
+    converged = newton(&s, views[4].buf, views[5].buf, tol);
+    double *q_out = views[6].buf, *c_out = views[7].buf;
+    for (Py_ssize_t j = 0; j < n; j++) q_out[j] = s.newton_q[j];
+    for (Py_ssize_t i = 0; i < m * 3; i++) c_out[i] = s.forces[i];
+    Py_END_ALLOW_THREADS
+    result = PyBool_FromLong(converged);
 done:
     PyMem_RawFree(memory);
     PyMem_RawFree(integers);
@@ -950,6 +1012,10 @@ static PyMethodDef methods[] = {
      "solve_split_lcp(J, b, mu, g, frictional, base, exact, max_realignments, dissipation_tol, mode_tol, pivot_tol,\n"
      "feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) -> (status, stage, pivots, realignments):\n"
      "the fast path's kernel, the numba kernel's steps; fills q (n,) and c (m, d). See quasistatic.solvers.numerics.lcp."},
+    {"exact_newton", (PyCFunction)(void (*)(void))exact_newton, METH_FASTCALL,
+     "exact_newton(J, b, mu, g, q, c, mode_tol, tol, cone_roundoff, newton_damping, newton_stop, q_out, c_out) -> bool:\n"
+     "Newton's method on the exact 3-D fixed-mode laws from (q, c), the numba kernel's steps; fills q_out (n,) and c_out (m, 3).\n"
+     "See quasistatic.solvers.numerics.lcp.exact_newton."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -967,7 +1033,7 @@ PyMODINIT_FUNC PyInit__lemke(void) {
         return NULL;
     }
     /* what quasistatic/compiled.py checks: a .so built from an older source is not used */
-    if (PyModule_AddIntConstant(module, "api_version", 2) < 0) {
+    if (PyModule_AddIntConstant(module, "api_version", 3) < 0) {
         Py_DECREF(module);
         return NULL;
     }

@@ -23,7 +23,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-API_VERSION = 2  # the _lemke.c these wrappers call (its module attribute api_version)
+API_VERSION = 3  # the _lemke.c these wrappers call (its module attribute api_version)
 
 
 def _load(name: str) -> Any:
@@ -49,6 +49,7 @@ __all__ = [
     "lemke",
     "fixed_mode_system",
     "solve_split_lcp",
+    "exact_newton",
     "NewtonTolerances",
     "audit_laws",
     "analyse_frictionless",
@@ -175,6 +176,35 @@ def solve_split_lcp(
         c,
     )
     return status, stage, q, c, pivots, realignments
+
+
+def exact_newton(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    q: np.ndarray,
+    c: np.ndarray,
+    mode_tol: float,
+    tol: float,
+    newton: NewtonTolerances,
+) -> tuple[bool, np.ndarray, np.ndarray]:
+    """Newton's method on the exact 3-D fixed-mode laws in C: ``(converged, q, c)`` as ``solvers/numerics/lcp.py::_newton``.
+
+    ``J`` (m, 3, n), ``b`` (m, 3), ``mu`` (m,), ``g`` (n,), the start ``q`` (n,) and ``c`` (m, 3), the mode and
+    convergence tolerances, and the Newton iterations' tolerances.
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree.
+    """
+    if J.ndim != 3 or J.shape[1] != 3:
+        raise ValueError(f"J must have shape (m, 3, n), not {J.shape}")
+    q_out, c_out = np.empty(J.shape[2]), np.empty(J.shape[:2])
+    arrays = (np.ascontiguousarray(a, np.float64) for a in (J, b, mu, g, q, c))
+    converged = extension.exact_newton(*arrays, mode_tol, tol, *newton, q_out, c_out)
+    return bool(converged), q_out, c_out
 
 
 def audit_laws(

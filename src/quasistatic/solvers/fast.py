@@ -20,6 +20,9 @@ Where Lemke cannot answer (a secondary ray, its pivot cap, or an exact-cone
 refinement that did not converge), a complete method takes over. A ray is no
 proof that no motion exists: Lemke's path reaches only solutions of index +1
 (``sgn det M_SS``), and some scenes' motions all have index -1 (docs/performance.md).
+On exact 3-D cones the point where the path ended is tried first as a start of
+Newton's method, as above (it converges on some scenes whose pyramid LCP has no
+solution Lemke reaches; a motion it returns keeps every mode and inequality).
 
 - One planar body: a motion at a vertex of the contacts' gap-rate and slip
   planes (:func:`~.certify.arrangement.motion_vertex`); where no vertex holds
@@ -27,7 +30,8 @@ proof that no motion exists: Lemke's path reaches only solutions of index +1
 - Otherwise (several bodies, 3-D), and where the vertices decide nothing: the
   mode branch and bound (:mod:`.certify.patterns`) stopped at its first
   motion, on the problem's own polyhedral laws (exact 3-D cones: an inscribed
-  8-edge pyramid, and the first of its motions from which Newton's method, as
+  8-edge pyramid, whose Lemke point, a solution or where its path ended, is
+  first tried as a start of Newton's method; then the first of its motions from which Newton's method, as
   above, converges to the exact cones; where none does, or equilibrium is too
   close to call, the same with 32 edges); a closed tree proves that no motion
   exists. Past the branch and bound's node budget, SCIP's complete search
@@ -81,6 +85,8 @@ _EXACT_FROM_RELAXATION = "exact laws solved by Newton's method from a point of t
 _NOT_EXACT = "no motion of the 8- or 32-edge pyramid converged to the exact cones by Newton's method"
 _FRICTIONLESS_PROOF = "no admissible twist, or no equilibrium: without friction either proves that no motion exists"
 _EXACT_FROM_PYRAMID = "exact laws solved by Newton's method with the contact modes of the branch and bound's pyramid motion"
+_FROM_LEMKE_END = "Newton's method from where Lemke's path ended"
+_EXACT_FROM_LEMKE_END = "exact laws solved by Newton's method with the contact modes of the last point of Lemke's path"
 
 
 def solve_fast(problem: Problem, options: Options) -> BackendResult:
@@ -104,9 +110,14 @@ def solve_fast(problem: Problem, options: Options) -> BackendResult:
         return BackendResult("failed", "failed: the fast path (Lemke's method) cannot prescribe contact modes", certified=False)
     status, stage, q, c, pivots, realignments = lemke_motion(problem)
     if status != SOLUTION:
-        return _complete_fallback(problem, options, _why_lemke_failed(int(status), int(stage), int(pivots)))
+        lemke = _why_lemke_failed(int(status), int(stage), int(pivots))
+        if status in (RAY, PIVOT_LIMIT) and _is_exact(problem):
+            found = _from_lemke_end(problem, q, c, (("lemke", lemke), ("method", _FROM_LEMKE_END)))
+            if found is not None:
+                return found
+        return _complete_fallback(problem, options, lemke)
     notes: tuple[tuple[str, object], ...] = (("method", "lemke"), ("pivots", int(pivots)), ("realignments", int(realignments)))
-    if problem.dimension == 3 and not problem.friction.is_polyhedral(3):
+    if _is_exact(problem):
         notes += (("exact_cone", _EXACT_STAGES[int(stage)]),)
     return BackendResult("solved", _SOLVED, (RawMotion(q, c),), certified=False, notes=notes)
 
@@ -157,6 +168,10 @@ def _on_pyramid(problem: Problem, options: Options, lemke: str, count: int, exac
         return verdict.with_notes(certificate=NO_VERTEX_PROOF, lemke=lemke)
     accept = _Acceptance(problem, exact)
     hint = lemke_point(form)[1] if form.n_edges > 2 else None  # 3-D: where Lemke ended orders the tree (2x fewer nodes)
+    if exact and hint is not None:  # that point as a start of Newton's method: cheaper than the tree, where it converges
+        found = _from_lemke_end(problem, hint[: form.n_q], form.forces(hint), notes + (("method", f"{_FROM_LEMKE_END} ({count} edges)"),))
+        if found is not None:
+            return found
     proof = prove_by_patterns(form, None, remaining=options.remaining, stop_at=accept, hint_x=hint)
     if proof.verdict is PatternVerdict.FOUND and accept.motion is not None:
         return _found(accept.motion, notes + (("method", f"mode branch and bound ({count} edges)"), *accept.notes))
@@ -185,10 +200,8 @@ class _Acceptance:
         if not self.exact:
             self.motion = RawMotion(motion.q, motion.c)  # a continuum's inner point
             return True
-        converged, q, c = exact_newton(self.problem, motion.q, motion.c)
-        if converged:
-            self.motion = RawMotion(q, c)
-        return bool(converged)
+        self.motion = _exact_from(self.problem, motion.q, motion.c)
+        return self.motion is not None
 
 
 def _no_motion(
@@ -224,6 +237,25 @@ def _exact_wedge(problem: Problem, options: Options, lemke: str) -> BackendResul
     if found:
         return _found(found[-1], (("lemke", lemke), ("method", "sector relaxation"), ("exact_cone", _EXACT_FROM_RELAXATION)))
     return _failed(f"{lemke}; the inscribed pyramid wedges, and the exact cones' sector relaxation decided nothing")
+
+
+def _is_exact(problem: Problem) -> bool:
+    """Exact 3-D cones, where Newton's method on the fixed-mode laws checks every law of a motion it returns."""
+    return problem.dimension == 3 and not problem.friction.is_polyhedral(3)
+
+
+def _exact_from(problem: Problem, q: np.ndarray, c: np.ndarray) -> RawMotion | None:
+    """The exact laws solved by Newton's method with the contact modes of ``(q, c)`` (any point, no law checked),
+    or None where it does not converge with every mode and inequality kept."""
+    converged, q_exact, c_exact = exact_newton(problem, q, c)
+    return RawMotion(q_exact, c_exact) if converged else None
+
+
+def _from_lemke_end(problem: Problem, q: np.ndarray, c: np.ndarray, notes: tuple[tuple[str, object], ...]) -> BackendResult | None:
+    """Exact cones: a motion by Newton's method from where a Lemke path ended (a ray's last point, or a pyramid's
+    solution), often near an exact motion that no pyramid's Lemke path reaches; None where it does not converge."""
+    motion = _exact_from(problem, q, c)
+    return None if motion is None else _found(motion, notes + (("exact_cone", _EXACT_FROM_LEMKE_END),))
 
 
 def _found(motion: RawMotion, notes: tuple[tuple[str, object], ...]) -> BackendResult:

@@ -291,7 +291,7 @@ FAMILIES: dict[str, Family] = {
             "grasp-3d",
             "ellipsoid held by point fingers moving at random, exact 3-D cones, mu ~ U[0.1, 1]",
             _variant(grasp_3d, "exact"),
-            quick_sizes=(4,),
+            quick_sizes=(4, 8),
             full_sizes=(4, 6, 8),
             quick_instances=1,
             full_instances=2,
