@@ -41,7 +41,7 @@ import numpy as np
 from ...interval import Interval, krawczyk, point
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes
 from ...laws.fixed_modes import FixedModeLaws
-from ...tolerances import DISTINCT_TWIST, LP_FEASIBILITY, MOTION_RANK
+from ...tolerances import DISTINCT_TWIST, JACOBIAN_RANK, LP_FEASIBILITY, MOTION_RANK
 from ..numerics.highs import optimise_each, solve_lp
 from ..result import Options
 from .patterns import CLOSED_LEAF, ROLLING_POLYGON, SEPARATING_LEAF, relaxation_excluded
@@ -97,11 +97,15 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
     by its contraction norm (four times it, at least halved) before the next try.
     """
     residual = laws.enclosure(point(x))
+    sigma = np.linalg.svd(laws.jacobian(x), compute_uv=False)
+    singular = sigma[-1] <= JACOBIAN_RANK * sigma[0]  # indeterminate forces: no box passes, only pinned twists
     arc = FIRST_ARC
     while arc >= LAST_ARC:
         twist = _twist_box(problem, masks, angles, arc)
         if twist is not None and np.max(twist[1] - twist[0]) <= DISTINCT_TWIST:
             return arc  # one twist (the forces need not be unique)
+        if singular:
+            return None
         box = None if twist is None else _local_box(problem, laws, masks, angles, arc, twist)
         if box is None or residual is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
             arc /= 2.0
