@@ -45,6 +45,7 @@ from ...tolerances import DISTINCT_TWIST, JACOBIAN_RANK, LP_FEASIBILITY, MOTION_
 from ..numerics.highs import optimise_each, solve_lp
 from ..result import Options
 from .patterns import CLOSED_LEAF, ROLLING_POLYGON, SEPARATING_LEAF, relaxation_excluded
+from .wedge import split_sectors
 
 __all__ = ["Uniqueness", "prove_unique_exact", "EXACT_UNIQUENESS_PROOF"]
 
@@ -265,7 +266,7 @@ def _far(
             return Uniqueness(False, reason="the sector relaxation's branch and bound gave no answer", rounds=rounds)
         if np.max(np.abs(proof.q - q)) > DISTINCT_TWIST and is_motion(proof.q):
             return Uniqueness(False, other=proof.q, reason="another exact motion exists", rounds=rounds)
-        if not _split(sectors, proof.sectors, FINEST_FRACTION * arc):
+        if not split_sectors(sectors, proof.sectors, FINEST_FRACTION * arc):
             return Uniqueness(False, reason="a leaf of the sector relaxation survives at the finest sectors", rounds=rounds)
     return Uniqueness(False, reason=f"out of time or of refinements ({rounds})", rounds=rounds)
 
@@ -347,16 +348,3 @@ def _first_sectors(angle: float, arc: float) -> np.ndarray:
 def _even_sectors() -> np.ndarray:
     count = int(round(2.0 * np.pi / FAR_SECTOR))
     return 2.0 * np.pi * np.arange(count + 1) / count
-
-
-def _split(sectors: list[np.ndarray], active: tuple[int, ...], finest: float) -> bool:
-    """Halve each sector a surviving leaf slides in; False when every one is already at the finest."""
-    changed = False
-    for i, k in enumerate(active):
-        if k < 0:
-            continue
-        lo, hi = sectors[i][k], sectors[i][k + 1]
-        if hi - lo > 2.0 * finest:
-            sectors[i] = np.insert(sectors[i], k + 1, 0.5 * (lo + hi))
-            changed = True
-    return changed

@@ -54,7 +54,7 @@ from ..numerics.scip_model import linear, new_model, optimize
 from ..result import Options
 from .patterns import ROLLING_POLYGON, relaxation_excluded
 
-__all__ = ["exact_cones_jam", "SECTORS", "FINEST", "BRANCH_AND_BOUND_ROUNDS", "BY_BRANCH_AND_BOUND", "BY_SCIP"]
+__all__ = ["exact_cones_jam", "split_sectors", "SECTORS", "FINEST", "BRANCH_AND_BOUND_ROUNDS", "BY_BRANCH_AND_BOUND", "BY_SCIP"]
 
 SECTORS = 8  # initial slip sectors per contact
 FINEST = 2.0 * np.pi / 256  # narrowest sector [rad] the refinement makes
@@ -86,7 +86,7 @@ def exact_cones_jam(
         status, active, q = _relaxation(problem, options, sectors, modes)
         if status == "infeasible":
             return True, max(len(s) - 1 for s in sectors), BY_SCIP
-        if status != "feasible" or (is_motion is not None and is_motion(q)) or not _split(sectors, active):
+        if status != "feasible" or (is_motion is not None and is_motion(q)) or not split_sectors(sectors, active):
             break  # out of time, or the point already satisfies the exact laws' friction: a motion is likely
     return False, max(len(s) - 1 for s in sectors), BY_SCIP
 
@@ -106,19 +106,20 @@ def _by_branch_and_bound(
             return None
         if is_motion is not None and is_motion(proof.q):
             return False
-        if not _split(sectors, list(proof.sectors)):
+        if not split_sectors(sectors, proof.sectors):
             return None
     return None
 
 
-def _split(sectors: list[np.ndarray], active: list[int]) -> bool:
-    """Halve each sector where the relaxed point's friction is not exact; False when there is none to halve."""
+def split_sectors(sectors: list[np.ndarray], active: Sequence[int], finest: float = FINEST) -> bool:
+    """Halve each sector a relaxed point slides in (``active``: per contact its sector, negative for none), in
+    place; False when each is already narrower than twice ``finest``."""
     changed = False
     for i, k in enumerate(active):
         if k < 0:
             continue
         lo, hi = sectors[i][k], sectors[i][k + 1]
-        if hi - lo > 2.0 * FINEST:
+        if hi - lo > 2.0 * finest:
             sectors[i] = np.insert(sectors[i], k + 1, 0.5 * (lo + hi))
             changed = True
     return changed
