@@ -295,3 +295,18 @@ def test_the_ranges_decide_friction_indeterminacy_where_the_shortcuts_cannot(
     monkeypatch.setattr(forces_module, "_forces_vary", lambda *args: None)
     solution = qs.solve(_pushed_box() if pushed else _pulled_box(1.0))
     assert solution.status == "solved" and solution.forces_indeterminate is indeterminate
+
+
+def test_an_lp_the_dual_simplex_leaves_without_a_status_is_answered() -> None:
+    """A sector relaxation's leaf of the puck example (four coplanar sliding supports, narrow sectors): HiGHS's
+    dual simplex stops on it without a status even with presolve off; the interior-point retry answers it."""
+    import json
+    from pathlib import Path
+
+    from quasistatic.solvers.numerics.highs import solve_lp
+
+    data = {k: np.asarray(v) for k, v in json.loads((Path(__file__).parent / "data" / "highs_no_status_lp.json").read_text()).items()}
+    rows = np.vstack([data["E"], data["A"]])
+    lower = np.concatenate([data["e"] - 1e-7, data["a"] - 1e-7])
+    upper = np.concatenate([data["e"] + 1e-7, np.full(len(data["a"]), np.inf)])
+    assert solve_lp(np.zeros(rows.shape[1]), rows, lower, upper).status == "infeasible"

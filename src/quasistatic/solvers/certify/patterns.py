@@ -515,11 +515,15 @@ def relaxation_excluded(
 
 
 def _relaxed_twist(rows: _Rows, node: _Node) -> tuple[str, np.ndarray]:
-    """The LP status of a leaf's twist rows (HiGHS, to ``LP_FEASIBILITY``) and, when ``optimal``, a twist meeting them."""
+    """The LP status of a leaf's twist rows, each loosened by ``LP_FEASIBILITY`` (as the nodes' are: closed rows
+    that depend on each other, such as four coplanar supports' gaps, disagree in round-off, and HiGHS then
+    answers no status), and, when ``optimal``, a twist meeting them."""
     equal, at_least = rows.row_mask(node.equal), rows.row_mask(node.at_least)
     E, e, A, a = rows.bank[equal], rows.rhs[equal], rows.bank[at_least], rows.rhs[at_least]
     rows.proof.lps += 1
-    lp = solve_lp(np.zeros(rows.g.size), np.vstack([E, A]), np.concatenate([e, a]), np.concatenate([e, np.full(a.size, np.inf)]))
+    lower = np.concatenate([e - LP_FEASIBILITY, a - LP_FEASIBILITY])
+    upper = np.concatenate([e + LP_FEASIBILITY, np.full(a.size, np.inf)])
+    lp = solve_lp(np.zeros(rows.g.size), np.vstack([E, A]), lower, upper)
     return lp.status, lp.x
 
 

@@ -243,6 +243,13 @@ def _run(solver: highspy.Highs, cost: np.ndarray, maximize: bool) -> LPResult:
         solver.clearSolver()
         status = _solve(solver)
         solver.setOptionValue("presolve", "choose")
+    if status == "error":
+        # The dual simplex can stop without a status on thin, degenerate sets (a sector relaxation's leaf of
+        # four coplanar sliding supports, narrow sectors); the interior-point method answers them.
+        solver.setOptionValue("solver", "ipm")
+        solver.clearSolver()
+        status = _solve(solver)
+        solver.setOptionValue("solver", "choose")
     m = solver.getNumRow()
     solution = solver.getSolution()
     x = np.array(solution.col_value) if n else np.zeros(0)
