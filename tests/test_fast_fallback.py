@@ -135,7 +135,7 @@ def test_fast_never_fails_or_contradicts_scip_3d(chunk: int) -> None:
     assert any(scip in ("solved", "ambiguous") for _, scip in statuses)
 
 
-@pytest.mark.parametrize("chunk", range(2))
+@pytest.mark.parametrize("chunk", [0, pytest.param(1, marks=pytest.mark.slow)])
 def test_fast_never_fails_or_contradicts_scip_3d_pyramid(chunk: int) -> None:
     """40 random 3-D scenes with a 4-edge pyramid (20 a chunk): there the branch and bound's "no motion" is a proof."""
     statuses = [_agrees_with_scip(random_scene(3, 6000 + 20 * chunk + k, friction="pyramid:4")) for k in range(20)]
