@@ -66,9 +66,6 @@ class Interval:
         lo, hi = _ends(other)
         return Interval(_down(self.lo - hi), _up(self.hi - lo))
 
-    def __rsub__(self, other: FloatArray | float) -> Interval:
-        return -self + other
-
     def __mul__(self, other: Interval | FloatArray | float) -> Interval:
         lo, hi = _ends(other)
         products = np.stack(np.broadcast_arrays(self.lo * lo, self.lo * hi, self.hi * lo, self.hi * hi))

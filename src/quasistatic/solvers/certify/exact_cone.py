@@ -235,10 +235,9 @@ def _summary(problem: Problem, motions: list[RawMotion], complete: bool, options
     """Exact motions refined from a pyramid search. Completeness holds for the pyramid only, so: one motion is
     ``solved`` (certified) only once the exact cones are proven to allow no other (:mod:`.exact_unique`); a
     list is marked incomplete."""
-    range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motions[0].q)))
     if len(motions) == 1 and not motions[0].continuum and complete:
         return _proven_unique(problem, motions[0], options, note)
-    return summarise(range_form, motions, False, options).with_notes(exact_cone=note)
+    return summarise(_range_form(problem, motions[0]), motions, False, options).with_notes(exact_cone=note)
 
 
 def _proven_unique(problem: Problem, motion: RawMotion, options: Options, note: str) -> BackendResult:
@@ -248,7 +247,7 @@ def _proven_unique(problem: Problem, motion: RawMotion, options: Options, note: 
     if uniqueness.proven:
         return unique_exact_motion(problem, motion, options, EXACT_UNIQUENESS_PROOF).with_notes(pyramid=note)
     other = _other_motion(problem, motion, uniqueness.other, options)
-    range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motion.q)))
+    range_form = _range_form(problem, motion)
     if other is not None:
         note += "; the exact-cone uniqueness proof met a second exact motion, which the pyramid misses: the list is incomplete"
         return summarise(range_form, [motion, other], False, options).with_notes(exact_cone=note)
@@ -271,17 +270,18 @@ def _other_motion(problem: Problem, motion: RawMotion, q: np.ndarray | None, opt
 
 def unique_exact_motion(problem: Problem, motion: RawMotion, options: Options, proof: str) -> BackendResult:
     """``solved``, certified, for a motion of the exact laws that ``proof`` shows is the only one (force ranges as usual)."""
-    range_form = polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motion.q)))
-    result = summarise(range_form, [motion], True, options)
+    result = summarise(_range_form(problem, motion), [motion], True, options)
     return dataclasses.replace(result, after_claim=f"; unique for the exact cones: {proof}").with_notes(exact_cone=proof)
 
 
-def _unique_for_the_pyramid(result: BackendResult) -> BackendResult:
-    """The pyramid's only motion, refined: an exact motion, but other exact motions are not excluded by proof.
+def _range_form(problem: Problem, motion: RawMotion) -> LCPForm:
+    """The polygon laws force ranges are worked out on: :data:`RANGE_EDGES` edges aligned with the motion's slips."""
+    return polyhedral_form(problem, aligned_edges(problem, RANGE_EDGES, slips(problem, motion.q)))
 
-    (A sector relaxation that excludes a box around the motion cannot close the gap: its looseness,
-    about width^2/8 of a sector, exceeds the box long before sectors reach their finest.)
-    """
+
+def _unique_for_the_pyramid(result: BackendResult) -> BackendResult:
+    """The pyramid's only motion, refined: an exact motion, but other exact motions are not excluded by proof
+    (:mod:`.exact_unique` did not close)."""
     message = (
         f"solved: one motion found; it is the only one of the {SEARCH_EDGES}-edge pyramid, but for the exact cones "
         "its uniqueness is not proven (use friction 'pyramid:K' for a certified answer on a pyramid)"

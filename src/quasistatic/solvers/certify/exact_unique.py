@@ -12,19 +12,22 @@ with these modes whose slips lie in the arcs has its twist in a polyhedron
 arcs, separating ones open) and its forces in another (each sliding
 contact's friction inside the polygon of its arc's chord and tangents,
 rolling forces inside the circumscribed 16-gon, equilibrium): LPs bound both
-by a box. Krawczyk's test (:func:`quasistatic.interval.krawczyk_unique`,
-interval arithmetic rounded outwards) proves the equations have exactly one
-zero in that box, which is the motion. ``r`` is halved until the test passes
-(the box must be small where the sliding contacts' friction turns fast).
+by a box. Krawczyk's test (:func:`quasistatic.interval.krawczyk`, interval
+arithmetic rounded outwards) proves the equations have exactly one zero in
+that box, which is the motion. ``r`` shrinks by the test's contraction norm
+until it passes (the box must be small where the sliding contacts' friction
+turns fast). Where the rows alone pin the twist, that decides it, however
+indeterminate the forces.
 
 Everywhere else. Every exact solution lies in some leaf of the sector
 relaxation of :mod:`.wedge` (per contact: separating, rolling, or sliding
 with its slip in one sector). The sectors of each sliding contact start with
 its arc as one sector; the mode branch and bound of
 :func:`~.patterns.relaxation_excluded` then excludes every leaf but those
-inside the arcs with the motion's modes (covered above), halving the sectors
-of a leaf that survives, as the wedge proof does. A surviving leaf whose
-twist is an exact motion ends the proof: a second motion exists.
+inside the arcs with the motion's modes (covered above) and those whose rows
+leave the motion's twist alone, halving the sectors of a leaf that survives,
+as the wedge proof does. A surviving leaf whose twist is an exact motion ends
+the proof: a second motion exists.
 
 Both parts hold to the tolerances of their LPs (``LP_FEASIBILITY``, which
 the boxes are widened by) and of the branch and bound's checked Farkas
@@ -97,7 +100,7 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
     still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and a box that fails is shrunk
     by its contraction norm (four times it, at least halved) before the next try.
     """
-    residual = laws.enclosure(point(x))
+    residual = laws.enclosure(point(x))  # never None: the motion's sliding contacts slip
     sigma = np.linalg.svd(laws.jacobian(x), compute_uv=False)
     singular = sigma[-1] <= JACOBIAN_RANK * sigma[0]  # indeterminate forces: no box passes, only pinned twists
     arc = FIRST_ARC
@@ -105,10 +108,10 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
         twist = _twist_box(problem, masks, angles, arc)
         if twist is not None and np.max(twist[1] - twist[0]) <= DISTINCT_TWIST:
             return arc  # one twist (the forces need not be unique)
-        if singular:
+        if singular or residual is None:
             return None
         box = None if twist is None else _local_box(problem, laws, masks, angles, arc, twist)
-        if box is None or residual is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
+        if box is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
             arc /= 2.0
             continue
         enclosure = laws.enclosure(box)
@@ -145,22 +148,31 @@ def _extents(A: np.ndarray, lower: np.ndarray, upper: np.ndarray, count: int, co
 
 def _twist_box(problem: Problem, masks: ModeMasks, angles: np.ndarray, arc: float) -> Extents | None:
     """Twist extents: closed contacts shut, rolling ones still, separating ones open, sliding slips in their arcs."""
+    rays = [(float(a) - arc, float(a) + arc) if sliding else None for a, sliding in zip(angles, masks.sliding, strict=True)]
+    A, lower, upper = _twist_rows(problem, masks.closed, masks.rolling, rays)
+    return _extents(A, lower, upper, problem.n_dof)
+
+
+def _twist_rows(
+    problem: Problem, shut: np.ndarray, still: np.ndarray, rays: list[tuple[float, float] | None]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Twist rows ``lower <= A q <= upper``: each contact shut (else open), still, or slipping between two rays."""
     rows, lower, upper = [], [], []
     for i in range(problem.n_contacts):
         Jn, bn, Jt, bt = problem.Jn[i], float(problem.bn[i]), problem.Jt[i], problem.bt[i]
         rows.append(Jn)
         lower.append(bn)
-        upper.append(bn if masks.closed[i] else np.inf)
-        if masks.rolling[i]:
+        upper.append(bn if shut[i] else np.inf)
+        if still[i]:
             rows += [Jt[0], Jt[1]]
             lower += [bt[0], bt[1]]
             upper += [bt[0], bt[1]]
-        elif masks.sliding[i]:
-            for row, value in _between_rays(Jt, bt, float(angles[i]) - arc, float(angles[i]) + arc):
+        elif (between := rays[i]) is not None:
+            for row, value in _between_rays(Jt, bt, *between):
                 rows.append(row)
                 lower.append(value)
                 upper.append(np.inf)
-    return _extents(np.array(rows), np.array(lower), np.array(upper), problem.n_dof)
+    return np.array(rows), np.array(lower), np.array(upper)
 
 
 def _between_rays(Jt: np.ndarray, bt: np.ndarray, lo: float, hi: float) -> list[tuple[np.ndarray, float]]:
@@ -297,34 +309,22 @@ def _only_twist(problem: Problem, sectors: list[np.ndarray], leaf: tuple[int, ..
     # Directions d with A_eq d = 0 and A_act d >= 0 are the twists' directions from q: with full rank none but
     # d = 0 has A_act d = 0, so one exists iff some A_act d can be made 1 (an optimum of 0, else of at least 1).
     n_active = int(active.sum())
+    n_equal = int(equal.sum())
     lp = solve_lp(
         -A[active].sum(axis=0),
         np.vstack([A[equal], A[active]]),
-        np.concatenate([np.zeros(int(equal.sum())), np.zeros(n_active)]),
-        np.concatenate([np.zeros(int(equal.sum())), np.ones(n_active)]),
+        np.zeros(n_equal + n_active),
+        np.concatenate([np.zeros(n_equal), np.ones(n_active)]),
     )
     return lp.status == "optimal" and -lp.objective < 0.5
 
 
 def _leaf_rows(problem: Problem, sectors: list[np.ndarray], leaf: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A leaf's twist rows ``lower <= A q <= upper``: its contacts shut or open, still, or slipping in a sector."""
-    rows, lower, upper = [], [], []
-    for i, k in enumerate(leaf):
-        Jn, bn, Jt, bt = problem.Jn[i], float(problem.bn[i]), problem.Jt[i], problem.bt[i]
-        rows.append(Jn)
-        lower.append(bn)
-        upper.append(np.inf if k == SEPARATING_LEAF else bn)
-        if k == CLOSED_LEAF and problem.mu[i] > 0:
-            rows += [Jt[0], Jt[1]]
-            lower += [bt[0], bt[1]]
-            upper += [bt[0], bt[1]]
-        elif k >= 0:
-            lo, hi = sectors[i][k], sectors[i][k + 1]
-            for row, value in _between_rays(Jt, bt, float(lo), float(hi)):
-                rows.append(row)
-                lower.append(value)
-                upper.append(np.inf)
-    return np.array(rows), np.array(lower), np.array(upper)
+    """A leaf's twist rows: its contacts shut or open, still (closed and frictional), or slipping in a sector."""
+    codes = np.array(leaf)
+    still = (codes == CLOSED_LEAF) & (problem.mu > 0)
+    rays = [(float(sectors[i][k]), float(sectors[i][k + 1])) if k >= 0 else None for i, k in enumerate(leaf)]
+    return _twist_rows(problem, codes != SEPARATING_LEAF, still, rays)
 
 
 def _first_sectors(angle: float, arc: float) -> np.ndarray:
