@@ -10,6 +10,8 @@ agreeing with itself.
 from __future__ import annotations
 
 import gc
+import subprocess
+import sys
 import weakref
 
 import numpy as np
@@ -177,12 +179,22 @@ def test_failing_item_is_named_by_a_worker() -> None:
     assert "while solving problems[3]" in info.value.__notes__
 
 
+FORKED_THREADS = """
+import threading
+import quasistatic as qs
+from quasistatic.tools.bench.families import grasp_2d
+
+items = [qs.assemble(grasp_2d(3, i)) for i in range(12)]
+before = threading.active_count()
+qs.solve_many(items, method="fast", n_jobs=2, chunks_per_job=2)
+print(before, threading.active_count())
+"""
+
+
 def test_forked_workers_leave_no_thread_behind() -> None:
     """A thread left running (a queue's feeder) would keep the next call from forking: it would fall back to
-    joblib, which pickles every item (measured 6x slower on the benchmark's batch)."""
-    import threading
-
-    items = [qs.assemble(grasp_2d(3, i)) for i in range(12)]
-    before = threading.active_count()
-    qs.solve_many(items, method="fast", n_jobs=2, chunks_per_job=2)
-    assert threading.active_count() == before
+    joblib, which pickles every item (measured 6x slower on the benchmark's batch). Run in a fresh process: the
+    test runner's own threads (pytest-xdist's) would keep it from forking at all."""
+    run = subprocess.run([sys.executable, "-c", FORKED_THREADS], capture_output=True, text=True, timeout=120, check=False)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split() == ["1", "1"]  # one thread before (so the workers were forked), and after
