@@ -9,15 +9,17 @@ equations (:mod:`quasistatic.laws.fixed_modes`). Around each sliding
 contact's slip angle take an arc of half-width ``r``. Every exact solution
 with these modes whose slips lie in the arcs has its twist in a polyhedron
 (closed contacts shut, rolling ones still, sliding ones' slips inside their
-arcs, separating ones open) and its forces in another (each sliding
-contact's friction inside the polygon of its arc's chord and tangents,
-rolling forces inside the circumscribed 16-gon, equilibrium): LPs bound both
-by a box. Krawczyk's test (:func:`quasistatic.interval.krawczyk`, interval
+arcs, separating ones open), bounded by a box in closed form where its
+equalities leave a line, else by LPs. Its forces solve the equilibrium,
+linear in them, with each sliding contact's friction direction inside its
+arc: an interval residual bound (:func:`quasistatic.interval.linear_solutions`)
+boxes them. Krawczyk's test (:func:`quasistatic.interval.krawczyk`, interval
 arithmetic rounded outwards) proves the equations have exactly one zero in
-that box, which is the motion. ``r`` shrinks by the test's contraction norm
-until it passes (the box must be small where the sliding contacts' friction
-turns fast). Where the rows alone pin the twist, that decides it, however
-indeterminate the forces.
+that box, which is the motion, or in its meet with Krawczyk's operator
+(which holds every zero of the box). ``r`` shrinks by the test's scaled
+contraction norm until it passes (the box must be small where the sliding
+contacts' friction turns fast). Where the rows alone pin the twist, that
+decides it, however indeterminate the forces.
 
 Everywhere else. Every exact solution lies in some leaf of the sector
 relaxation of :mod:`.wedge` (per contact: separating, rolling, or sliding
@@ -30,7 +32,7 @@ as the wedge proof does. A surviving leaf whose twist is an exact motion ends
 the proof: a second motion exists.
 
 Both parts hold to the tolerances of their LPs (``LP_FEASIBILITY``, which
-the boxes are widened by) and of the branch and bound's checked Farkas
+the twist box is widened by) and of the branch and bound's checked Farkas
 vectors; the arithmetic of Krawczyk's test is rigorous.
 """
 
@@ -99,8 +101,8 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
     """The widest arc tried (from :data:`FIRST_ARC`) whose box holds only the motion; None if none does.
 
     The box holds one twist when the rows pin it (every contact rolling or separating, say: the forces may
-    still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and a box that fails is shrunk
-    by its contraction norm (four times it, at least halved) before the next try.
+    still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and an arc whose box fails is
+    shrunk by the test's contraction norm (four times it, at least halved) before the next try.
     """
     residual = laws.enclosure(point(x))  # never None: the motion's sliding contacts slip
     sigma = np.linalg.svd(laws.jacobian(x), compute_uv=False)
