@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import quasistatic as qs
-from quasistatic.interval import Interval, krawczyk, matmul, point
+from quasistatic.interval import Interval, krawczyk, linear_solutions, matmul, point, unit_vectors
 from quasistatic.laws import ModeMasks, contact_modes
 from quasistatic.laws.fixed_modes import FixedModeLaws
 from quasistatic.solvers import Options
@@ -67,6 +67,54 @@ def test_krawczyk_proves_the_one_root_of_x2_minus_2_only_in_a_box_that_holds_it_
     residual = _square_minus_two(point(center))[0]
     test = krawczyk(center, box, residual, _square_minus_two(box)[1])
     assert test.unique is unique
+    if 0.0 < lo < np.sqrt(2.0) < hi:  # (the box [-2, 2] has no inverse at its centre)
+        assert test.image is not None and _holds(test.image, np.array([np.sqrt(2.0)]))  # every zero of the box
+
+
+def test_krawczyk_contraction_is_measured_in_the_box_own_scale() -> None:
+    """Two decoupled equations, one in units 10^6 times the other's: the norm is the worse one's, not 10^6."""
+
+    def laws(box: Interval) -> tuple[Interval, Interval]:
+        x, y = box[0:1], box[1:2]
+        jacobian = Interval(np.zeros((2, 2)), np.zeros((2, 2)))
+        dx, dy = x * 2.0, (y * 2e-6) * 1e-6
+        jacobian.lo[0, 0], jacobian.hi[0, 0], jacobian.lo[1, 1], jacobian.hi[1, 1] = dx.lo[0], dx.hi[0], dy.lo[0], dy.hi[0]
+        return Interval(
+            np.concatenate([(x.square() - 2.0).lo, (y.square() * 1e-12 - 2.0).lo]),
+            np.concatenate([(x.square() - 2.0).hi, (y.square() * 1e-12 - 2.0).hi]),
+        ), jacobian
+
+    root = np.array([np.sqrt(2.0), 1e6 * np.sqrt(2.0)])
+    box = Interval(root * 0.99, root * 1.01)
+    test = krawczyk(root, box, laws(point(root))[0], laws(box)[1])
+    assert test.unique and test.contraction < 0.1
+
+
+def test_linear_solutions_hold_the_solution_of_every_system_of_the_family() -> None:
+    rng = np.random.default_rng(2)
+    for _ in range(50):
+        A_mid = rng.normal(size=(4, 4)) + 4.0 * np.eye(4)
+        A = Interval(A_mid - 0.05 * rng.random((4, 4)), A_mid + 0.05 * rng.random((4, 4)))
+        b = _random_interval(rng, (4,))
+        box = linear_solutions(A, b)
+        assert box is not None
+        for _ in range(20):
+            assert _holds(box, np.linalg.solve(_sample(rng, A), _sample(rng, b)))
+
+
+def test_linear_solutions_refuse_a_family_holding_a_singular_matrix() -> None:
+    A = Interval(np.array([[1.0, 0.0], [0.0, -0.1]]), np.array([[1.0, 0.0], [0.0, 0.1]]))  # diag(1, 0) among them
+    assert linear_solutions(A, point(np.ones(2))) is None
+
+
+@pytest.mark.parametrize("centre", [0.0, 0.5 * np.pi, np.pi, -0.5 * np.pi, 1.0, 3.0, -3.1, 7.0])
+def test_unit_vectors_hold_every_direction_of_the_arc_and_its_extremes(centre: float) -> None:
+    lo, hi = np.array([centre - 0.2, centre - 1e-9]), np.array([centre + 0.3, centre + 1e-9])
+    box = unit_vectors(lo, hi)
+    for k in range(2):
+        for angle in np.linspace(lo[k], hi[k], 101):
+            assert _holds(box[k], np.array([np.cos(angle), np.sin(angle)]))
+    assert np.all(box.hi[1] - box.lo[1] < 1e-8)  # a thin arc gives a thin box
 
 
 def _solved_grasp() -> tuple[qs.Problem, FixedModeLaws, np.ndarray]:
@@ -93,6 +141,27 @@ def test_the_fixed_mode_enclosure_refuses_a_box_where_a_slip_may_vanish() -> Non
     problem, laws, x = _solved_grasp()
     huge = Interval(x - 100.0, x + 100.0)
     assert laws.enclosure(huge) is None  # a sliding contact's slip direction is not smooth through zero slip
+
+
+def test_the_force_matrix_holds_the_equilibrium_columns_for_every_slip_direction_in_its_boxes() -> None:
+    """``E`` of ``g + E f = 0`` (a sliding contact's column ``n - mu T^T e``) for sampled directions ``e``, and
+    at the motion's own slips the laws' Jacobian block."""
+    problem, laws, x = _solved_grasp()
+    n = problem.n_dof
+    slips = problem.velocities(x[:n])[:, :2]
+    angles = np.arctan2(slips[:, 1], slips[:, 0])
+    at_motion = laws.force_matrix(unit_vectors(angles, angles))
+    assert _holds(at_motion, laws.jacobian(x)[:n, n:])
+    box = laws.force_matrix(unit_vectors(angles - 0.1, angles + 0.1))
+    sliding = np.flatnonzero(laws.masks.sliding)
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        E = laws.jacobian(x)[:n, n:].copy()
+        for i in sliding:
+            a = angles[i] + rng.uniform(-0.1, 0.1)
+            e = np.array([np.cos(a), np.sin(a)])
+            E[:, laws.column[i] - n] = problem.Jn[i] - problem.mu[i] * (problem.Jt[i].T @ e)
+        assert _holds(box, E)
 
 
 def test_krawczyk_proves_the_grasp_motion_alone_in_a_small_box_not_a_wide_one() -> None:

@@ -7,6 +7,9 @@ unit). Products of a point matrix with an interval vector or matrix
 (:func:`matmul`) work in midpoint-radius form and add a bound on the
 rounding of the sums.
 
+A box holding the solutions of every linear system of an interval family
+(:func:`linear_solutions`) bounds the exact-cone certificate's forces.
+
 Only what the exact-cone certificate needs is here (:mod:`quasistatic.laws.fixed_modes`
 encloses its laws over a box with it): no library for interval arithmetic is a
 dependency of the project, and this much is short.
@@ -20,7 +23,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Interval", "point", "matmul", "krawczyk", "KrawczykTest"]
+__all__ = ["Interval", "point", "matmul", "krawczyk", "KrawczykTest", "linear_solutions", "unit_vectors"]
 
 FloatArray = npt.NDArray[np.float64]
 _EPS = float(np.finfo(float).eps)
@@ -68,8 +71,8 @@ class Interval:
 
     def __mul__(self, other: Interval | FloatArray | float) -> Interval:
         lo, hi = _ends(other)
-        products = np.stack(np.broadcast_arrays(self.lo * lo, self.lo * hi, self.hi * lo, self.hi * hi))
-        return Interval(_down(products.min(axis=0)), _up(products.max(axis=0)))
+        a, b, c, d = self.lo * lo, self.lo * hi, self.hi * lo, self.hi * hi  # pairwise: no stacked copy (measured 2x)
+        return Interval(_down(np.minimum(np.minimum(a, b), np.minimum(c, d))), _up(np.maximum(np.maximum(a, b), np.maximum(c, d))))
 
     __rmul__ = __mul__
 
@@ -133,10 +136,13 @@ def matmul(A: npt.NDArray[np.floating[Any]] | Interval, x: Interval) -> Interval
 @dataclass(frozen=True)
 class KrawczykTest:
     """Krawczyk's verdict (``unique``: exactly one zero in the box, proven) and the row-sum norm of
-    ``|I - Y F'(box)|``, which must be below 1 for the test to pass: a box that fails shrinks by about it."""
+    ``|I - Y F'(box)|`` in the box's own scale (``D^-1 |I - Y F'| D``, ``D`` the box's half-widths), which must be
+    below 1 for the test to pass: a box that fails shrinks by about it (its entries may differ by orders of
+    magnitude, twists against forces: the unscaled norm says little of how far the box is from passing)."""
 
     unique: bool
     contraction: float
+    image: Interval | None = None  # Krawczyk's operator: every zero of the box lies in it
 
 
 def krawczyk(center: FloatArray, box: Interval, residual: Interval, jacobian: Interval) -> KrawczykTest:
@@ -156,6 +162,58 @@ def krawczyk(center: FloatArray, box: Interval, residual: Interval, jacobian: In
         return KrawczykTest(False, np.inf)
     identity = np.eye(center.size)
     contraction = Interval(identity, identity.copy()) - matmul(Y, jacobian)
-    norm = float(np.max(np.maximum(np.abs(contraction.lo), np.abs(contraction.hi)).sum(axis=1), initial=0.0))
+    radius = box.rad
+    with np.errstate(divide="ignore", invalid="ignore"):  # a flat side (radius 0) cannot hold K inside it
+        scaled = (_magnitude(contraction) @ radius) / radius
+    norm = float(np.max(np.where(radius > 0.0, scaled, np.inf), initial=0.0))
     K = point(center) - matmul(Y, residual) + matmul(contraction, box - center)
-    return KrawczykTest(K.inside(box), norm)
+    return KrawczykTest(K.inside(box), norm, K)
+
+
+def linear_solutions(A: Interval, b: Interval) -> Interval | None:
+    """A box holding the solution of ``A x = b`` for every square matrix of ``A`` and vector of ``b``; None where
+    the preconditioned family is not proven regular.
+
+    With ``C`` an approximate inverse of ``A.mid``, ``x~ = C b.mid`` and ``G`` enclosing ``I - C A``: the error
+    ``e = x - x~`` solves ``e = C (b - A x~) + (I - C A) e``, so with ``beta = ||G||_inf < 1`` (which makes every
+    ``A`` regular) ``||e|| <= ||r|| / (1 - beta)`` for ``r`` enclosing ``C (b - A x~)``, and entry by entry
+    ``|e| <= |r| + |G| ||e||`` (Rump's residual bound; Neumaier, *Interval Methods for Systems of Equations*, 4.1).
+    """
+    try:
+        C = np.linalg.inv(A.mid)
+    except np.linalg.LinAlgError:
+        return None
+    if not np.all(np.isfinite(C)):
+        return None
+    approximate = C @ b.mid
+    identity = np.eye(approximate.size)
+    G = _magnitude(Interval(identity, identity.copy()) - matmul(C, A))
+    r = _magnitude(matmul(C, b - matmul(A, point(approximate))))
+    beta = float(_up_sum(G).max(initial=0.0))
+    if not beta < 1.0:
+        return None
+    norm = float(_up(np.max(r, initial=0.0) / _down(np.array(1.0 - beta))))
+    error = _up(r + _up_sum(G * norm))  # the products' rounding is within the sum's error allowance
+    return Interval(_down(approximate - error), _up(approximate + error))
+
+
+def _magnitude(x: Interval) -> FloatArray:
+    """``max |v|`` over each entry's interval (exact)."""
+    return np.maximum(np.abs(x.lo), np.abs(x.hi))
+
+
+def _up_sum(terms: FloatArray) -> FloatArray:
+    """An upper bound on each row's sum of the non-negative ``terms``."""
+    return _up(terms.sum(axis=-1)) + _sum_error(terms, -1)
+
+
+def unit_vectors(lo: FloatArray, hi: FloatArray) -> Interval:
+    """Boxes (k, 2) holding ``(cos a, sin a)`` for every angle ``a`` in ``[lo, hi]`` [rad] (each of the k arcs
+    shorter than a turn)."""
+    ends_cos, ends_sin = np.stack([np.cos(lo), np.cos(hi)]), np.stack([np.sin(lo), np.sin(hi)])
+    # an extreme is reached inside the arc where the arc holds its angle (0 and pi for cos, +-pi/2 for sin)
+    inside = [np.floor((hi - at) / (2.0 * np.pi)) * 2.0 * np.pi + at >= lo for at in (0.0, np.pi, 0.5 * np.pi, -0.5 * np.pi)]
+    cos_lo, cos_hi = np.where(inside[1], -1.0, ends_cos.min(axis=0)), np.where(inside[0], 1.0, ends_cos.max(axis=0))
+    sin_lo, sin_hi = np.where(inside[3], -1.0, ends_sin.min(axis=0)), np.where(inside[2], 1.0, ends_sin.max(axis=0))
+    slack = 4.0 * _EPS  # numpy's cos and sin err by less than an ulp of 1, and the extremes' angles by rounding
+    return Interval(np.stack([cos_lo, sin_lo], axis=1) - slack, np.stack([cos_hi, sin_hi], axis=1) + slack)

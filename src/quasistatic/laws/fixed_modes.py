@@ -286,9 +286,8 @@ class FixedModeLaws:
                     return None
                 inverse_speed = squared.sqrt().reciprocal()
                 e = slip * inverse_speed  # the slip direction
-                along = matmul(J[i, :t].T, e)  # T^T e (n,)
+                along, normal_column = self._sliding_column(int(i), e)
                 mu = float(self.mu[i])
-                normal_column = normal_column - along * mu
                 equilibrium = equilibrium - along * (cn * mu)
                 k = -(cn * inverse_speed) * mu
                 projector = point(J[i, :t].T @ J[i, :t]) - along[:, None] * along[None, :]
@@ -297,3 +296,22 @@ class FixedModeLaws:
         put(slice(0, n), slice(0, n), twist_block)
         lo[:n], hi[:n] = equilibrium.lo, equilibrium.hi
         return Interval(lo, hi), Interval(jac_lo, jac_hi)
+
+    def force_matrix(self, directions: Interval) -> Interval:
+        """The equilibrium's derivative in the force unknowns, ``E`` (n, N - n) with ``g + E f = 0`` at fixed
+        twist, for every slip direction of each sliding contact within ``directions`` (m, t): the same columns as
+        :meth:`enclosure`'s, the directions given rather than taken from a box's slips."""
+        n, t, J = self.n, self.t, self.J
+        lo, hi = np.zeros((n, self.size - n)), np.zeros((n, self.size - n))
+        for i in np.flatnonzero(self.kind != SEPARATING):
+            col = int(self.column[i]) - n
+            column = self._sliding_column(int(i), directions[i])[1] if self.kind[i] == SLIDING and self.mu[i] > 0.0 else point(J[i, t])
+            lo[:, col], hi[:, col] = column.lo, column.hi
+            if self.kind[i] == ROLLING:
+                lo[:, col + 1 : col + 1 + t] = hi[:, col + 1 : col + 1 + t] = J[i, :t].T
+        return Interval(lo, hi)
+
+    def _sliding_column(self, i: int, e: Interval) -> tuple[Interval, Interval]:
+        """``T^T e`` and the normal force's column ``N - mu T^T e`` of sliding contact ``i`` (friction ``-mu c_n e``)."""
+        along = matmul(self.J[i, : self.t].T, e)
+        return along, point(self.J[i, self.t]) - along * float(self.mu[i])

@@ -9,15 +9,17 @@ equations (:mod:`quasistatic.laws.fixed_modes`). Around each sliding
 contact's slip angle take an arc of half-width ``r``. Every exact solution
 with these modes whose slips lie in the arcs has its twist in a polyhedron
 (closed contacts shut, rolling ones still, sliding ones' slips inside their
-arcs, separating ones open) and its forces in another (each sliding
-contact's friction inside the polygon of its arc's chord and tangents,
-rolling forces inside the circumscribed 16-gon, equilibrium): LPs bound both
-by a box. Krawczyk's test (:func:`quasistatic.interval.krawczyk`, interval
+arcs, separating ones open), bounded by a box in closed form where its
+equalities leave a line, else by LPs. Its forces solve the equilibrium,
+linear in them, with each sliding contact's friction direction inside its
+arc: an interval residual bound (:func:`quasistatic.interval.linear_solutions`)
+boxes them. Krawczyk's test (:func:`quasistatic.interval.krawczyk`, interval
 arithmetic rounded outwards) proves the equations have exactly one zero in
-that box, which is the motion. ``r`` shrinks by the test's contraction norm
-until it passes (the box must be small where the sliding contacts' friction
-turns fast). Where the rows alone pin the twist, that decides it, however
-indeterminate the forces.
+that box, which is the motion, or in its meet with Krawczyk's operator
+(which holds every zero of the box). ``r`` shrinks by the test's scaled
+contraction norm until it passes (the box must be small where the sliding
+contacts' friction turns fast). Where the rows alone pin the twist, that
+decides it, however indeterminate the forces.
 
 Everywhere else. Every exact solution lies in some leaf of the sector
 relaxation of :mod:`.wedge` (per contact: separating, rolling, or sliding
@@ -30,7 +32,7 @@ as the wedge proof does. A surviving leaf whose twist is an exact motion ends
 the proof: a second motion exists.
 
 Both parts hold to the tolerances of their LPs (``LP_FEASIBILITY``, which
-the boxes are widened by) and of the branch and bound's checked Farkas
+the twist box is widened by) and of the branch and bound's checked Farkas
 vectors; the arithmetic of Krawczyk's test is rigorous.
 """
 
@@ -41,13 +43,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...interval import Interval, krawczyk, point
+from ...interval import Interval, KrawczykTest, krawczyk, linear_solutions, matmul, point, unit_vectors
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes
 from ...laws.fixed_modes import FixedModeLaws
-from ...tolerances import DISTINCT_TWIST, JACOBIAN_RANK, LP_FEASIBILITY, MOTION_RANK
+from ...tolerances import DISTINCT_TWIST, JACOBIAN_RANK, LP_FEASIBILITY, MOTION_RANK, SAME_TWIST
 from ..numerics.highs import optimise_each, solve_lp
+from ..numerics.line_extent import line_axis_extents
 from ..result import Options
-from .patterns import CLOSED_LEAF, ROLLING_POLYGON, SEPARATING_LEAF, relaxation_excluded
+from .patterns import CLOSED_LEAF, SEPARATING_LEAF, relaxation_excluded
 from .wedge import split_sectors
 
 __all__ = ["Uniqueness", "prove_unique_exact", "EXACT_UNIQUENESS_PROOF"]
@@ -56,8 +59,9 @@ EXACT_UNIQUENESS_PROOF = (
     "Krawczyk's interval test near the motion, and a sector relaxation of the exact laws excluding every other "
     "mode pattern and slip direction (mode branch and bound, LPs and Farkas vectors)"
 )
-FIRST_ARC = 2.0**-6  # half-width [rad] of the first arc tried around each sliding contact's slip
+FIRST_ARC = 2.0**-8  # half-width [rad] of the first arc tried around each sliding contact's slip
 LAST_ARC = 2.0**-24  # the narrowest arc tried before the near part gives up
+NARROWINGS = 2  # Krawczyk's test tried again on a box narrowed by its operator (the first arc then passes on 8 #1)
 FAR_SECTOR = np.pi / 3  # widest sector outside the arcs (narrower than a half-turn; measured against pi/2, pi/4 and pi/6: fastest)
 FINEST_FRACTION = 1.0 / 64  # a sector is not halved below this fraction of the arc
 FAR_ROUNDS = 8  # most refinements of the sectors (measured on 73 motions: proofs took 1-4, failures ran to 7-16)
@@ -97,8 +101,8 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
     """The widest arc tried (from :data:`FIRST_ARC`) whose box holds only the motion; None if none does.
 
     The box holds one twist when the rows pin it (every contact rolling or separating, say: the forces may
-    still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and a box that fails is shrunk
-    by its contraction norm (four times it, at least halved) before the next try.
+    still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and an arc whose box fails is
+    shrunk by the test's contraction norm (four times it, at least halved) before the next try.
     """
     residual = laws.enclosure(point(x))  # never None: the motion's sliding contacts slip
     sigma = np.linalg.svd(laws.jacobian(x), compute_uv=False)
@@ -110,30 +114,45 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
             return arc  # one twist (the forces need not be unique)
         if singular or residual is None:
             return None
-        box = None if twist is None else _local_box(problem, laws, masks, angles, arc, twist)
+        box = None if twist is None else _local_box(laws, x, twist, unit_vectors(angles - arc, angles + arc))
         if box is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
             arc /= 2.0
             continue
-        enclosure = laws.enclosure(box)
-        if enclosure is None:
+        test = _narrowed_krawczyk(laws, x, residual[0], box)
+        if test is None:
             arc /= 2.0
             continue
-        test = krawczyk(x, box, residual[0], enclosure[1])
         if test.unique:
             return arc
         arc /= max(2.0, 4.0 * min(test.contraction, 1e6))
     return None
 
 
-def _local_box(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, angles: np.ndarray, arc: float, twist: Extents) -> Interval | None:
+def _narrowed_krawczyk(laws: FixedModeLaws, x: np.ndarray, residual: Interval, box: Interval) -> KrawczykTest | None:
+    """Krawczyk's test on ``box``, then again on its meet with Krawczyk's operator (which holds every zero of the
+    box, so a pass there proves the box's zero unique) while that meet holds ``x``, :data:`NARROWINGS` times at
+    most; None where a slip may vanish in the box."""
+    for _ in range(1 + NARROWINGS):
+        enclosure = laws.enclosure(box)
+        if enclosure is None:
+            return None
+        test = krawczyk(x, box, residual, enclosure[1])
+        if test.unique or test.image is None:
+            return test
+        box = Interval(np.maximum(box.lo, test.image.lo), np.minimum(box.hi, test.image.hi))
+        if not (np.all(box.lo <= x) and np.all(x <= box.hi)):
+            return test
+    return test
+
+
+def _local_box(laws: FixedModeLaws, x: np.ndarray, twist: Extents, directions: Interval) -> Interval | None:
     """A box (in the fixed-mode unknowns) holding every exact solution with these modes and slips in the arcs,
-    given the box of their twists; None where the forces are unbounded."""
-    forces = _force_box(problem, laws, masks, angles, arc)
+    given the box of their twists and of their slip directions; None where the forces are not proven bounded."""
+    margin = LP_FEASIBILITY * (1.0 + np.maximum(np.abs(twist[0]), np.abs(twist[1]))) + SAME_TWIST
+    forces = _force_box(laws, x, directions)
     if forces is None:
         return None
-    lo, hi = np.concatenate([twist[0], forces[0]]), np.concatenate([twist[1], forces[1]])
-    margin = LP_FEASIBILITY * (1.0 + np.maximum(np.abs(lo), np.abs(hi)))
-    return Interval(lo - margin, hi + margin)
+    return Interval(np.concatenate([twist[0] - margin, forces.lo]), np.concatenate([twist[1] + margin, forces.hi]))
 
 
 def _extents(A: np.ndarray, lower: np.ndarray, upper: np.ndarray, count: int, col_lower: np.ndarray | None = None) -> Extents | None:
@@ -147,10 +166,18 @@ def _extents(A: np.ndarray, lower: np.ndarray, upper: np.ndarray, count: int, co
 
 
 def _twist_box(problem: Problem, masks: ModeMasks, angles: np.ndarray, arc: float) -> Extents | None:
-    """Twist extents: closed contacts shut, rolling ones still, separating ones open, sliding slips in their arcs."""
+    """Twist extents: closed contacts shut, rolling ones still, separating ones open, sliding slips in their arcs
+    (read off in closed form where the equalities leave a line, else by LPs)."""
     rays = [(float(a) - arc, float(a) + arc) if sliding else None for a, sliding in zip(angles, masks.sliding, strict=True)]
     A, lower, upper = _twist_rows(problem, masks.closed, masks.rolling, rays)
-    return _extents(A, lower, upper, problem.n_dof)
+    equal = lower == upper  # every other row is only bounded below
+    on_line = line_axis_extents(A[equal], lower[equal], A[~equal], lower[~equal])
+    if on_line is None:
+        return _extents(A, lower, upper, problem.n_dof)
+    if on_line.empty or on_line.free:
+        return None
+    ends = np.array(on_line.extremes)  # the segment's ends (one, where they are within SAME_TWIST)
+    return ends.min(axis=0), ends.max(axis=0)
 
 
 def _twist_rows(
@@ -182,54 +209,16 @@ def _between_rays(Jt: np.ndarray, bt: np.ndarray, lo: float, hi: float) -> list[
     return [(side @ Jt, float(side @ bt)) for side in (after_lo, before_hi)]
 
 
-def _force_box(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, angles: np.ndarray, arc: float) -> Extents | None:
-    """Extents of the fixed-mode force unknowns (per closed contact its normal force, then a rolling one's c_t)
-    over the forces that balance the load: sliding friction in its arc's polygon, rolling forces in the 16-gon."""
-    closed = np.flatnonzero(masks.closed)
-    normal = {int(i): laws.column[i] - problem.n_dof for i in closed}  # the LP's columns: the laws' force unknowns first
-    spare = laws.size - problem.n_dof
-    tangential = {}
-    for i in closed:
-        if masks.rolling[i]:
-            tangential[int(i)] = [normal[int(i)] + 1, normal[int(i)] + 2]
-        else:
-            tangential[int(i)] = [spare, spare + 1]
-            spare += 2
-    equilibrium = np.zeros((problem.n_dof, spare))
-    limits = np.zeros((0, spare))
-    for i in closed:
-        equilibrium[:, normal[int(i)]] = problem.Jn[i]
-        equilibrium[:, tangential[int(i)]] = problem.Jt[i].T
-        mu = float(problem.mu[i])
-        polygon = _arc_polygon(mu, float(angles[i]), arc) if masks.sliding[i] else _circumscribed(mu)
-        rows = np.zeros((len(polygon), spare))
-        rows[:, tangential[int(i)]] = -polygon[:, :2]  # direction . (-c_t) >= at_least c_n
-        rows[:, normal[int(i)]] = -polygon[:, 2]
-        limits = np.vstack([limits, rows])
-    A = np.vstack([equilibrium, limits])
-    lower = np.concatenate([-problem.g, np.zeros(len(limits))])
-    upper = np.concatenate([-problem.g, np.full(len(limits), np.inf)])
-    col_lower = np.full(spare, -np.inf)
-    col_lower[list(normal.values())] = 0.0
-    return _extents(A, lower, upper, laws.size - problem.n_dof, col_lower)
+def _force_box(laws: FixedModeLaws, x: np.ndarray, directions: Interval) -> Interval | None:
+    """A box holding the fixed-mode force unknowns of every solution whose sliding contacts slip within
+    ``directions`` (m, 2); None where the forces are not proven unique for each such slip.
 
-
-def _arc_polygon(mu: float, angle: float, arc: float) -> np.ndarray:
-    """Rows ``(d0, d1, a)``: ``d . p >= a c_n`` for the friction ``p = -c_t`` of a slip in the arc (``p`` on the
-    circle's arc): between its rays, beyond its chord, inside the tangents at its ends and middle."""
-    lo, hi = angle - arc, angle + arc
-    rays = [(-np.sin(lo), np.cos(lo), 0.0), (np.sin(hi), -np.cos(hi), 0.0)]
-    chord = [(np.cos(angle), np.sin(angle), mu * np.cos(arc))]
-    tangents = [(-np.cos(a), -np.sin(a), -mu) for a in (lo, angle, hi)]
-    return np.array(rays + chord + tangents)
-
-
-def _circumscribed(mu: float) -> np.ndarray:
-    """Rows as in :func:`_arc_polygon` for a force inside the circle: the circumscribed 16-gon (no friction: none)."""
-    if mu <= 0.0:
-        return np.array([(1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, -1.0, 0.0)])
-    corners = 2.0 * np.pi * np.arange(ROLLING_POLYGON) / ROLLING_POLYGON
-    return np.stack([np.cos(corners), np.sin(corners), np.full(ROLLING_POLYGON, -mu)], axis=1)
+    The equilibrium ``E f = -g`` is linear in them, and ``E`` depends on the slip directions alone: with ``C``
+    the pseudo-inverse of ``E`` at the motion, every such ``f`` solves the square ``C E f = -C g``, whose
+    solutions over the directions' ``E`` an interval residual bound encloses (no LP).
+    """
+    C = np.linalg.pinv(laws.jacobian(x)[: laws.n, laws.n :])
+    return linear_solutions(matmul(C, laws.force_matrix(directions)), matmul(C, point(-laws.g)))
 
 
 def _far(
