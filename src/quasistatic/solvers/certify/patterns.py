@@ -263,6 +263,7 @@ class _Rows:
     survivor: _Node | None = None  # the sector relaxation's leaf whose twists and forces were not excluded
     survivor_twist: np.ndarray | None = None  # a twist of it (None: its LP did not answer)
     covered: Callable[[_Node], bool] | None = None  # sector relaxation leaves the caller proves by other means
+    by_rank: bool = False  # closed rows of deficient rank still bound the twists (see :func:`_closed_set`)
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
 
     @classmethod
@@ -498,7 +499,7 @@ def relaxation_excluded(
         return tuple(SEPARATING_LEAF if mode.separating else sector_of.get(id(mode), CLOSED_LEAF) for mode in node.modes)
 
     skip = None if covered is None else lambda node: covered(leaf(node))
-    rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=twist, form=None, remaining=remaining, covered=skip)
+    rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=twist, form=None, remaining=remaining, covered=skip, by_rank=True)
     m = problem.n_contacts
     every = (1 << layout.loads.shape[1]) - 1
     root_columns = functools.reduce(lambda bits, mode: bits & ~mode.removes, layout.roots, every)  # no padding
@@ -760,8 +761,10 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
         if child.depth == leaf and rows.form is None:  # the sector relaxation: a leaf with a twist is a point of it
+            if rows.covered is not None and rows.covered(child):
+                continue  # before its LP: most covered leaves' rows meet the motion's twist, and the LP would pass
             status, q = _relaxed_twist(rows, child)
-            if status == "infeasible" or (rows.covered is not None and rows.covered(child)):
+            if status == "infeasible":
                 continue
             rows.survivor, rows.survivor_twist = child, (q if status == "optimal" else None)
             return False
@@ -1192,15 +1195,18 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     """
     n = rows.g.size
     k = node.closed_rows
-    plane = k == n - 2 and rows.width > 2  # 3-D pyramids: a plane of twists is bounded exactly (planar: as before)
-    if (k < n - 1 and not plane) or k == 0:
+    widest = 2 if rows.width > 2 else 1  # 3-D: a plane of twists is bounded exactly (planar: a line at most)
+    if k < n - widest or k == 0:
         return _UNKNOWN
     closed = rows.closed_sets.get(node.equal)
     if closed is None:
         closed = rows.closed_sets[node.equal] = _closed_set(rows, rows.row_mask(node.equal), k)
     if isinstance(closed, _Twists):
         return closed
-    if closed.slope is not None and not plane:
+    if closed.free > widest:
+        return _UNKNOWN  # rows of deficient rank leave more than a plane
+    plane = closed.free == 2
+    if closed.free == 1:
         interval = _interval(closed, (-math.inf, math.inf), node.at_least)
         return _PRUNED if interval is None else _line(rows, closed, *interval)
     at_least = rows.row_mask(node.at_least)
@@ -1273,6 +1279,7 @@ class _ClosedSet:
     direction: np.ndarray
     slope: np.ndarray | None
     plane: np.ndarray  # (2, n): orthonormal directions of what ``n - 2`` rows leave (the last two of E's full ``vt``)
+    free: int  # the dimension of what the closed rows leave: 0 a point, 1 a line, 2 a plane
     # The same per bank row as plain floats, read a few at a time by :func:`_narrowed`: ``reserve``, and the
     # row's rate along the line (``slope``) or along each of the plane's directions (on ``n - 2`` rows); else empty.
     row_reserve: list[float]
@@ -1291,17 +1298,24 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     ``ZERO |E+_j|_1`` of the exact set (an ill-conditioned pair of contacts turns the LPs' 1e-7 into more than
     the search's ``DISTINCT_TWIST``). Rows of full column rank pin the twists to one point; ``n - 1`` rows
     leave a line ``q0 + t d``, on which every inequality row bounds ``t``.
+
+    With ``rows.by_rank``, rows of deficient rank (four coplanar supports' gaps: three independent rows) are
+    read by their ``r`` singular values above ``MOTION_RANK``: with ``E+`` truncated to them the bounds above
+    hold as written (``U_r^T (E q - e) = S_r V_r^T (q - q0)`` exactly), and the twists lie near ``q0`` plus
+    the span of the other ``n - r`` right singular vectors; the residual then proves nothing (the rows the
+    small singular values join may disagree in round-off), so no set is pruned for it.
     """
     n = rows.g.size
     E, e = rows.bank[equal], rows.rhs[equal]  # ``equal``: a boolean mask of the bank's rows
     u, sigma, vt = np.linalg.svd(E, full_matrices=k < n)  # a line's direction is the last row of the full vt
-    if sigma[-1] <= MOTION_RANK or k > n and sigma[n - 1] <= MOTION_RANK:
+    full = min(k, n)
+    r = int(np.count_nonzero(sigma > MOTION_RANK)) if rows.by_rank else full
+    if r == 0 or sigma[r - 1] <= MOTION_RANK:
         return _UNKNOWN
-    r = min(k, n)
     pseudo_inverse = (vt[:r].T / sigma[:r]) @ u[:, :r].T
     q0 = pseudo_inverse @ e
     residual = E @ q0 - e
-    if residual @ residual > k * LP_FEASIBILITY**2:
+    if r == full and residual @ residual > k * LP_FEASIBILITY**2:
         return _PRUNED
     spread = ZERO * np.abs(pseudo_inverse).sum(axis=1)  # as far as a twist meeting the rows as the seed does may lie
     radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
@@ -1309,13 +1323,14 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     bank = rows.bank
     reserve = bank @ q0 + LP_FEASIBILITY * np.abs(bank @ pseudo_inverse).sum(axis=1) - rows.rhs + LP_FEASIBILITY
     direction = vt[-1]
-    slope = bank @ direction if k < n else None
+    free = n - r
+    slope = bank @ direction if free else None
     rates: tuple[list[float], ...] = ()  # for a line or a plane only (a point's children keep it)
-    if k == n - 1 and slope is not None:
+    if free == 1 and slope is not None:
         rates = (slope.tolist(),)
-    elif k == n - 2:
+    elif free == 2:
         rates = ((bank @ vt[-2]).tolist(), (bank @ vt[-1]).tolist())
-    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], reserve.tolist() if rates else [], rates)
+    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], free, reserve.tolist() if rates else [], rates)
 
 
 def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
