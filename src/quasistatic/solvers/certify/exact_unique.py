@@ -268,9 +268,11 @@ def _far(
         return pinned[key]
 
     rounds = 0
+    farkas: tuple[np.ndarray, ...] = ()  # the last round's, tried first on the next
     while options.remaining() > 0.0 and rounds < FAR_ROUNDS:
         rounds += 1
-        proof = relaxation_excluded(problem, sectors, options.remaining, covered, twist=q)
+        proof = relaxation_excluded(problem, sectors, options.remaining, covered, twist=q, farkas=farkas)
+        farkas = proof.farkas
         options.report(1, proof.nodes)  # a long proof shows on the CLI's status line
         if proof.excluded:
             return Uniqueness(True, rounds=rounds)

@@ -130,7 +130,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
@@ -456,13 +456,15 @@ class RelaxationProof:
     ``excluded``: no pattern holds a point of the relaxation (then no exact motion exists), but those the
     caller ``covered``. Otherwise ``sectors`` names, per contact, the sector a surviving pattern slides in
     (:data:`CLOSED_LEAF`: rolling, or closed and frictionless; :data:`SEPARATING_LEAF`), with a twist ``q`` of it;
-    ``sectors`` is None when the search gave no answer (budget, time, an LP that did not answer).
+    ``sectors`` is None when the search gave no answer (budget, time, an LP that did not answer). ``farkas``:
+    the last Farkas vectors the search kept, which the caller may pass to the next, refined search.
     """
 
     excluded: bool
     sectors: tuple[int, ...] | None = None
     q: np.ndarray | None = None
     nodes: int = 0
+    farkas: tuple[np.ndarray, ...] = ()  # the last Farkas vectors found (twist space), for the next refinement
 
 
 ROLLING_POLYGON = 16  # tangents of the circle bounding a rolling contact's force in the sector relaxation
@@ -475,6 +477,7 @@ def relaxation_excluded(
     remaining: Callable[[], float] | None = None,
     covered: Callable[[tuple[int, ...]], bool] | None = None,
     twist: np.ndarray | None = None,
+    farkas: Sequence[np.ndarray] = (),
 ) -> RelaxationProof:
     """Whether the sector relaxation of the exact 3-D laws (:mod:`.wedge`) has no point, by the mode branch and bound.
 
@@ -490,7 +493,9 @@ def relaxation_excluded(
     returned (its sectors, and a twist of it): the caller refines them. A leaf whose modes (as
     :attr:`RelaxationProof.sectors` names them) ``covered`` accepts is passed over: the caller proves what it
     holds by other means. With ``twist`` (a motion's), a node whose rows leave that twist alone is passed over
-    as a seed's is in :func:`prove_by_patterns` (its leaves hold no other motion).
+    as a seed's is in :func:`prove_by_patterns` (its leaves hold no other motion). ``farkas``: vectors (an
+    earlier search's :attr:`RelaxationProof.farkas`) checked on this search's columns and kept where they hold,
+    so they exclude nodes before any fit (refined sectors' polygons lie inside the coarse ones': most still do).
     """
     layout, sector_of = _sector_layout(problem, sectors)
     width = layout.loads.shape[1] // problem.n_contacts
@@ -504,15 +509,17 @@ def relaxation_excluded(
     every = (1 << layout.loads.shape[1]) - 1
     root_columns = functools.reduce(lambda bits, mode: bits & ~mode.removes, layout.roots, every)  # no padding
     root = _Node(0, (1 << m) - 1, root_columns, layout.roots, 0)
+    for y in farkas:
+        rows.farkas.add(y, 0)  # checked on this layout's columns: kept only where it holds
     fit = _fitted_forces(rows, root.columns)
     closed = fit is None or _search(rows, _past_settled(rows, root), fit, _UNKNOWN)
-    nodes = rows.proof.nodes
+    nodes, kept = rows.proof.nodes, tuple(rows.farkas.vectors)
     if closed:
-        return RelaxationProof(True, nodes=nodes)
+        return RelaxationProof(True, nodes=nodes, farkas=kept)
     survivor, q = rows.survivor, rows.survivor_twist
     if survivor is None or q is None:
-        return RelaxationProof(False, nodes=nodes)  # out of nodes or time, or an LP that did not answer
-    return RelaxationProof(False, leaf(survivor), q, nodes)
+        return RelaxationProof(False, nodes=nodes, farkas=kept)  # out of nodes or time, or an LP that did not answer
+    return RelaxationProof(False, leaf(survivor), q, nodes, kept)
 
 
 def _relaxed_twist(rows: _Rows, node: _Node) -> tuple[str, np.ndarray]:
@@ -1130,6 +1137,7 @@ class _FarkasVectors:
     g: np.ndarray
     margin: float
     blockers: list[int] = field(default_factory=list)  # newest last
+    vectors: list[np.ndarray] = field(default_factory=list)  # the vectors themselves, as ``blockers``
     count: int = 0
 
     def add(self, y: np.ndarray, columns: int) -> bool:
@@ -1142,8 +1150,10 @@ class _FarkasVectors:
             return False
         if len(self.blockers) < FARKAS_KEPT:
             self.blockers.append(blockers)
+            self.vectors.append(y)
         else:
             self.blockers[self.count % FARKAS_KEPT] = blockers
+            self.vectors[self.count % FARKAS_KEPT] = y
         self.count += 1
         return True
 
