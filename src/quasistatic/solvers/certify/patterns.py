@@ -264,6 +264,7 @@ class _Rows:
     survivor_twist: np.ndarray | None = None  # a twist of it (None: its LP did not answer)
     covered: Callable[[_Node], bool] | None = None  # sector relaxation leaves the caller proves by other means
     by_rank: bool = False  # closed rows of deficient rank still bound the twists (see :func:`_closed_set`)
+    seed_rows: _SeedRows | None = None  # the sector relaxation's seed: the rows it meets (see :func:`_seed_alone`)
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
 
     @classmethod
@@ -493,7 +494,9 @@ def relaxation_excluded(
     returned (its sectors, and a twist of it): the caller refines them. A leaf whose modes (as
     :attr:`RelaxationProof.sectors` names them) ``covered`` accepts is passed over: the caller proves what it
     holds by other means. With ``twist`` (a motion's), a node whose rows leave that twist alone is passed over
-    as a seed's is in :func:`prove_by_patterns` (its leaves hold no other motion). ``farkas``: vectors (an
+    as a seed's is in :func:`prove_by_patterns` (its leaves hold no other motion): by the bounds on its closed
+    rows' point, line or plane, and a leaf by :func:`_seed_alone` (an LP where the seed meets rows of its leaf
+    as inequalities; measured: asked of every node whose twists are not bounded, it costs more than it saves). ``farkas``: vectors (an
     earlier search's :attr:`RelaxationProof.farkas`) checked on this search's columns and kept where they hold,
     so they exclude nodes before any fit (refined sectors' polygons lie inside the coarse ones': most still do).
     """
@@ -505,6 +508,7 @@ def relaxation_excluded(
 
     skip = None if covered is None else lambda node: covered(leaf(node))
     rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=twist, form=None, remaining=remaining, covered=skip, by_rank=True)
+    rows.seed_rows = None if twist is None else _SeedRows.of(layout, twist)
     m = problem.n_contacts
     every = (1 << layout.loads.shape[1]) - 1
     root_columns = functools.reduce(lambda bits, mode: bits & ~mode.removes, layout.roots, every)  # no padding
@@ -533,6 +537,53 @@ def _relaxed_twist(rows: _Rows, node: _Node) -> tuple[str, np.ndarray]:
     upper = np.concatenate([e + LP_FEASIBILITY, np.full(a.size, np.inf)])
     lp = solve_lp(np.zeros(rows.g.size), np.vstack([E, A]), lower, upper)
     return lp.status, lp.x
+
+
+@dataclass(frozen=True)
+class _SeedRows:
+    """Which bank rows the sector relaxation's seed twist meets (bits), each to ``LP_FEASIBILITY`` relative to
+    its value: ``on`` its plane, ``above`` it as an inequality; and :func:`_seed_alone`'s verdicts by rows."""
+
+    on: int
+    above: int
+    verdicts: dict[tuple[int, int], bool] = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, layout: _Layout, q: np.ndarray) -> _SeedRows:
+        values = layout.bank @ q - layout.rhs
+        slack = LP_FEASIBILITY * (1.0 + np.abs(layout.rhs))
+        return cls(_bits(np.abs(values) <= slack), _bits(values >= -slack))
+
+
+def _seed_alone(rows: _Rows, node: _Node) -> bool:
+    """Whether the seed's twist (the sector relaxation's, ``rows.seed_rows``) is the only twist meeting the
+    node's rows: it meets them, and no direction leaves it (the rows it meets with equality have full rank, and an
+    LP finds no direction into the others). The rows of every leaf below hold the node's: none holds another twist."""
+    seed = rows.seed_rows
+    if seed is None or node.equal & ~seed.on or node.at_least & ~seed.above:
+        return False
+    key = (node.equal, node.at_least)
+    if key not in seed.verdicts:
+        seed.verdicts[key] = _no_direction(rows, node.equal, node.at_least & seed.on)
+    return seed.verdicts[key]
+
+
+def _no_direction(rows: _Rows, equal: int, active: int) -> bool:
+    """Whether no direction ``d != 0`` has ``E d = 0`` and ``A d >= 0`` (``E``: the bank rows ``equal``, ``A``:
+    ``active``, bits): ``[E; A]`` of full column rank (relative ``MOTION_RANK``; else no answer, False), and no
+    ``A d`` can be made nonzero, so an LP's optimum of ``sum A d`` with ``0 <= A d <= 1`` is 0 (else at least 1)."""
+    E, A = rows.bank[rows.row_mask(equal)], rows.bank[rows.row_mask(active)]
+    tight = np.vstack([E, A])
+    if tight.shape[0] < rows.g.size:
+        return False
+    sigma = np.linalg.svd(tight, compute_uv=False)
+    if sigma[-1] <= MOTION_RANK * sigma[0]:
+        return False  # a direction that meets every tight row with equality (conservative: no LP asked)
+    if not active:
+        return True
+    rows.proof.lps += 1
+    lp = solve_lp(-A.sum(axis=0), tight, np.zeros(tight.shape[0]), np.concatenate([np.zeros(E.shape[0]), np.ones(A.shape[0])]))
+    return lp.status == "optimal" and -lp.objective < 0.5
 
 
 def _sector_layout(problem: Problem, sectors: list[np.ndarray]) -> tuple[_Layout, dict[int, int]]:
@@ -767,6 +818,8 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
         if child_fit is None:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
+        if child.depth == leaf and _seed_alone(rows, child):
+            continue  # the seed's twist is the only one it holds (the sector relaxation's)
         if child.depth == leaf and rows.form is None:  # the sector relaxation: a leaf with a twist is a point of it
             if rows.covered is not None and rows.covered(child):
                 continue  # before its LP: most covered leaves' rows meet the motion's twist, and the LP would pass
