@@ -4,7 +4,9 @@
 Soundness (random scenes, one set with every other contact frictionless): the branch and bound excludes the
 relaxation only where SCIP proves it infeasible, and never where the exact laws have a motion (the certified
 solve found one). It decides: on the random scenes SCIP calls infeasible it excludes most, and the jammed
-benchmark grasps get their wedge proof from it with SCIP's relaxation never built.
+benchmark grasps get their wedge proof from it with SCIP's relaxation never built. On a box rolling on a table
+(gap rows of rank 3): the closed rows still bound the twists, the leaves that pin the motion's twist are passed
+over, and Farkas vectors handed to a search exclude nothing they do not prove.
 """
 
 from __future__ import annotations
@@ -15,7 +17,9 @@ import numpy as np
 import pytest
 
 import quasistatic as qs
+import quasistatic.solvers.certify.patterns as patterns
 import quasistatic.solvers.certify.wedge as wedge
+from quasistatic.solvers.certified import solve_cheap_certified
 from quasistatic.solvers.certify.patterns import relaxation_excluded
 from quasistatic.solvers.result import Options
 from quasistatic.tools.bench.families import grasp_3d
@@ -77,3 +81,49 @@ def test_jammed_grasps_are_proven_by_the_branch_and_bound_without_scip(instance:
     assert solution.status == "jammed" and solution.certified
     assert solution.certificate is not None and solution.certificate.kind is qs.CertificateKind.SECTOR_RELAXATION
     assert wedge.BY_BRANCH_AND_BOUND in solution.certificate.text
+
+
+@pytest.fixture(scope="module")
+def rolling_box() -> tuple[qs.Problem, np.ndarray]:
+    """A box rolling on a table with four coplanar supports (gap rows of rank 3), and its motion's twist."""
+    problem = qs.assemble(random_scene(3, 186))
+    motion = solve_cheap_certified(problem, Options(time_limit=30.0)).motions[0]
+    assert set(qs.laws.contact_modes(problem, motion.q)) == {"rolling"}
+    return problem, motion.q
+
+
+def test_closed_rows_of_deficient_rank_leave_a_line_that_holds_the_motion(rolling_box: tuple[qs.Problem, np.ndarray]) -> None:
+    problem, q = rolling_box
+    layout, _ = patterns._sector_layout(problem, _uniform(problem, 4))
+    m = problem.n_contacts
+    equal = np.zeros(layout.bank.shape[0], dtype=bool)
+    equal[[*range(m), m, 2 * m]] = True  # every gap shut, contact 0 still: six rows of rank 5
+    width = layout.loads.shape[1] // m
+    for by_rank in (False, True):
+        rows = patterns._Rows.of(layout, problem.g, width, 100, seed=q, form=None, by_rank=by_rank)
+        closed = patterns._closed_set(rows, equal, int(equal.sum()))
+        if not by_rank:
+            assert closed is patterns._UNKNOWN  # what the pyramid search still says of such rows
+            continue
+        assert isinstance(closed, patterns._ClosedSet) and closed.free == 1
+        offset = q - closed.q0
+        assert np.linalg.norm(offset - (offset @ closed.direction) * closed.direction) <= closed.radius + 1e-12
+
+
+def test_the_far_part_passes_over_the_leaves_that_pin_the_motions_twist(rolling_box: tuple[qs.Problem, np.ndarray]) -> None:
+    problem, q = rolling_box
+    sectors = _uniform(problem, 4)
+    assert not relaxation_excluded(problem, sectors).excluded  # the motion is a point of the relaxation
+    proof = relaxation_excluded(problem, sectors, twist=q)
+    assert proof.excluded  # every leaf holding it holds it alone
+
+
+def test_farkas_vectors_passed_to_a_search_are_checked_on_its_own_columns(rolling_box: tuple[qs.Problem, np.ndarray]) -> None:
+    problem, _ = rolling_box
+    sectors = _uniform(problem, 4)
+    rng = np.random.default_rng(0)
+    false = [rng.normal(size=problem.n_dof) for _ in range(40)] + [-problem.g, problem.g]
+    proof = relaxation_excluded(problem, sectors, farkas=false)
+    assert not proof.excluded  # the box has a motion: no vector may exclude it
+    refined = relaxation_excluded(problem, [np.sort(np.append(s, s[0] + 0.1)) for s in sectors], farkas=proof.farkas)
+    assert not refined.excluded and all(v.shape == (problem.n_dof,) for v in proof.farkas)

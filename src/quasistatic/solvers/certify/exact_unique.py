@@ -46,8 +46,8 @@ import numpy as np
 from ...interval import Interval, KrawczykTest, krawczyk, linear_solutions, matmul, point, unit_vectors
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes
 from ...laws.fixed_modes import FixedModeLaws
-from ...tolerances import DISTINCT_TWIST, JACOBIAN_RANK, LP_FEASIBILITY, MOTION_RANK, SAME_TWIST
-from ..numerics.highs import optimise_each, solve_lp
+from ...tolerances import DISTINCT_TWIST, JACOBIAN_RANK, LP_FEASIBILITY, SAME_TWIST
+from ..numerics.highs import optimise_each
 from ..numerics.line_extent import line_axis_extents
 from ..result import Options
 from .patterns import CLOSED_LEAF, SEPARATING_LEAF, relaxation_excluded
@@ -232,12 +232,11 @@ def _far(
 ) -> Uniqueness:
     """Every leaf of the sector relaxation outside the arcs (or with other modes) excluded, refining the sectors.
 
-    A surviving leaf whose twists are all the motion's (its rows pin them: a rolling contact whose force may
-    reach the circle, say) holds no other motion; it is passed over from then on.
+    A node whose twists are all the motion's (its rows pin them: a rolling contact whose force may reach the
+    circle, say) holds no other motion; the branch and bound passes it over (``twist=q``).
     """
     sectors = [_first_sectors(float(angles[i]), arc) if masks.sliding[i] else _even_sectors() for i in range(problem.n_contacts)]
     wanted = np.where(masks.closed, CLOSED_LEAF, SEPARATING_LEAF)
-    pinned: dict[tuple[object, ...], bool] = {}
 
     def near(leaf: tuple[int, ...]) -> bool:
         for i, k in enumerate(leaf):
@@ -248,18 +247,12 @@ def _far(
                 return False
         return True
 
-    def covered(leaf: tuple[int, ...]) -> bool:
-        if near(leaf):
-            return True
-        key = _key(sectors, leaf)
-        if key not in pinned:
-            pinned[key] = _only_twist(problem, sectors, leaf, q)
-        return pinned[key]
-
     rounds = 0
+    farkas: tuple[np.ndarray, ...] = ()  # the last round's, tried first on the next
     while options.remaining() > 0.0 and rounds < FAR_ROUNDS:
         rounds += 1
-        proof = relaxation_excluded(problem, sectors, options.remaining, covered, twist=q)
+        proof = relaxation_excluded(problem, sectors, options.remaining, near, twist=q, farkas=farkas)
+        farkas = proof.farkas
         options.report(1, proof.nodes)  # a long proof shows on the CLI's status line
         if proof.excluded:
             return Uniqueness(True, rounds=rounds)
@@ -270,50 +263,6 @@ def _far(
         if not split_sectors(sectors, proof.sectors, FINEST_FRACTION * arc):
             return Uniqueness(False, reason="a leaf of the sector relaxation survives at the finest sectors", rounds=rounds)
     return Uniqueness(False, reason=f"out of time or of refinements ({rounds})", rounds=rounds)
-
-
-def _key(sectors: list[np.ndarray], leaf: tuple[int, ...]) -> tuple[object, ...]:
-    """A leaf's modes by value (a sector by its bounds, which stay as sectors are split)."""
-    return tuple(k if k < 0 else (float(sectors[i][k]), float(sectors[i][k + 1])) for i, k in enumerate(leaf))
-
-
-def _only_twist(problem: Problem, sectors: list[np.ndarray], leaf: tuple[int, ...], q: np.ndarray) -> bool:
-    """Whether ``q`` is the only twist meeting the leaf's rows: it meets them, and no direction leaves it
-    (the rows it meets with equality have full rank, and an LP finds no direction into the others)."""
-    A, lower, upper = _leaf_rows(problem, sectors, leaf)
-    values = A @ q
-    slack = LP_FEASIBILITY * (1.0 + np.abs(lower))
-    if np.any(values < lower - slack) or np.any(values > upper + slack):
-        return False
-    equal = lower == upper
-    active = ~equal & (values - lower <= slack)
-    tight = A[equal | active]
-    if tight.shape[0] < problem.n_dof:
-        return False
-    sigma = np.linalg.svd(tight, compute_uv=False)
-    if sigma[-1] <= MOTION_RANK * sigma[0]:
-        return False  # a direction that meets every tight row with equality (conservative: no LP asked)
-    if not active.any():
-        return True
-    # Directions d with A_eq d = 0 and A_act d >= 0 are the twists' directions from q: with full rank none but
-    # d = 0 has A_act d = 0, so one exists iff some A_act d can be made 1 (an optimum of 0, else of at least 1).
-    n_active = int(active.sum())
-    n_equal = int(equal.sum())
-    lp = solve_lp(
-        -A[active].sum(axis=0),
-        np.vstack([A[equal], A[active]]),
-        np.zeros(n_equal + n_active),
-        np.concatenate([np.zeros(n_equal), np.ones(n_active)]),
-    )
-    return lp.status == "optimal" and -lp.objective < 0.5
-
-
-def _leaf_rows(problem: Problem, sectors: list[np.ndarray], leaf: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A leaf's twist rows: its contacts shut or open, still (closed and frictional), or slipping in a sector."""
-    codes = np.array(leaf)
-    still = (codes == CLOSED_LEAF) & (problem.mu > 0)
-    rays = [(float(sectors[i][k]), float(sectors[i][k + 1])) if k >= 0 else None for i, k in enumerate(leaf)]
-    return _twist_rows(problem, codes != SEPARATING_LEAF, still, rays)
 
 
 def _first_sectors(angle: float, arc: float) -> np.ndarray:

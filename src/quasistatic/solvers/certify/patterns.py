@@ -130,7 +130,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
@@ -263,6 +263,8 @@ class _Rows:
     survivor: _Node | None = None  # the sector relaxation's leaf whose twists and forces were not excluded
     survivor_twist: np.ndarray | None = None  # a twist of it (None: its LP did not answer)
     covered: Callable[[_Node], bool] | None = None  # sector relaxation leaves the caller proves by other means
+    by_rank: bool = False  # closed rows of deficient rank still bound the twists (see :func:`_closed_set`)
+    seed_rows: _SeedRows | None = None  # the sector relaxation's seed: the rows it meets (see :func:`_seed_alone`)
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
 
     @classmethod
@@ -455,13 +457,15 @@ class RelaxationProof:
     ``excluded``: no pattern holds a point of the relaxation (then no exact motion exists), but those the
     caller ``covered``. Otherwise ``sectors`` names, per contact, the sector a surviving pattern slides in
     (:data:`CLOSED_LEAF`: rolling, or closed and frictionless; :data:`SEPARATING_LEAF`), with a twist ``q`` of it;
-    ``sectors`` is None when the search gave no answer (budget, time, an LP that did not answer).
+    ``sectors`` is None when the search gave no answer (budget, time, an LP that did not answer). ``farkas``:
+    the last Farkas vectors the search kept, which the caller may pass to the next, refined search.
     """
 
     excluded: bool
     sectors: tuple[int, ...] | None = None
     q: np.ndarray | None = None
     nodes: int = 0
+    farkas: tuple[np.ndarray, ...] = ()  # the last Farkas vectors found (twist space), for the next refinement
 
 
 ROLLING_POLYGON = 16  # tangents of the circle bounding a rolling contact's force in the sector relaxation
@@ -474,6 +478,7 @@ def relaxation_excluded(
     remaining: Callable[[], float] | None = None,
     covered: Callable[[tuple[int, ...]], bool] | None = None,
     twist: np.ndarray | None = None,
+    farkas: Sequence[np.ndarray] = (),
 ) -> RelaxationProof:
     """Whether the sector relaxation of the exact 3-D laws (:mod:`.wedge`) has no point, by the mode branch and bound.
 
@@ -489,7 +494,11 @@ def relaxation_excluded(
     returned (its sectors, and a twist of it): the caller refines them. A leaf whose modes (as
     :attr:`RelaxationProof.sectors` names them) ``covered`` accepts is passed over: the caller proves what it
     holds by other means. With ``twist`` (a motion's), a node whose rows leave that twist alone is passed over
-    as a seed's is in :func:`prove_by_patterns` (its leaves hold no other motion).
+    as a seed's is in :func:`prove_by_patterns` (its leaves hold no other motion): by the bounds on its closed
+    rows' point, line or plane, and a leaf by :func:`_seed_alone` (an LP where the seed meets rows of its leaf
+    as inequalities; measured: asked of every node whose twists are not bounded, it costs more than it saves). ``farkas``: vectors (an
+    earlier search's :attr:`RelaxationProof.farkas`) checked on this search's columns and kept where they hold,
+    so they exclude nodes before any fit (refined sectors' polygons lie inside the coarse ones': most still do).
     """
     layout, sector_of = _sector_layout(problem, sectors)
     width = layout.loads.shape[1] // problem.n_contacts
@@ -498,20 +507,23 @@ def relaxation_excluded(
         return tuple(SEPARATING_LEAF if mode.separating else sector_of.get(id(mode), CLOSED_LEAF) for mode in node.modes)
 
     skip = None if covered is None else lambda node: covered(leaf(node))
-    rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=twist, form=None, remaining=remaining, covered=skip)
+    rows = _Rows.of(layout, problem.g, width, PYRAMID_PATTERN_NODES, seed=twist, form=None, remaining=remaining, covered=skip, by_rank=True)
+    rows.seed_rows = None if twist is None else _SeedRows.of(layout, twist)
     m = problem.n_contacts
     every = (1 << layout.loads.shape[1]) - 1
     root_columns = functools.reduce(lambda bits, mode: bits & ~mode.removes, layout.roots, every)  # no padding
     root = _Node(0, (1 << m) - 1, root_columns, layout.roots, 0)
+    for y in farkas:
+        rows.farkas.add(y, 0)  # checked on this layout's columns: kept only where it holds
     fit = _fitted_forces(rows, root.columns)
     closed = fit is None or _search(rows, _past_settled(rows, root), fit, _UNKNOWN)
-    nodes = rows.proof.nodes
+    nodes, kept = rows.proof.nodes, tuple(rows.farkas.vectors)
     if closed:
-        return RelaxationProof(True, nodes=nodes)
+        return RelaxationProof(True, nodes=nodes, farkas=kept)
     survivor, q = rows.survivor, rows.survivor_twist
     if survivor is None or q is None:
-        return RelaxationProof(False, nodes=nodes)  # out of nodes or time, or an LP that did not answer
-    return RelaxationProof(False, leaf(survivor), q, nodes)
+        return RelaxationProof(False, nodes=nodes, farkas=kept)  # out of nodes or time, or an LP that did not answer
+    return RelaxationProof(False, leaf(survivor), q, nodes, kept)
 
 
 def _relaxed_twist(rows: _Rows, node: _Node) -> tuple[str, np.ndarray]:
@@ -525,6 +537,53 @@ def _relaxed_twist(rows: _Rows, node: _Node) -> tuple[str, np.ndarray]:
     upper = np.concatenate([e + LP_FEASIBILITY, np.full(a.size, np.inf)])
     lp = solve_lp(np.zeros(rows.g.size), np.vstack([E, A]), lower, upper)
     return lp.status, lp.x
+
+
+@dataclass(frozen=True)
+class _SeedRows:
+    """Which bank rows the sector relaxation's seed twist meets (bits), each to ``LP_FEASIBILITY`` relative to
+    its value: ``on`` its plane, ``above`` it as an inequality; and :func:`_seed_alone`'s verdicts by rows."""
+
+    on: int
+    above: int
+    verdicts: dict[tuple[int, int], bool] = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, layout: _Layout, q: np.ndarray) -> _SeedRows:
+        values = layout.bank @ q - layout.rhs
+        slack = LP_FEASIBILITY * (1.0 + np.abs(layout.rhs))
+        return cls(_bits(np.abs(values) <= slack), _bits(values >= -slack))
+
+
+def _seed_alone(rows: _Rows, node: _Node) -> bool:
+    """Whether the seed's twist (the sector relaxation's, ``rows.seed_rows``) is the only twist meeting the
+    node's rows: it meets them, and no direction leaves it (the rows it meets with equality have full rank, and an
+    LP finds no direction into the others). The rows of every leaf below hold the node's: none holds another twist."""
+    seed = rows.seed_rows
+    if seed is None or node.equal & ~seed.on or node.at_least & ~seed.above:
+        return False
+    key = (node.equal, node.at_least)
+    if key not in seed.verdicts:
+        seed.verdicts[key] = _no_direction(rows, node.equal, node.at_least & seed.on)
+    return seed.verdicts[key]
+
+
+def _no_direction(rows: _Rows, equal: int, active: int) -> bool:
+    """Whether no direction ``d != 0`` has ``E d = 0`` and ``A d >= 0`` (``E``: the bank rows ``equal``, ``A``:
+    ``active``, bits): ``[E; A]`` of full column rank (relative ``MOTION_RANK``; else no answer, False), and no
+    ``A d`` can be made nonzero, so an LP's optimum of ``sum A d`` with ``0 <= A d <= 1`` is 0 (else at least 1)."""
+    E, A = rows.bank[rows.row_mask(equal)], rows.bank[rows.row_mask(active)]
+    tight = np.vstack([E, A])
+    if tight.shape[0] < rows.g.size:
+        return False
+    sigma = np.linalg.svd(tight, compute_uv=False)
+    if sigma[-1] <= MOTION_RANK * sigma[0]:
+        return False  # a direction that meets every tight row with equality (conservative: no LP asked)
+    if not active:
+        return True
+    rows.proof.lps += 1
+    lp = solve_lp(-A.sum(axis=0), tight, np.zeros(tight.shape[0]), np.concatenate([np.zeros(E.shape[0]), np.ones(A.shape[0])]))
+    return lp.status == "optimal" and -lp.objective < 0.5
 
 
 def _sector_layout(problem: Problem, sectors: list[np.ndarray]) -> tuple[_Layout, dict[int, int]]:
@@ -759,9 +818,13 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
         if child_fit is None:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
+        if child.depth == leaf and _seed_alone(rows, child):
+            continue  # the seed's twist is the only one it holds (the sector relaxation's)
         if child.depth == leaf and rows.form is None:  # the sector relaxation: a leaf with a twist is a point of it
+            if rows.covered is not None and rows.covered(child):
+                continue  # before its LP: most covered leaves' rows meet the motion's twist, and the LP would pass
             status, q = _relaxed_twist(rows, child)
-            if status == "infeasible" or (rows.covered is not None and rows.covered(child)):
+            if status == "infeasible":
                 continue
             rows.survivor, rows.survivor_twist = child, (q if status == "optimal" else None)
             return False
@@ -1127,6 +1190,7 @@ class _FarkasVectors:
     g: np.ndarray
     margin: float
     blockers: list[int] = field(default_factory=list)  # newest last
+    vectors: list[np.ndarray] = field(default_factory=list)  # the vectors themselves, as ``blockers``
     count: int = 0
 
     def add(self, y: np.ndarray, columns: int) -> bool:
@@ -1139,8 +1203,10 @@ class _FarkasVectors:
             return False
         if len(self.blockers) < FARKAS_KEPT:
             self.blockers.append(blockers)
+            self.vectors.append(y)
         else:
             self.blockers[self.count % FARKAS_KEPT] = blockers
+            self.vectors[self.count % FARKAS_KEPT] = y
         self.count += 1
         return True
 
@@ -1192,15 +1258,18 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
     """
     n = rows.g.size
     k = node.closed_rows
-    plane = k == n - 2 and rows.width > 2  # 3-D pyramids: a plane of twists is bounded exactly (planar: as before)
-    if (k < n - 1 and not plane) or k == 0:
+    widest = 2 if rows.width > 2 else 1  # 3-D: a plane of twists is bounded exactly (planar: a line at most)
+    if k < n - widest or k == 0:
         return _UNKNOWN
     closed = rows.closed_sets.get(node.equal)
     if closed is None:
         closed = rows.closed_sets[node.equal] = _closed_set(rows, rows.row_mask(node.equal), k)
     if isinstance(closed, _Twists):
         return closed
-    if closed.slope is not None and not plane:
+    if closed.free > widest:
+        return _UNKNOWN  # rows of deficient rank leave more than a plane
+    plane = closed.free == 2
+    if closed.free == 1:
         interval = _interval(closed, (-math.inf, math.inf), node.at_least)
         return _PRUNED if interval is None else _line(rows, closed, *interval)
     at_least = rows.row_mask(node.at_least)
@@ -1273,6 +1342,7 @@ class _ClosedSet:
     direction: np.ndarray
     slope: np.ndarray | None
     plane: np.ndarray  # (2, n): orthonormal directions of what ``n - 2`` rows leave (the last two of E's full ``vt``)
+    free: int  # the dimension of what the closed rows leave: 0 a point, 1 a line, 2 a plane
     # The same per bank row as plain floats, read a few at a time by :func:`_narrowed`: ``reserve``, and the
     # row's rate along the line (``slope``) or along each of the plane's directions (on ``n - 2`` rows); else empty.
     row_reserve: list[float]
@@ -1291,17 +1361,24 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     ``ZERO |E+_j|_1`` of the exact set (an ill-conditioned pair of contacts turns the LPs' 1e-7 into more than
     the search's ``DISTINCT_TWIST``). Rows of full column rank pin the twists to one point; ``n - 1`` rows
     leave a line ``q0 + t d``, on which every inequality row bounds ``t``.
+
+    With ``rows.by_rank``, rows of deficient rank (four coplanar supports' gaps: three independent rows) are
+    read by their ``r`` singular values above ``MOTION_RANK``: with ``E+`` truncated to them the bounds above
+    hold as written (``U_r^T (E q - e) = S_r V_r^T (q - q0)`` exactly), and the twists lie near ``q0`` plus
+    the span of the other ``n - r`` right singular vectors; the residual then proves nothing (the rows the
+    small singular values join may disagree in round-off), so no set is pruned for it.
     """
     n = rows.g.size
     E, e = rows.bank[equal], rows.rhs[equal]  # ``equal``: a boolean mask of the bank's rows
     u, sigma, vt = np.linalg.svd(E, full_matrices=k < n)  # a line's direction is the last row of the full vt
-    if sigma[-1] <= MOTION_RANK or k > n and sigma[n - 1] <= MOTION_RANK:
+    full = min(k, n)
+    r = int(np.count_nonzero(sigma > MOTION_RANK)) if rows.by_rank else full
+    if r == 0 or sigma[r - 1] <= MOTION_RANK:
         return _UNKNOWN
-    r = min(k, n)
     pseudo_inverse = (vt[:r].T / sigma[:r]) @ u[:, :r].T
     q0 = pseudo_inverse @ e
     residual = E @ q0 - e
-    if residual @ residual > k * LP_FEASIBILITY**2:
+    if r == full and residual @ residual > k * LP_FEASIBILITY**2:
         return _PRUNED
     spread = ZERO * np.abs(pseudo_inverse).sum(axis=1)  # as far as a twist meeting the rows as the seed does may lie
     radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
@@ -1309,13 +1386,14 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     bank = rows.bank
     reserve = bank @ q0 + LP_FEASIBILITY * np.abs(bank @ pseudo_inverse).sum(axis=1) - rows.rhs + LP_FEASIBILITY
     direction = vt[-1]
-    slope = bank @ direction if k < n else None
+    free = n - r
+    slope = bank @ direction if free else None
     rates: tuple[list[float], ...] = ()  # for a line or a plane only (a point's children keep it)
-    if k == n - 1 and slope is not None:
+    if free == 1 and slope is not None:
         rates = (slope.tolist(),)
-    elif k == n - 2:
+    elif free == 2:
         rates = ((bank @ vt[-2]).tolist(), (bank @ vt[-1]).tolist())
-    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], reserve.tolist() if rates else [], rates)
+    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], free, reserve.tolist() if rates else [], rates)
 
 
 def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
