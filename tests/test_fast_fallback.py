@@ -24,7 +24,7 @@ from quasistatic.solvers import fast
 from quasistatic.solvers.certify.arrangement import motion_vertex
 from quasistatic.solvers.certify.cheap import lemke_point, satisfies_form
 from quasistatic.solvers.certify.patterns import PatternVerdict, prove_by_patterns
-from quasistatic.solvers.numerics.lcp import lemke_motion
+from quasistatic.solvers.numerics.lcp import lemke_depth, lemke_motion
 from quasistatic.solvers.numerics.lemke import RAY
 from quasistatic.tools.bench.families import FAMILIES
 from random_scenes import random_scene
@@ -104,7 +104,7 @@ def test_fast_answers_the_bench_grasps_where_lemke_ends_on_a_ray(family: str, si
     fast, scip = _agrees_with_scip(scene)
     assert (fast, scip) == ("solved", certified_status)
     answer = qs.solve(problem, method="fast")
-    assert dict(answer.notes)["method"].startswith(("arrangement vertex", "mode branch and bound"))
+    assert dict(answer.notes)["method"].startswith(("arrangement vertex", "mode branch and bound", FROM_LEMKE_END))
     assert "secondary ray" in dict(answer.notes)["lemke"]
 
 
@@ -287,6 +287,26 @@ def test_newton_from_the_rays_last_point_answers_grasp_3d_6_3(monkeypatch: pytes
     twist = _twist(problem, answer.twists)
     for other in (before, default):
         assert np.allclose(twist, _twist(problem, other.twists), rtol=0.0, atol=1e-9 * np.abs(twist).max())
+
+
+def test_newton_from_the_rays_last_point_with_its_depth_answers_grasp_3d_8_0(monkeypatch: pytest.MonkeyPatch) -> None:
+    """grasp-3d 8 #0: Lemke's ray point solves the laws with every gap rate raised by the artificial variable, so
+    the contacts the path holds closed penetrate by it. Newton's method started with those contacts closed
+    reaches the motion the mode branch and bound gave before (one of its two; ~100x slower); read with no depth
+    (those contacts open), it fails and the branch and bound answers."""
+    scene = FAMILIES["grasp-3d"].make(8, 0)
+    problem = qs.assemble(scene)
+    status, _, q, _, _, _ = lemke_motion(problem)
+    assert status == RAY and lemke_depth(problem, q) > 0.0
+    answer = qs.solve(problem, method="fast")
+    assert answer.status == "solved" and dict(answer.notes)["method"] == FROM_LEMKE_END, answer.message
+    assert answer.motion is not None and answer.motion.audit.passed and not answer.certified
+    with monkeypatch.context() as patch:
+        patch.setattr(fast, "lemke_depth", lambda *args: 0.0)
+        no_depth = qs.solve(problem, method="fast")
+    assert dict(no_depth.notes)["method"] == "mode branch and bound (8 edges)"
+    twist = _twist(problem, answer.twists)
+    assert np.allclose(twist, _twist(problem, no_depth.twists), rtol=0.0, atol=1e-9 * np.abs(twist).max())
 
 
 @pytest.mark.parametrize(("seed", "edges"), [(7111, 8), (7040, 32)])

@@ -21,8 +21,9 @@ refinement that did not converge), a complete method takes over. A ray is no
 proof that no motion exists: Lemke's path reaches only solutions of index +1
 (``sgn det M_SS``), and some scenes' motions all have index -1 (docs/performance.md).
 On exact 3-D cones the point where the path ended is tried first as a start of
-Newton's method, as above (it converges on some scenes whose pyramid LCP has no
-solution Lemke reaches; a motion it returns keeps every mode and inequality).
+Newton's method, as above, with the contacts the path held closed (penetrating by
+its artificial variable) closed (it converges on some scenes whose pyramid LCP has
+no solution Lemke reaches; a motion it returns keeps every mode and inequality).
 
 - One planar body: a motion at a vertex of the contacts' gap-rate and slip
   planes (:func:`~.certify.arrangement.motion_vertex`); where no vertex holds
@@ -66,7 +67,7 @@ from .certify.diagnose import diagnose, no_motion
 from .certify.patterns import NO_MOTION_PROOF, PatternVerdict, prove_by_patterns
 from .certify.search import enumerate_motions
 from .certify.wedge import exact_cones_jam
-from .numerics.lcp import FAST_EDGES, NOT_CONVERGED, exact_newton, lemke_motion
+from .numerics.lcp import FAST_EDGES, NOT_CONVERGED, exact_newton, lemke_depth, lemke_motion
 from .numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION
 from .result import BackendResult, Options
 
@@ -244,17 +245,22 @@ def _is_exact(problem: Problem) -> bool:
     return problem.dimension == 3 and not problem.friction.is_polyhedral(3)
 
 
-def _exact_from(problem: Problem, q: np.ndarray, c: np.ndarray) -> RawMotion | None:
-    """The exact laws solved by Newton's method with the contact modes of ``(q, c)`` (any point, no law checked),
-    or None where it does not converge with every mode and inequality kept."""
-    converged, q_exact, c_exact = exact_newton(problem, q, c)
+def _exact_from(problem: Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0) -> RawMotion | None:
+    """The exact laws solved by Newton's method with the contact modes of ``(q, c)`` (any point, no law checked; a
+    contact penetrating by at most ``depth`` counts as closed), or None where it does not converge with every mode
+    and inequality kept."""
+    converged, q_exact, c_exact = exact_newton(problem, q, c, depth)
     return RawMotion(q_exact, c_exact) if converged else None
 
 
 def _from_lemke_end(problem: Problem, q: np.ndarray, c: np.ndarray, notes: tuple[tuple[str, object], ...]) -> BackendResult | None:
     """Exact cones: a motion by Newton's method from where a Lemke path ended (a ray's last point, or a pyramid's
-    solution), often near an exact motion that no pyramid's Lemke path reaches; None where it does not converge."""
-    motion = _exact_from(problem, q, c)
+    solution), often near an exact motion that no pyramid's Lemke path reaches; None where it does not converge.
+
+    The contacts start closed where the path held them closed: a ray's last point solves the laws with every gap
+    rate raised by the artificial variable, so those contacts penetrate by it (:func:`lemke_depth`); read with a
+    depth of zero, Newton started from grasp-3d 8 #0's ray point with every such contact open and failed."""
+    motion = _exact_from(problem, q, c, lemke_depth(problem, q))
     return None if motion is None else _found(motion, notes + (("exact_cone", _EXACT_FROM_LEMKE_END),))
 
 

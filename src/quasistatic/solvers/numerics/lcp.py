@@ -39,6 +39,7 @@ __all__ = [
     "split_lcp_points",
     "lemke_motion",
     "exact_newton",
+    "lemke_depth",
     "LemkeInputs",
     "NOT_CONVERGED",
     "PIVOTS_PER_ROW",
@@ -99,17 +100,28 @@ def lemke_motion(problem: Problem) -> tuple[int, int, np.ndarray, np.ndarray, in
     )
 
 
-def exact_newton(problem: Problem, q: np.ndarray, c: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray]:
+def exact_newton(problem: Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0) -> tuple[bool, np.ndarray, np.ndarray]:
     """The exact 3-D laws with the contact modes of a pyramid's motion ``(q, c)``, by the kernel's Newton method
     (the one :func:`solve_split_lcp` runs on Lemke's motion). Returns whether it converged with every mode and
     inequality kept, the twist ``q`` (n,) and forces ``c`` (m, 3).
+
+    ``depth`` [scene velocity]: how far the start lets contacts penetrate and still counts them closed (the
+    artificial variable of a Lemke point that is not a solution, :func:`lemke_depth`); 0 for a motion.
 
     Its C twin runs where the extension was built, with numba or without: about 3x faster than the numba
     kernel called from Python, 25x faster than the kernel as plain Python (grasp-3d 6 #3 and 8 #0-#3, from
     where Lemke's path ended; docs/performance.md)."""
     data = problem.derived("fast", LemkeInputs)
     newton = _newton_compiled if HAVE_EXTENSION else _newton
-    return newton(data.J, data.b, data.mu, data.g, q, c, MODE_SPEED, FRICTION_ALIGNMENT)
+    return newton(data.J, data.b, data.mu, data.g, q, c, depth, MODE_SPEED, FRICTION_ALIGNMENT)
+
+
+def lemke_depth(problem: Problem, q: np.ndarray) -> float:
+    """The artificial variable ``z0`` of a Lemke point that is not a solution (a secondary ray's last point) [scene
+    velocity]: the path solves the laws with every gap rate raised by ``z0``, so the contacts it holds closed
+    penetrate at ``-z0`` and the deepest penetration of the twist ``q`` (n,) is ``z0`` (0 where none does)."""
+    normal_rates = problem.J[:, -1, :] @ q - problem.b[:, -1]
+    return max(0.0, -float(normal_rates.min(initial=0.0)))
 
 
 _NEWTON = NewtonTolerances(CONE_ROUNDOFF, NEWTON_DAMPING, NEWTON_STOP)  # the C kernel's Newton iterations, built once
@@ -195,7 +207,7 @@ def solve_split_lcp(
         if realignments == 0 or realignments == max_realignments or error > 0.5 * previous:
             # First, and whenever re-alignment stalls (a pyramid lets a slip turn within its
             # vertex's fan at no change of force): the exact laws with these contact modes.
-            converged, q_exact, c_exact = _newton(J, b, mu, g, q, c, mode_tol, dissipation_tol)
+            converged, q_exact, c_exact = _newton(J, b, mu, g, q, c, 0.0, mode_tol, dissipation_tol)
             if converged:
                 return SOLUTION, 2, q_exact, c_exact, pivots, realignments
             if realignments == max_realignments:
@@ -295,15 +307,15 @@ def split_lcp_points(
 
 
 def _newton_compiled(
-    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, q: np.ndarray, c: np.ndarray, mode_tol: float, tol: float
+    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, q: np.ndarray, c: np.ndarray, depth: float, mode_tol: float, tol: float
 ) -> tuple[bool, np.ndarray, np.ndarray]:
     """:func:`_newton` in the extension's C, step for step, to the bit (:func:`exact_newton` calls it where it was built)."""
-    return compiled_exact_newton(J, b, mu, g, q, c, mode_tol, tol, _NEWTON)
+    return compiled_exact_newton(J, b, mu, g, q, c, depth, mode_tol, tol, _NEWTON)
 
 
 @njit
 def _newton(
-    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, q: np.ndarray, c: np.ndarray, mode_tol: float, tol: float
+    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, q: np.ndarray, c: np.ndarray, depth: float, mode_tol: float, tol: float
 ) -> tuple[bool, np.ndarray, np.ndarray]:
     """The exact 3-D laws with fixed contact modes, by damped Newton steps, from the motion ``(q, c)``.
 
@@ -311,7 +323,8 @@ def _newton(
     force of each rolling (frictional) one. Equations: equilibrium; closed
     contacts do not move along their normal; rolling ones do not slip. A
     sliding contact's friction is ``-mu cn slip/|slip|``. The modes start as
-    those of ``q``; a closed contact whose normal force turns negative opens,
+    those of ``q``, a contact closed where its gap rate is within ``depth`` of
+    zero or below (a Lemke point's penetration, :func:`lemke_depth`); a closed contact whose normal force turns negative opens,
     an open one that would penetrate closes and a sliding one that stops rolls,
     and the equations are solved again (a few times at most). Returns whether
     a solution kept every mode and inequality (normal forces >= 0, rolling
@@ -321,7 +334,7 @@ def _newton(
     kind = np.zeros(m, dtype=np.int64)  # 0 separating, 1 rolling (frictional), 2 sliding or frictionless
     for i in range(m):
         u_n, speed = _contact_speeds(J, b, q, i)
-        if u_n <= mode_tol:
+        if u_n + depth <= mode_tol:
             kind[i] = 1 if mu[i] > 0.0 and speed <= mode_tol else 2
     forces = c.copy()
     for _ in range(8):
