@@ -383,12 +383,12 @@ def test_the_extensions_split_lcp_kernel_checks_its_arrays() -> None:
 
 def _newton_starts() -> Iterator[tuple[str, lcp.LemkeInputs, np.ndarray, np.ndarray]]:
     """Starts of Newton's method on the exact 3-D cases: where the fast kernel ended (a ray's last point, or its
-    motion), grasp-3d 6 #3's and 8 #0's rays (from which Newton converges, 8 #0 with the ray's depth), and random
-    points (from which it mostly fails)."""
+    motion), grasp-3d 6 #3's, 8 #0's and 8 #1's rays (from which Newton converges, 8 #0 with the ray's depth, 8 #1
+    with quick mode switches too), and random points (from which it mostly fails)."""
     rng = np.random.default_rng(11)
     rays = [
         (f"grasp-3d {size} #{i}", qs.assemble(FAMILIES["grasp-3d"].make(size, i)).derived("fast", lcp.LemkeInputs))
-        for size, i in ((6, 3), (8, 0))
+        for size, i in ((6, 3), (8, 0), (8, 1))
     ]
     for name, data in [*_split_lcp_cases(), *rays]:
         if not data.exact:
@@ -405,8 +405,8 @@ def test_the_extensions_newton_is_the_numba_kernels() -> None:
     verdicts = set()
     for name, data, q, c in _newton_starts():
         depth = max(0.0, -float((data.J[:, 2] @ q - data.b[:, 2]).min()))  # the penetration Lemke's point allows (a ray's)
-        for start_depth in (0.0, depth):
-            arguments = (data.J, data.b, data.mu, data.g, q, c, start_depth, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
+        for start_depth, patience in ((0.0, lcp.NEWTON_ITERATIONS), (depth, lcp.NEWTON_ITERATIONS), (depth, lcp.QUICK_PATIENCE)):
+            arguments = (data.J, data.b, data.mu, data.g, q, c, start_depth, patience, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
             got, want = lcp._newton_compiled(*arguments), lcp._newton(*arguments)
             assert got[0] == want[0], name
             for g, w in ((got[1], want[1]), (got[2], want[2])):
@@ -430,7 +430,7 @@ def test_exact_newton_runs_the_extensions_newton(monkeypatch: pytest.MonkeyPatch
 def test_the_extensions_newton_checks_its_arrays() -> None:
     data = qs.assemble(FAMILIES["grasp-3d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
     q, c = np.zeros(data.J.shape[2]), np.zeros(data.J.shape[:2])
-    tolerances = (0.0, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
+    tolerances = (0.0, lcp.NEWTON_ITERATIONS, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
     with pytest.raises(ValueError, match=r"J must have shape \(m, 3, n\)"):
         lcp._newton_compiled(data.J[:, 1:], data.b[:, 1:], data.mu, data.g, q, c[:, 1:], *tolerances)
     with pytest.raises(ValueError, match="b must have shape"):

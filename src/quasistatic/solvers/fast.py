@@ -67,7 +67,7 @@ from .certify.diagnose import diagnose, no_motion
 from .certify.patterns import NO_MOTION_PROOF, PatternVerdict, prove_by_patterns
 from .certify.search import enumerate_motions
 from .certify.wedge import exact_cones_jam
-from .numerics.lcp import FAST_EDGES, NOT_CONVERGED, exact_newton, lemke_depth, lemke_motion
+from .numerics.lcp import FAST_EDGES, NEWTON_ITERATIONS, NOT_CONVERGED, QUICK_PATIENCE, exact_newton, lemke_depth, lemke_motion
 from .numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION
 from .result import BackendResult, Options
 
@@ -245,11 +245,11 @@ def _is_exact(problem: Problem) -> bool:
     return problem.dimension == 3 and not problem.friction.is_polyhedral(3)
 
 
-def _exact_from(problem: Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0) -> RawMotion | None:
+def _exact_from(problem: Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0, patience: int = NEWTON_ITERATIONS) -> RawMotion | None:
     """The exact laws solved by Newton's method with the contact modes of ``(q, c)`` (any point, no law checked; a
-    contact penetrating by at most ``depth`` counts as closed), or None where it does not converge with every mode
-    and inequality kept."""
-    converged, q_exact, c_exact = exact_newton(problem, q, c, depth)
+    contact penetrating by at most ``depth`` counts as closed; ``patience`` as :func:`.numerics.lcp.exact_newton`),
+    or None where it does not converge with every mode and inequality kept."""
+    converged, q_exact, c_exact = exact_newton(problem, q, c, depth, patience)
     return RawMotion(q_exact, c_exact) if converged else None
 
 
@@ -259,9 +259,15 @@ def _from_lemke_end(problem: Problem, q: np.ndarray, c: np.ndarray, notes: tuple
 
     The contacts start closed where the path held them closed: a ray's last point solves the laws with every gap
     rate raised by the artificial variable, so those contacts penetrate by it (:func:`lemke_depth`); read with a
-    depth of zero, Newton started from grasp-3d 8 #0's ray point with every such contact open and failed."""
-    motion = _exact_from(problem, q, c, lemke_depth(problem, q))
-    return None if motion is None else _found(motion, notes + (("exact_cone", _EXACT_FROM_LEMKE_END),))
+    depth of zero, Newton started from grasp-3d 8 #0's ray point with every such contact open and failed.
+    Newton's rounds first switch modes as soon as two iterations stall (grasp-3d 8 #1's motion, cheaply), then
+    run the kernel's full rounds (8 #0's); the note ``newton_patience`` says which converged."""
+    depth = lemke_depth(problem, q)
+    for patience in (QUICK_PATIENCE, NEWTON_ITERATIONS):
+        motion = _exact_from(problem, q, c, depth, patience)
+        if motion is not None:
+            return _found(motion, notes + (("exact_cone", _EXACT_FROM_LEMKE_END), ("newton_patience", patience)))
+    return None
 
 
 def _found(motion: RawMotion, notes: tuple[tuple[str, object], ...]) -> BackendResult:
