@@ -24,7 +24,7 @@ from quasistatic.solvers import fast
 from quasistatic.solvers.certify.arrangement import motion_vertex
 from quasistatic.solvers.certify.cheap import lemke_point, satisfies_form
 from quasistatic.solvers.certify.patterns import PatternVerdict, prove_by_patterns
-from quasistatic.solvers.numerics.lcp import lemke_motion
+from quasistatic.solvers.numerics.lcp import NEWTON_ITERATIONS, QUICK_PATIENCE, lemke_depth, lemke_motion
 from quasistatic.solvers.numerics.lemke import RAY
 from quasistatic.tools.bench.families import FAMILIES
 from random_scenes import random_scene
@@ -104,7 +104,7 @@ def test_fast_answers_the_bench_grasps_where_lemke_ends_on_a_ray(family: str, si
     fast, scip = _agrees_with_scip(scene)
     assert (fast, scip) == ("solved", certified_status)
     answer = qs.solve(problem, method="fast")
-    assert dict(answer.notes)["method"].startswith(("arrangement vertex", "mode branch and bound"))
+    assert dict(answer.notes)["method"].startswith(("arrangement vertex", "mode branch and bound", FROM_LEMKE_END))
     assert "secondary ray" in dict(answer.notes)["lemke"]
 
 
@@ -205,6 +205,7 @@ def test_past_the_node_budget_scips_search_finds_the_motion(monkeypatch: pytest.
     from quasistatic.solvers.certify import patterns
 
     scene = FAMILIES["grasp-3d"].make(8, 1)
+    monkeypatch.setattr(fast, "_from_lemke_end", lambda *args: None)  # which answers 8 #1 first
     unhindered = qs.solve(scene, method="fast")
     monkeypatch.setattr(patterns, "PYRAMID_PATTERN_NODES", 10)
     answer = qs.solve(scene, method="fast")
@@ -289,10 +290,49 @@ def test_newton_from_the_rays_last_point_answers_grasp_3d_6_3(monkeypatch: pytes
         assert np.allclose(twist, _twist(problem, other.twists), rtol=0.0, atol=1e-9 * np.abs(twist).max())
 
 
-@pytest.mark.parametrize(("seed", "edges"), [(7111, 8), (7040, 32)])
+def test_newton_from_the_rays_last_point_with_its_depth_answers_grasp_3d_8_0(monkeypatch: pytest.MonkeyPatch) -> None:
+    """grasp-3d 8 #0: Lemke's ray point solves the laws with every gap rate raised by the artificial variable, so
+    the contacts the path holds closed penetrate by it. Newton's method started with those contacts closed
+    reaches the motion the mode branch and bound gave before (one of its two; ~100x slower); read with no depth
+    (those contacts open), it fails and the branch and bound answers."""
+    scene = FAMILIES["grasp-3d"].make(8, 0)
+    problem = qs.assemble(scene)
+    status, _, q, _, _, _ = lemke_motion(problem)
+    assert status == RAY and lemke_depth(problem, q) > 0.0
+    answer = qs.solve(problem, method="fast")
+    assert answer.status == "solved" and dict(answer.notes)["method"] == FROM_LEMKE_END, answer.message
+    assert dict(answer.notes)["newton_patience"] == NEWTON_ITERATIONS  # quick mode switches miss this one
+    assert answer.motion is not None and answer.motion.audit.passed and not answer.certified
+    with monkeypatch.context() as patch:
+        patch.setattr(fast, "lemke_depth", lambda *args: 0.0)
+        no_depth = qs.solve(problem, method="fast")
+    assert dict(no_depth.notes)["method"] == "mode branch and bound (8 edges)"
+    twist = _twist(problem, answer.twists)
+    assert np.allclose(twist, _twist(problem, no_depth.twists), rtol=0.0, atol=1e-9 * np.abs(twist).max())
+
+
+def test_newton_with_quick_mode_switches_answers_grasp_3d_8_1(monkeypatch: pytest.MonkeyPatch) -> None:
+    """grasp-3d 8 #1: from Lemke's ray point (with its depth), Newton's method whose rounds end once two iterations
+    stall with a mode switch due reaches the scene's one motion, the one the mode branch and bound gave before
+    (~100x slower); with the kernel's full rounds alone it fails there, and the branch and bound answers."""
+    problem = qs.assemble(FAMILIES["grasp-3d"].make(8, 1))
+    assert lemke_motion(problem)[0] == RAY
+    answer = qs.solve(problem, method="fast")
+    notes = dict(answer.notes)
+    assert answer.status == "solved" and notes["method"] == FROM_LEMKE_END and notes["newton_patience"] == QUICK_PATIENCE
+    assert answer.motion is not None and answer.motion.audit.passed and not answer.certified
+    with monkeypatch.context() as patch:
+        patch.setattr(fast, "QUICK_PATIENCE", NEWTON_ITERATIONS)
+        patient = qs.solve(problem, method="fast")
+    assert dict(patient.notes)["method"] == "mode branch and bound (8 edges)"
+    twist = _twist(problem, answer.twists)
+    assert np.allclose(twist, _twist(problem, patient.twists), rtol=0.0, atol=1e-9 * np.abs(twist).max())
+
+
+@pytest.mark.parametrize(("seed", "edges"), [(7390, 8), (7040, 32)])
 def test_newton_from_a_finer_pyramids_lemke_point(seed: int, edges: int, monkeypatch: pytest.MonkeyPatch) -> None:
     """Random 3-D scenes where Newton's method from the 6-edge ray's last point fails, but from where Lemke's path
-    ended on the fallback's 8-edge pyramid (7111), or on the 32-edge one (7040: no equilibrium in the 8-edge
+    ended on the fallback's 8-edge pyramid (7390), or on the 32-edge one (7040: no equilibrium in the 8-edge
     pyramid), it converges before the branch and bound: a motion SCIP lists; before, the tree gave it."""
     scene = random_scene(3, seed)
     answer = qs.solve(scene, method="fast")

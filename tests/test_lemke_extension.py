@@ -383,10 +383,14 @@ def test_the_extensions_split_lcp_kernel_checks_its_arrays() -> None:
 
 def _newton_starts() -> Iterator[tuple[str, lcp.LemkeInputs, np.ndarray, np.ndarray]]:
     """Starts of Newton's method on the exact 3-D cases: where the fast kernel ended (a ray's last point, or its
-    motion), grasp-3d 6 #3's ray (from which Newton converges), and random points (from which it mostly fails)."""
+    motion), grasp-3d 6 #3's, 8 #0's and 8 #1's rays (from which Newton converges, 8 #0 with the ray's depth, 8 #1
+    with quick mode switches too), and random points (from which it mostly fails)."""
     rng = np.random.default_rng(11)
-    ray = ("grasp-3d 6 #3", qs.assemble(FAMILIES["grasp-3d"].make(6, 3)).derived("fast", lcp.LemkeInputs))
-    for name, data in [*_split_lcp_cases(), ray]:
+    rays = [
+        (f"grasp-3d {size} #{i}", qs.assemble(FAMILIES["grasp-3d"].make(size, i)).derived("fast", lcp.LemkeInputs))
+        for size, i in ((6, 3), (8, 0), (8, 1))
+    ]
+    for name, data in [*_split_lcp_cases(), *rays]:
         if not data.exact:
             continue
         q, c = lcp.solve_split_lcp(*_kernel_arguments(data))[2:4]
@@ -400,12 +404,14 @@ def test_the_extensions_newton_is_the_numba_kernels() -> None:
     """The same verdict and the same point to 1e-9 relative (the same loops: in practice to the bit), converged or not."""
     verdicts = set()
     for name, data, q, c in _newton_starts():
-        arguments = (data.J, data.b, data.mu, data.g, q, c, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
-        got, want = lcp._newton_compiled(*arguments), lcp._newton(*arguments)
-        assert got[0] == want[0], name
-        for g, w in ((got[1], want[1]), (got[2], want[2])):
-            np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(w).max(initial=0.0))), err_msg=name)
-        verdicts.add(bool(want[0]))
+        depth = max(0.0, -float((data.J[:, 2] @ q - data.b[:, 2]).min()))  # the penetration Lemke's point allows (a ray's)
+        for start_depth, patience in ((0.0, lcp.NEWTON_ITERATIONS), (depth, lcp.NEWTON_ITERATIONS), (depth, lcp.QUICK_PATIENCE)):
+            arguments = (data.J, data.b, data.mu, data.g, q, c, start_depth, patience, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
+            got, want = lcp._newton_compiled(*arguments), lcp._newton(*arguments)
+            assert got[0] == want[0], name
+            for g, w in ((got[1], want[1]), (got[2], want[2])):
+                np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(w).max(initial=0.0))), err_msg=name)
+            verdicts.add(bool(want[0]))
     assert verdicts == {True, False}
 
 
@@ -424,7 +430,7 @@ def test_exact_newton_runs_the_extensions_newton(monkeypatch: pytest.MonkeyPatch
 def test_the_extensions_newton_checks_its_arrays() -> None:
     data = qs.assemble(FAMILIES["grasp-3d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
     q, c = np.zeros(data.J.shape[2]), np.zeros(data.J.shape[:2])
-    tolerances = (lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
+    tolerances = (0.0, lcp.NEWTON_ITERATIONS, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
     with pytest.raises(ValueError, match=r"J must have shape \(m, 3, n\)"):
         lcp._newton_compiled(data.J[:, 1:], data.b[:, 1:], data.mu, data.g, q, c[:, 1:], *tolerances)
     with pytest.raises(ValueError, match="b must have shape"):

@@ -10,11 +10,12 @@
  *   lemke_address
  *       The address of quasistatic_lemke, the same method on raw pointers (no Python objects):
  *       the numba install's kernels call it from compiled code.
- *   exact_newton(J, b, mu, g, q, c, mode_tol, tol, cone_roundoff, newton_damping, newton_stop, q_out, c_out) -> bool
+ *   exact_newton(J, b, mu, g, q, c, depth, patience, mode_tol, tol, cone_roundoff, newton_damping, newton_stop, q_out, c_out)
+ *       -> bool
  *       Newton's method on the exact 3-D fixed-mode laws from (q, c), solvers/numerics/lcp.py::_newton step
  *       for step (the kernel's own Newton, called alone); q_out (n,) and c_out (m, 3) are filled.
  *   api_version
- *       3; quasistatic/compiled.py runs without a .so built from an older source.
+ *       5; quasistatic/compiled.py runs without a .so built from an older source.
  *   fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces) -> None
  *       The fixed-mode laws at x, laws/fixed_modes.py::system loop for loop (the 3-D fast
  *       path's Newton iterations call it); the last three arrays are filled.
@@ -421,6 +422,7 @@ done:
 /* ---------------------------------------------------------------- the split-twist LCP kernel */
 
 enum { NOT_CONVERGED = 3 };
+enum { NEWTON_ITERATIONS = 50 }; /* most Newton iterations a set of contact modes gets (lcp.py::NEWTON_ITERATIONS) */
 
 /* Python's max(a, b) as numba compiles it: b only when b > a, so a NaN in b is passed over and one in a kept. */
 static double py_max(double a, double b) { return b > a ? b : a; }
@@ -654,12 +656,26 @@ static void newton_step(Split *s, Py_ssize_t size) {
     linear_solve(size, normal, gradient, s->U, s->step); /* singular or not, the kernel takes what comes out */
 }
 
-/* Damped Newton steps with step halving on the fixed-mode laws from s->x (lcp.py::_gauss_newton): s->x, s->residual,
- * s->jacobian and s->forces end at the last accepted point; returns its largest residual. */
-static double gauss_newton(Split *s, Py_ssize_t size) {
+/* Whether lcp.py::_newton would switch a contact's mode at the twist q and forces (m, 3) (lcp.py::_switch_due). */
+static int switch_due(const Split *s, const double *q, const double *forces) {
+    double u_n, speed;
+    for (Py_ssize_t i = 0; i < s->m; i++) {
+        contact_speeds(s, q, i, &u_n, &speed);
+        if ((s->kind[i] == SEPARATING && u_n < 0.0) || (s->kind[i] != SEPARATING && forces[i * 3 + 2] < 0.0)) return 1;
+        if (s->kind[i] == SLIDING && s->mu[i] > 0.0 && speed <= s->mode_tol) return 1;
+    }
+    return 0;
+}
+
+/* Damped Newton steps with step halving on the fixed-mode laws from s->x (lcp.py::_gauss_newton): at most NEWTON_ITERATIONS,
+ * or until patience of them have not halved the residual while a mode switch is due. s->x, s->residual, s->jacobian and
+ * s->forces end at the last accepted point; returns its largest residual. */
+static double gauss_newton(Split *s, Py_ssize_t size, long long patience) {
     laws_at(s, size, s->x, s->residual, s->jacobian, s->forces);
     double norm = largest_magnitude(size, s->residual);
-    for (int iteration = 0; iteration < 50; iteration++) {
+    double reference = norm;
+    long long stalled = 0;
+    for (int iteration = 0; iteration < NEWTON_ITERATIONS; iteration++) {
         if (norm <= s->newton_stop) break;
         newton_step(s, size);
         double t = 1.0;
@@ -681,18 +697,25 @@ static double gauss_newton(Split *s, Py_ssize_t size) {
             t *= 0.5;
         }
         if (!improved) break;
+        if (norm <= 0.5 * reference) {
+            reference = norm, stalled = 0;
+            continue;
+        }
+        stalled++;
+        if (stalled >= patience && switch_due(s, s->x, s->forces)) break;
     }
     return norm;
 }
 
-/* The exact 3-D laws with the contact modes of (q, c), by lcp.py::_newton's rules; the result in s->newton_q and
- * s->forces (m, 3). Returns whether it converged with every mode and inequality kept. */
-static int newton(Split *s, const double *q, const double *c, double tol) {
+/* The exact 3-D laws with the contact modes of (q, c), by lcp.py::_newton's rules (a contact closed where its gap rate
+ * is at most depth below mode_tol); the result in s->newton_q and s->forces (m, 3). Returns whether it converged with every
+ * mode and inequality kept. */
+static int newton(Split *s, const double *q, const double *c, double depth, long long patience, double tol) {
     const Py_ssize_t m = s->m, n = s->n;
     double u_n, speed;
     for (Py_ssize_t i = 0; i < m; i++) {
         contact_speeds(s, q, i, &u_n, &speed);
-        s->kind[i] = u_n <= s->mode_tol ? (s->mu[i] > 0.0 && speed <= s->mode_tol ? ROLLING : SLIDING) : SEPARATING;
+        s->kind[i] = u_n + depth <= s->mode_tol ? (s->mu[i] > 0.0 && speed <= s->mode_tol ? ROLLING : SLIDING) : SEPARATING;
     }
     for (Py_ssize_t i = 0; i < m * 3; i++) s->forces[i] = c[i];
     for (Py_ssize_t j = 0; j < n; j++) s->newton_q[j] = q[j];
@@ -712,7 +735,7 @@ static int newton(Split *s, const double *q, const double *c, double tol) {
                 s->x[s->column[i] + 2] = fi[1];
             }
         }
-        const double norm = gauss_newton(s, size);
+        const double norm = gauss_newton(s, size, patience);
         for (Py_ssize_t j = 0; j < n; j++) s->newton_q[j] = s->x[j];
         int changed = 0;
         for (Py_ssize_t i = 0; i < m; i++) {
@@ -788,7 +811,7 @@ static SplitResult split_lcp(Split *s, int exact, int64_t max_realignments, doub
         }
         if (out.realignments == 0 || out.realignments == max_realignments || error > 0.5 * previous) {
             /* First, and whenever re-alignment stalls: the exact laws with these contact modes. */
-            if (newton(s, q, c, s->dissipation_tol)) {
+            if (newton(s, q, c, 0.0, NEWTON_ITERATIONS, s->dissipation_tol)) {
                 for (Py_ssize_t j = 0; j < s->n; j++) q[j] = s->newton_q[j];
                 for (Py_ssize_t i = 0; i < s->m * 3; i++) c[i] = s->forces[i];
                 out.stage = 2;
@@ -951,16 +974,18 @@ done:
 
 static PyObject *exact_newton(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
     (void)module;
-    if (nargs != 13) {
-        PyErr_SetString(PyExc_TypeError, "exact_newton(J, b, mu, g, q, c, mode_tol, tol, cone_roundoff, newton_damping, newton_stop,"
-                                         " q_out, c_out) takes 13 arguments");
+    if (nargs != 15) {
+        PyErr_SetString(PyExc_TypeError, "exact_newton(J, b, mu, g, q, c, depth, patience, mode_tol, tol, cone_roundoff,"
+                                         " newton_damping, newton_stop, q_out, c_out) takes 15 arguments");
         return NULL;
     }
     Split s;
     memset(&s, 0, sizeof s);
-    double tol;
-    if (take_double(args, 6, &s.mode_tol) || take_double(args, 7, &tol) || take_double(args, 8, &s.cone_roundoff) ||
-        take_double(args, 9, &s.newton_damping) || take_double(args, 10, &s.newton_stop))
+    double depth, tol;
+    const long long patience = PyLong_AsLongLong(args[7]);
+    if (patience == -1 && PyErr_Occurred()) return NULL;
+    if (take_double(args, 6, &depth) || take_double(args, 8, &s.mode_tol) || take_double(args, 9, &tol) ||
+        take_double(args, 10, &s.cone_roundoff) || take_double(args, 11, &s.newton_damping) || take_double(args, 12, &s.newton_stop))
         return NULL;
     Py_buffer probe;
     if (PyObject_GetBuffer(args[0], &probe, PyBUF_STRIDES) < 0) return NULL;
@@ -980,7 +1005,7 @@ static PyObject *exact_newton(PyObject *module, PyObject *const *args, Py_ssize_
     PyObject *result = NULL;
     double *memory = NULL;
     int64_t *integers = NULL;
-    const int indices[8] = {0, 1, 2, 3, 4, 5, 11, 12};
+    const int indices[8] = {0, 1, 2, 3, 4, 5, 13, 14};
     for (; taken < 8; taken++)
         if (take_buffer(args[indices[taken]], &views[taken], names[taken], "d", taken >= 6, ndims[taken], shapes[taken]) < 0) goto done;
     s.J = views[0].buf, s.b = views[1].buf, s.mu = views[2].buf, s.g = views[3].buf;
@@ -988,7 +1013,7 @@ static PyObject *exact_newton(PyObject *module, PyObject *const *args, Py_ssize_
     if (allocate(&s, &memory, &integers) < 0) goto done;
     int converged;
     Py_BEGIN_ALLOW_THREADS
-    converged = newton(&s, views[4].buf, views[5].buf, tol);
+    converged = newton(&s, views[4].buf, views[5].buf, depth, patience, tol);
     double *q_out = views[6].buf, *c_out = views[7].buf;
     for (Py_ssize_t j = 0; j < n; j++) q_out[j] = s.newton_q[j];
     for (Py_ssize_t i = 0; i < m * 3; i++) c_out[i] = s.forces[i];
@@ -1013,7 +1038,8 @@ static PyMethodDef methods[] = {
      "feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) -> (status, stage, pivots, realignments):\n"
      "the fast path's kernel, the numba kernel's steps; fills q (n,) and c (m, d). See quasistatic.solvers.numerics.lcp."},
     {"exact_newton", (PyCFunction)(void (*)(void))exact_newton, METH_FASTCALL,
-     "exact_newton(J, b, mu, g, q, c, mode_tol, tol, cone_roundoff, newton_damping, newton_stop, q_out, c_out) -> bool:\n"
+     "exact_newton(J, b, mu, g, q, c, depth, patience, mode_tol, tol, cone_roundoff, newton_damping, newton_stop, q_out, c_out)"
+     " -> bool:\n"
      "Newton's method on the exact 3-D fixed-mode laws from (q, c), the numba kernel's steps; fills q_out (n,) and c_out (m, 3).\n"
      "See quasistatic.solvers.numerics.lcp.exact_newton."},
     {NULL, NULL, 0, NULL},
@@ -1033,7 +1059,7 @@ PyMODINIT_FUNC PyInit__lemke(void) {
         return NULL;
     }
     /* what quasistatic/compiled.py checks: a .so built from an older source is not used */
-    if (PyModule_AddIntConstant(module, "api_version", 3) < 0) {
+    if (PyModule_AddIntConstant(module, "api_version", 5) < 0) {
         Py_DECREF(module);
         return NULL;
     }

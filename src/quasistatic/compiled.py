@@ -23,7 +23,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-API_VERSION = 3  # the _lemke.c these wrappers call (its module attribute api_version)
+API_VERSION = 5  # the _lemke.c these wrappers call (its module attribute api_version)
 
 
 def _load(name: str) -> Any:
@@ -185,14 +185,17 @@ def exact_newton(
     g: np.ndarray,
     q: np.ndarray,
     c: np.ndarray,
+    depth: float,
+    patience: int,
     mode_tol: float,
     tol: float,
     newton: NewtonTolerances,
 ) -> tuple[bool, np.ndarray, np.ndarray]:
     """Newton's method on the exact 3-D fixed-mode laws in C: ``(converged, q, c)`` as ``solvers/numerics/lcp.py::_newton``.
 
-    ``J`` (m, 3, n), ``b`` (m, 3), ``mu`` (m,), ``g`` (n,), the start ``q`` (n,) and ``c`` (m, 3), the mode and
-    convergence tolerances, and the Newton iterations' tolerances.
+    ``J`` (m, 3, n), ``b`` (m, 3), ``mu`` (m,), ``g`` (n,), the start ``q`` (n,) and ``c`` (m, 3), the start's
+    penetration counted as closed ``depth``, the iterations without progress before a due mode switch ``patience``,
+    the mode and convergence tolerances, and the Newton iterations' tolerances.
 
     Raises
     ------
@@ -203,7 +206,7 @@ def exact_newton(
         raise ValueError(f"J must have shape (m, 3, n), not {J.shape}")
     q_out, c_out = np.empty(J.shape[2]), np.empty(J.shape[:2])
     arrays = (np.ascontiguousarray(a, np.float64) for a in (J, b, mu, g, q, c))
-    converged = extension.exact_newton(*arrays, mode_tol, tol, *newton, q_out, c_out)
+    converged = extension.exact_newton(*arrays, depth, patience, mode_tol, tol, *newton, q_out, c_out)
     return bool(converged), q_out, c_out
 
 

@@ -39,6 +39,7 @@ __all__ = [
     "split_lcp_points",
     "lemke_motion",
     "exact_newton",
+    "lemke_depth",
     "LemkeInputs",
     "NOT_CONVERGED",
     "PIVOTS_PER_ROW",
@@ -50,6 +51,8 @@ PIVOTS_PER_ROW = 20  # Lemke pivot cap per LCP row
 NOT_CONVERGED = 3  # kernel status beyond Lemke's: neither re-alignment nor Newton's method reached the exact cone
 FAST_EDGES = 6  # pyramid edges for exact 3-D cones (Newton then solves the circle; 6 was 2-3x faster than 8 on 3-D grasps, same successes)
 REALIGNMENTS = 20  # most edge re-alignments for exact 3-D cones
+NEWTON_ITERATIONS = 50  # most Newton iterations a set of contact modes gets (the kernel's patience: a stall never ends it early)
+QUICK_PATIENCE = 2  # Newton iterations without halving the residual after which a due mode switch ends the round (8 #1)
 PLANAR_EDGES = np.array([1.0, -1.0])  # a 2-D cone's edges along the tangent, as the kernels build them
 
 
@@ -99,17 +102,34 @@ def lemke_motion(problem: Problem) -> tuple[int, int, np.ndarray, np.ndarray, in
     )
 
 
-def exact_newton(problem: Problem, q: np.ndarray, c: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray]:
+def exact_newton(
+    problem: Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0, patience: int = NEWTON_ITERATIONS
+) -> tuple[bool, np.ndarray, np.ndarray]:
     """The exact 3-D laws with the contact modes of a pyramid's motion ``(q, c)``, by the kernel's Newton method
     (the one :func:`solve_split_lcp` runs on Lemke's motion). Returns whether it converged with every mode and
     inequality kept, the twist ``q`` (n,) and forces ``c`` (m, 3).
+
+    ``depth`` [scene velocity]: how far the start lets contacts penetrate and still counts them closed (the
+    artificial variable of a Lemke point that is not a solution, :func:`lemke_depth`); 0 for a motion.
+    ``patience``: Newton iterations without halving the residual after which a mode switch that is due (a
+    normal force turned negative, a penetration, a slip stopped) ends the round, rather than after
+    :data:`NEWTON_ITERATIONS` (the kernel's own Newton): 2 (:data:`QUICK_PATIENCE`) reaches grasp-3d 8 #1's motion
+    from Lemke's ray point and takes 6 #3's in ~15x fewer evaluations of the laws, but misses 8 #0's.
 
     Its C twin runs where the extension was built, with numba or without: about 3x faster than the numba
     kernel called from Python, 25x faster than the kernel as plain Python (grasp-3d 6 #3 and 8 #0-#3, from
     where Lemke's path ended; docs/performance.md)."""
     data = problem.derived("fast", LemkeInputs)
     newton = _newton_compiled if HAVE_EXTENSION else _newton
-    return newton(data.J, data.b, data.mu, data.g, q, c, MODE_SPEED, FRICTION_ALIGNMENT)
+    return newton(data.J, data.b, data.mu, data.g, q, c, depth, patience, MODE_SPEED, FRICTION_ALIGNMENT)
+
+
+def lemke_depth(problem: Problem, q: np.ndarray) -> float:
+    """The artificial variable ``z0`` of a Lemke point that is not a solution (a secondary ray's last point) [scene
+    velocity]: the path solves the laws with every gap rate raised by ``z0``, so the contacts it holds closed
+    penetrate at ``-z0`` and the deepest penetration of the twist ``q`` (n,) is ``z0`` (0 where none does)."""
+    normal_rates = problem.J[:, -1, :] @ q - problem.b[:, -1]
+    return max(0.0, -float(normal_rates.min(initial=0.0)))
 
 
 _NEWTON = NewtonTolerances(CONE_ROUNDOFF, NEWTON_DAMPING, NEWTON_STOP)  # the C kernel's Newton iterations, built once
@@ -195,7 +215,7 @@ def solve_split_lcp(
         if realignments == 0 or realignments == max_realignments or error > 0.5 * previous:
             # First, and whenever re-alignment stalls (a pyramid lets a slip turn within its
             # vertex's fan at no change of force): the exact laws with these contact modes.
-            converged, q_exact, c_exact = _newton(J, b, mu, g, q, c, mode_tol, dissipation_tol)
+            converged, q_exact, c_exact = _newton(J, b, mu, g, q, c, 0.0, NEWTON_ITERATIONS, mode_tol, dissipation_tol)
             if converged:
                 return SOLUTION, 2, q_exact, c_exact, pivots, realignments
             if realignments == max_realignments:
@@ -295,15 +315,33 @@ def split_lcp_points(
 
 
 def _newton_compiled(
-    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, q: np.ndarray, c: np.ndarray, mode_tol: float, tol: float
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    q: np.ndarray,
+    c: np.ndarray,
+    depth: float,
+    patience: int,
+    mode_tol: float,
+    tol: float,
 ) -> tuple[bool, np.ndarray, np.ndarray]:
     """:func:`_newton` in the extension's C, step for step, to the bit (:func:`exact_newton` calls it where it was built)."""
-    return compiled_exact_newton(J, b, mu, g, q, c, mode_tol, tol, _NEWTON)
+    return compiled_exact_newton(J, b, mu, g, q, c, depth, patience, mode_tol, tol, _NEWTON)
 
 
 @njit
 def _newton(
-    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, q: np.ndarray, c: np.ndarray, mode_tol: float, tol: float
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    q: np.ndarray,
+    c: np.ndarray,
+    depth: float,
+    patience: int,
+    mode_tol: float,
+    tol: float,
 ) -> tuple[bool, np.ndarray, np.ndarray]:
     """The exact 3-D laws with fixed contact modes, by damped Newton steps, from the motion ``(q, c)``.
 
@@ -311,9 +349,11 @@ def _newton(
     force of each rolling (frictional) one. Equations: equilibrium; closed
     contacts do not move along their normal; rolling ones do not slip. A
     sliding contact's friction is ``-mu cn slip/|slip|``. The modes start as
-    those of ``q``; a closed contact whose normal force turns negative opens,
+    those of ``q``, a contact closed where its gap rate is within ``depth`` of
+    zero or below (a Lemke point's penetration, :func:`lemke_depth`); a closed contact whose normal force turns negative opens,
     an open one that would penetrate closes and a sliding one that stops rolls,
-    and the equations are solved again (a few times at most). Returns whether
+    and the equations are solved again (a few times at most); such a switch ends
+    a round early once ``patience`` iterations have not halved the residual. Returns whether
     a solution kept every mode and inequality (normal forces >= 0, rolling
     forces in their cones, sliding contacts sliding, open ones apart), and it.
     """
@@ -321,7 +361,7 @@ def _newton(
     kind = np.zeros(m, dtype=np.int64)  # 0 separating, 1 rolling (frictional), 2 sliding or frictionless
     for i in range(m):
         u_n, speed = _contact_speeds(J, b, q, i)
-        if u_n <= mode_tol:
+        if u_n + depth <= mode_tol:
             kind[i] = 1 if mu[i] > 0.0 and speed <= mode_tol else 2
     forces = c.copy()
     for _ in range(8):
@@ -334,7 +374,7 @@ def _newton(
             if kind[i] == 1:
                 x[column[i] + 1] = forces[i, 0]
                 x[column[i] + 2] = forces[i, 1]
-        x, norm, forces = _gauss_newton(J, b, mu, g, x, kind, column, n)
+        x, norm, forces = _gauss_newton(J, b, mu, g, x, kind, column, n, patience, mode_tol)
         q = x[:n].copy()
         changed = False
         for i in range(m):
@@ -377,15 +417,27 @@ def _contact_speeds(J: np.ndarray, b: np.ndarray, q: np.ndarray, i: int) -> tupl
 
 @njit
 def _gauss_newton(
-    J: np.ndarray, b: np.ndarray, mu: np.ndarray, g: np.ndarray, x: np.ndarray, kind: np.ndarray, column: np.ndarray, n: int
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    x: np.ndarray,
+    kind: np.ndarray,
+    column: np.ndarray,
+    n: int,
+    patience: int,
+    mode_tol: float,
 ) -> tuple[np.ndarray, float, np.ndarray]:
-    """Damped Newton (short least-squares steps where singular; step halving) on the fixed-mode laws.
+    """Damped Newton (short least-squares steps where singular; step halving) on the fixed-mode laws, for at most
+    :data:`NEWTON_ITERATIONS` iterations, or until ``patience`` of them have not halved the residual while a mode
+    switch is due (:func:`_switch_due`: these modes cannot hold, so the round ends early).
 
     Returns the point, its largest residual and its contact forces (m, 3).
     """
     residual, jacobian, forces = system(J, b, mu, g, x, kind, column, n)
     norm = np.max(np.abs(residual))
-    for _ in range(50):
+    reference, stalled = norm, 0
+    for _ in range(NEWTON_ITERATIONS):
         if norm <= NEWTON_STOP:
             break
         step = _newton_step(jacobian, residual)
@@ -402,7 +454,25 @@ def _gauss_newton(
             t *= 0.5
         if not improved:
             break
+        if norm <= 0.5 * reference:
+            reference, stalled = norm, 0
+            continue
+        stalled += 1
+        if stalled >= patience and _switch_due(J, b, mu, x[:n], kind, forces, mode_tol):
+            break
     return x, norm, forces
+
+
+@njit
+def _switch_due(J: np.ndarray, b: np.ndarray, mu: np.ndarray, q: np.ndarray, kind: np.ndarray, forces: np.ndarray, mode_tol: float) -> bool:
+    """Whether :func:`_newton` would switch a contact's mode at the twist ``q`` and ``forces`` (its rules after a round)."""
+    for i in range(kind.shape[0]):
+        u_n, speed = _contact_speeds(J, b, q, i)
+        if kind[i] == 0 and u_n < 0.0 or kind[i] > 0 and forces[i, 2] < 0.0:
+            return True
+        if kind[i] == 2 and mu[i] > 0.0 and speed <= mode_tol:
+            return True
+    return False
 
 
 def _newton_step_numpy(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
