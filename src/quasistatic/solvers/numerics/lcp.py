@@ -378,16 +378,11 @@ def _newton(
         q = x[:n].copy()
         changed = False
         for i in range(m):
-            u_n, speed = _contact_speeds(J, b, q, i)
-            if kind[i] == 0 and u_n < 0.0:
-                kind[i] = 1 if mu[i] > 0.0 and speed <= mode_tol else 2
-                changed = True
-            elif kind[i] > 0 and forces[i, 2] < 0.0:
-                kind[i] = 0
-                forces[i, :] = 0.0
-                changed = True
-            elif kind[i] == 2 and mu[i] > 0.0 and speed <= mode_tol:
-                kind[i] = 1
+            switched = _switched_kind(J, b, mu, q, kind, forces, i, mode_tol)
+            if switched >= 0:
+                kind[i] = switched
+                if switched == 0:
+                    forces[i, :] = 0.0
                 changed = True
         if changed:
             continue
@@ -466,13 +461,26 @@ def _gauss_newton(
 @njit
 def _switch_due(J: np.ndarray, b: np.ndarray, mu: np.ndarray, q: np.ndarray, kind: np.ndarray, forces: np.ndarray, mode_tol: float) -> bool:
     """Whether :func:`_newton` would switch a contact's mode at the twist ``q`` and ``forces`` (its rules after a round)."""
-    for i in range(kind.shape[0]):
-        u_n, speed = _contact_speeds(J, b, q, i)
-        if kind[i] == 0 and u_n < 0.0 or kind[i] > 0 and forces[i, 2] < 0.0:
-            return True
-        if kind[i] == 2 and mu[i] > 0.0 and speed <= mode_tol:
-            return True
-    return False
+    due = False
+    for i in range(kind.shape[0]):  # a loop, not any() over a generator: numba compiles it
+        due = due or _switched_kind(J, b, mu, q, kind, forces, i, mode_tol) >= 0
+    return due
+
+
+@njit
+def _switched_kind(
+    J: np.ndarray, b: np.ndarray, mu: np.ndarray, q: np.ndarray, kind: np.ndarray, forces: np.ndarray, i: int, mode_tol: float
+) -> int:
+    """Contact ``i``'s mode after a Newton round at ``q`` and ``forces`` where it must switch, else -1: an open one
+    that would penetrate closes, a closed one pulling (normal force < 0) opens, a sliding one that stopped rolls."""
+    u_n, speed = _contact_speeds(J, b, q, i)
+    if kind[i] == 0 and u_n < 0.0:
+        return 1 if mu[i] > 0.0 and speed <= mode_tol else 2
+    if kind[i] > 0 and forces[i, 2] < 0.0:
+        return 0
+    if kind[i] == 2 and mu[i] > 0.0 and speed <= mode_tol:
+        return 1
+    return -1
 
 
 def _newton_step_numpy(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
