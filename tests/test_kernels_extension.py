@@ -12,11 +12,14 @@ reference is the compiled numba kernel, so these tests need numba.
 
 from __future__ import annotations
 
+import importlib
 import os
 import subprocess
 import sys
 import textwrap
 from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -29,7 +32,9 @@ from quasistatic.check import audit
 from quasistatic.solvers import lp
 from quasistatic.tolerances import FORCE_RANK, JACOBI_ORTHOGONAL, MODE_SPEED, MOTION_RANK, ZERO
 from quasistatic.tools.bench.families import FAMILIES, grasp_3d
+from random_scenes import random_scene
 
+ROOT = Path(__file__).resolve().parents[1]
 NO_EXTENSION = "QUASISTATIC_NO_EXTENSION"  # set to 1 where an install without a C compiler is intended
 
 needs_kernels = pytest.mark.skipif(not compiled.HAVE_KERNELS, reason=f"built without the C extensions ({NO_EXTENSION} set)")
@@ -340,3 +345,66 @@ def test_drop_roundoff_refuses_arrays_it_cannot_fill() -> None:
         compiled.drop_roundoff(np.zeros((2, 3)), np.zeros(2))
     with pytest.raises(ValueError, match="values must be a C-contiguous, writable float64"):
         compiled.drop_roundoff(np.zeros((3, 2)).T, np.zeros(3))
+
+
+# --------------------------------------------------------------------------- assembly
+
+
+def _assembly_scenes() -> Iterator[qs.Scene]:
+    """Every family at a few sizes (piles: contacts between free bodies), random planar and spatial scenes (movers
+    that turn), a robot-driven fingertip, and coincident points (the scales' rule for a scene of no extent)."""
+    for family in FAMILIES.values():
+        for size in (*family.quick_sizes, *family.full_sizes)[:3]:
+            if size <= 100:
+                yield family.make(size, 1)
+    for seed in range(40):
+        yield random_scene(2, seed)
+        yield random_scene(3, seed)
+    yield qs.load_scene(ROOT / "examples" / "robot_tip.yaml")
+    for com in ([0.3, -0.2, 0.5], [0.0, 0.0, 0.0]):
+        box = qs.Body("box", mass=1.0, com=com)
+        yield qs.Scene([box], [qs.Contact("box", "table", com, [0.0, 0.0, 1.0], mu=0.5)], [qs.Mover("table")])
+
+
+@needs_kernels
+def test_assembly_in_c_gives_the_numpy_twins_bits(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``assemble`` runs the C kernel, and its problem is ``assemble_numpy``'s to the bit: the laws and the scales."""
+    assembly = importlib.import_module("quasistatic.laws.assemble")
+    calls = []
+
+    def spy(*args: Any) -> Any:
+        calls.append(len(args[0]))
+        return compiled.assemble_scene(*args)
+
+    monkeypatch.setattr(assembly, "compiled_assemble", spy)
+    scenes = list(_assembly_scenes())
+    for scene in scenes:
+        got, want = assembly.assemble(scene), assembly.assemble_numpy(scene)
+        laws = ("frames", "J", "b", "g", "mu")
+        _assert_same_bits(tuple(getattr(got, name) for name in laws), tuple(getattr(want, name) for name in laws))
+        np.testing.assert_array_equal(got.scales.origin, want.scales.origin)
+        assert (got.scales.length, got.scales.force, got.scales.velocity) == (want.scales.length, want.scales.force, want.scales.velocity)
+        for name in ("frames", "J", "b", "g"):  # -0.0 where the twin has -0.0
+            assert np.array_equal(np.signbit(getattr(got, name)), np.signbit(getattr(want, name))), name
+    assert len(calls) == len(scenes)
+    assert scenes[-1].contacts and assembly.assemble(scenes[-1]).scales.length == 1.0  # all at the origin
+    assert assembly.assemble(scenes[-2]).scales.length == 0.5  # all at one point: its largest coordinate
+
+
+@needs_kernels
+def test_assembly_kernel_refuses_what_it_cannot_read() -> None:
+    """Bad shapes and body indices outside the bodies raise ValueError; nothing is read or written out of bounds."""
+    m, d, k = 2, 3, 6
+    normals, points, coms = np.tile([0.0, 0.0, 1.0], (m, 1)), np.zeros((m, d)), np.zeros((1, d))
+    owners, others = np.zeros(m, dtype=np.int64), np.full(m, -1, dtype=np.int64)
+    movers = (np.zeros((m, k)), np.zeros((m, d)), np.zeros((m, d)), np.zeros((m, d)))
+    loads = (np.zeros((1, k)), np.ones(1), np.array([0.0, 0.0, -9.81]))
+    compiled.assemble_scene(normals, points, coms, owners, others, *movers, *loads, 1e-150)  # well formed
+    with pytest.raises(ValueError, match="outside 0..0"):
+        compiled.assemble_scene(normals, points, coms, np.array([0, 1]), others, *movers, *loads, 1e-150)
+    with pytest.raises(ValueError, match="outside 0..0"):
+        compiled.assemble_scene(normals, points, coms, owners, np.array([-1, -2]), *movers, *loads, 1e-150)
+    with pytest.raises(ValueError, match="points must have 2 dimensions"):
+        compiled.assemble_scene(normals, np.zeros((m + 1, d)), coms, owners, others, *movers, *loads, 1e-150)
+    with pytest.raises(ValueError, match="m >= 1"):
+        compiled.assemble_scene(np.zeros((0, d)), points[:0], coms, owners[:0], others[:0], *(a[:0] for a in movers), *loads, 1e-150)

@@ -16,6 +16,11 @@
  *       laws/motion.py::_to_world_kernel: physical twists T (bodies, k) and world forces (m, d), filled.
  *   drop_roundoff(values, roundoff) -> None
  *       check/motion.py::_drop_roundoff: values (rows, c) within roundoff (c,) of zero set to 0, in place.
+ *   assemble_scene(normals, points, coms, owners, others, twists, origins, places, driven, wrenches, masses,
+ *                  gravity, smallest_length, frames, J, b, g_and_scales) -> None
+ *       laws/assemble.py::assemble_numpy from the scene's numbers: the movers' point velocities, the scales
+ *       (model/scales.py), each contact's frame, rows of J and b, and the loads g; frames, J (zeros on
+ *       entry), b and g_and_scales (g, then the origin, length, force and velocity) are filled.
  *
  * The Python C API and buffers only (every array C-contiguous, no numpy headers), so setuptools
  * alone builds it; quasistatic/compiled.py wraps it. Shapes and indices are checked
@@ -566,6 +571,199 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- assembly */
+
+static inline void cross3(const double *a, const double *b, double *out) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* A scene's numbers as model/kinematics.py::mover_parts and laws/assemble.py gather them (row-major). */
+typedef struct {
+    Py_ssize_t m, d, k, bodies;
+    const double *normals, *points, *coms, *twists, *origins, *places, *driven, *wrenches, *masses, *gravity;
+    const int64_t *owners, *others;
+    double smallest_length;
+} SceneNumbers;
+
+/* model/kinematics.py::mover_point_velocities for contact i: driven + v + omega x (place - origin). */
+static void mover_velocity(const SceneNumbers *S, Py_ssize_t i, double *out) {
+    const Py_ssize_t d = S->d;
+    const double *twist = S->twists + i * S->k, *place = S->places + i * d, *origin = S->origins + i * d, *driven = S->driven + i * d;
+    double r[3], spin[3];
+    for (Py_ssize_t j = 0; j < d; j++) r[j] = place[j] - origin[j];
+    if (d == 2) { /* omega (-r_y, r_x), as the numpy twin multiplies it */
+        spin[0] = twist[2] * r[1] * -1.0;
+        spin[1] = twist[2] * r[0] * 1.0;
+    } else {
+        cross3(twist + 3, r, spin);
+    }
+    for (Py_ssize_t j = 0; j < d; j++) out[j] = driven[j] + twist[j] + spin[j];
+}
+
+/* Body a's load (k,): model/scales.py::_loads, the wrench plus mass times gravity. */
+static void body_load(const SceneNumbers *S, Py_ssize_t a, double *load) {
+    for (Py_ssize_t j = 0; j < S->k; j++) load[j] = S->wrenches[a * S->k + j];
+    for (Py_ssize_t j = 0; j < S->d; j++) load[j] += S->masses[a] * S->gravity[j];
+}
+
+static double square_sum(const double *v, Py_ssize_t n) {
+    double total = v[0] * v[0];
+    for (Py_ssize_t j = 1; j < n; j++) total += v[j] * v[j];
+    return total;
+}
+
+/* model/scales.py::scene_scales: origin (d,), then length, force, velocity, in `out` (d + 3,); each sum in
+ * order, as NumPy adds along these axes. `velocities` (m, d) are the movers' point velocities. */
+static void scene_scales(const SceneNumbers *S, const double *velocities, double *out) {
+    const Py_ssize_t d = S->d, count = S->m + S->bodies;
+    double *origin = out, place[3], load[6];
+    for (Py_ssize_t j = 0; j < d; j++) origin[j] = S->points[j];
+    for (Py_ssize_t p = 1; p < count; p++)
+        for (Py_ssize_t j = 0; j < d; j++) origin[j] += p < S->m ? S->points[p * d + j] : S->coms[(p - S->m) * d + j];
+    for (Py_ssize_t j = 0; j < d; j++) origin[j] /= (double)count;
+    double widest = 0.0, largest = 0.0;
+    for (Py_ssize_t p = 0; p < count; p++) {
+        const double *x = p < S->m ? S->points + p * d : S->coms + (p - S->m) * d;
+        for (Py_ssize_t j = 0; j < d; j++) place[j] = x[j] - origin[j];
+        widest = greater(widest, square_sum(place, d));
+        for (Py_ssize_t j = 0; j < d; j++) largest = greater(largest, fabs(x[j]));
+    }
+    double length = sqrt(widest);
+    if (length == 0.0) /* every point coincides: only their distance from the world origin sets a size */
+        length = S->smallest_length <= largest && largest <= 1.0 / S->smallest_length ? largest : 1.0;
+    double force = 0.0, torque = 0.0, speed = 0.0;
+    for (Py_ssize_t a = 0; a < S->bodies; a++) {
+        body_load(S, a, load);
+        force = greater(force, sqrt(square_sum(load, d)));
+        torque = greater(torque, sqrt(square_sum(load + d, S->k - d)));
+    }
+    force = greater(force, torque / length);
+    for (Py_ssize_t i = 0; i < S->m; i++) speed = greater(speed, square_sum(velocities + i * d, d));
+    const double velocity = sqrt(speed);
+    out[d] = length, out[d + 1] = force == 0.0 ? 1.0 : force, out[d + 2] = velocity == 0.0 ? 1.0 : velocity;
+}
+
+/* model/kinematics.py::contact_frames for one normal n (d = 2 or 3): rows t (t1, t2), then n. */
+static void contact_frame(const double *n, Py_ssize_t d, double *frame) {
+    if (d == 2) {
+        frame[0] = n[1], frame[1] = -n[0], frame[2] = n[0], frame[3] = n[1];
+        return;
+    }
+    int axis = 0; /* np.argmin(|n|): the first of equal smallest entries */
+    for (int j = 1; j < 3; j++)
+        if (fabs(n[j]) < fabs(n[axis])) axis = j;
+    const double e[3] = {axis == 0 ? 1.0 : 0.0, axis == 1 ? 1.0 : 0.0, axis == 2 ? 1.0 : 0.0};
+    double t1[3];
+    cross3(n, e, t1);
+    const double norm = sqrt(square_sum(t1, 3));
+    for (int j = 0; j < 3; j++) frame[j] = t1[j] / norm;
+    cross3(n, frame, frame + 3);
+    for (int j = 0; j < 3; j++) frame[6 + j] = n[j];
+}
+
+/* laws/assemble.py::_twist_rows for one contact: each frame row's velocity per unit twist of a body whose
+ * com is `arm` away from the point, added into its block `J` of the contact's rows (negated for the other body). */
+static void add_twist_rows(const double *frame, const double *arm, Py_ssize_t d, int negate, double *J, Py_ssize_t width) {
+    const Py_ssize_t k = d == 2 ? 3 : 6;
+    for (Py_ssize_t s = 0; s < d; s++) {
+        const double *f = frame + s * d;
+        double row[6];
+        for (Py_ssize_t j = 0; j < d; j++) row[j] = f[j];
+        if (d == 2) row[2] = arm[0] * f[1] - arm[1] * f[0];
+        else cross3(arm, f, row + 3);
+        for (Py_ssize_t j = 0; j < k; j++) J[s * width + j] += negate ? -row[j] : row[j];
+    }
+}
+
+/* laws/assemble.py::assemble_numpy for contact i: its frame, rows of J and b, in the scales' units. */
+static void contact_laws(const SceneNumbers *S, Py_ssize_t i, const double *scales, const double *velocity, double *frame, double *J,
+                         double *b) {
+    const Py_ssize_t d = S->d, width = S->k * S->bodies;
+    const double *origin = scales, length = scales[d];
+    double point[3], arm[3];
+    contact_frame(S->normals + i * d, d, frame);
+    for (Py_ssize_t j = 0; j < d; j++) point[j] = (S->points[i * d + j] - origin[j]) / length;
+    const int64_t partners[2] = {S->owners[i], S->others[i]};
+    for (int side = 0; side < 2 && partners[side] >= 0; side++) { /* the other free body's motion counts against */
+        for (Py_ssize_t j = 0; j < d; j++) arm[j] = point[j] - (S->coms[partners[side] * d + j] - origin[j]) / length;
+        add_twist_rows(frame, arm, d, side, J + partners[side] * S->k, width);
+    }
+    for (Py_ssize_t s = 0; s < d; s++) { /* the mover's point velocity in the frame, summed in order */
+        double total = frame[s * d] * velocity[0];
+        for (Py_ssize_t j = 1; j < d; j++) total += frame[s * d + j] * velocity[j];
+        b[s] = total / scales[d + 2];
+    }
+}
+
+static PyObject *assemble_scene(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 17) {
+        PyErr_SetString(PyExc_TypeError,
+                        "assemble_scene(normals, points, coms, owners, others, twists, origins, places, driven, wrenches, masses, "
+                        "gravity, smallest_length, frames, J, b, g_and_scales) takes 17 arguments");
+        return NULL;
+    }
+    SceneNumbers S = {0};
+    if (take_floats(args[12], &S.smallest_length, "smallest_length") < 0) return NULL;
+    Buffers b = {.taken = 0};
+    Py_ssize_t normals[2] = {-1, -1};
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "normals", FLOATS, 0, 2, normals) < 0) goto done;
+    S.m = normals[0], S.d = normals[1], S.k = S.d == 2 ? 3 : 6;
+    if ((S.d != 2 && S.d != 3) || S.m == 0) {
+        PyErr_SetString(PyExc_ValueError, "normals must be (m, 2) or (m, 3) with m >= 1");
+        goto done;
+    }
+    const Py_ssize_t m = S.m, d = S.d, k = S.k;
+    Py_ssize_t points[2] = {m, d}, coms[2] = {-1, d}, owners[1] = {m}, others[1] = {m}, twists[2] = {m, k}, origins[2] = {m, d};
+    Py_ssize_t places[2] = {m, d}, driven[2] = {m, d};
+    if (take_next(&b, args[1], "points", FLOATS, 0, 2, points) < 0 || take_next(&b, args[2], "coms", FLOATS, 0, 2, coms) < 0 ||
+        take_next(&b, args[3], "owners", INTEGERS, 0, 1, owners) < 0 || take_next(&b, args[4], "others", INTEGERS, 0, 1, others) < 0 ||
+        take_next(&b, args[5], "twists", FLOATS, 0, 2, twists) < 0 || take_next(&b, args[6], "origins", FLOATS, 0, 2, origins) < 0 ||
+        take_next(&b, args[7], "places", FLOATS, 0, 2, places) < 0 || take_next(&b, args[8], "driven", FLOATS, 0, 2, driven) < 0)
+        goto done;
+    S.bodies = coms[0];
+    Py_ssize_t wrenches[2] = {S.bodies, k}, masses[1] = {S.bodies}, gravity[1] = {d};
+    Py_ssize_t frames[3] = {m, d, d}, J[3] = {m, d, k * S.bodies}, bv[2] = {m, d}, out[1] = {S.bodies * k + d + 3};
+    if (take_next(&b, args[9], "wrenches", FLOATS, 0, 2, wrenches) < 0 || take_next(&b, args[10], "masses", FLOATS, 0, 1, masses) < 0 ||
+        take_next(&b, args[11], "gravity", FLOATS, 0, 1, gravity) < 0 || take_next(&b, args[13], "frames", FLOATS, 1, 3, frames) < 0 ||
+        take_next(&b, args[14], "J", FLOATS, 1, 3, J) < 0 || take_next(&b, args[15], "b", FLOATS, 1, 2, bv) < 0 ||
+        take_next(&b, args[16], "g_and_scales", FLOATS, 1, 1, out) < 0)
+        goto done;
+    S.normals = b.views[0].buf, S.points = b.views[1].buf, S.coms = b.views[2].buf, S.owners = b.views[3].buf, S.others = b.views[4].buf;
+    S.twists = b.views[5].buf, S.origins = b.views[6].buf, S.places = b.views[7].buf, S.driven = b.views[8].buf;
+    S.wrenches = b.views[9].buf, S.masses = b.views[10].buf, S.gravity = b.views[11].buf;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        if (S.owners[i] < 0 || S.owners[i] >= S.bodies || S.others[i] < -1 || S.others[i] >= S.bodies) {
+            PyErr_Format(PyExc_ValueError, "contact %zd names body %lld or other %lld outside 0..%zd", i, (long long)S.owners[i],
+                         (long long)S.others[i], S.bodies - 1);
+            goto done;
+        }
+    }
+    double *velocities = PyMem_Malloc((size_t)(m * d) * sizeof(double));
+    if (velocities == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    double *frame = b.views[12].buf, *Jv = b.views[13].buf, *bo = b.views[14].buf, *g = b.views[15].buf, *scales = g + S.bodies * k;
+    for (Py_ssize_t i = 0; i < m; i++) mover_velocity(&S, i, velocities + i * d);
+    scene_scales(&S, velocities, scales);
+    const double length = scales[d], force = scales[d + 1];
+    for (Py_ssize_t i = 0; i < m; i++)
+        contact_laws(&S, i, scales, velocities + i * d, frame + i * d * d, Jv + i * d * k * S.bodies, bo + i * d);
+    for (Py_ssize_t a = 0; a < S.bodies; a++) { /* laws/assemble.py: each load over the wrench units F, then F L */
+        body_load(&S, a, g + a * k);
+        for (Py_ssize_t j = 0; j < k; j++) g[a * k + j] /= j < d ? force : force * length;
+    }
+    PyMem_Free(velocities);
+    result = Py_NewRef(Py_None);
+done:
+    release(&b);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"audit_laws", (PyCFunction)(void (*)(void))audit_laws, METH_FASTCALL,
      "audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed, sums, u, slips, normal):\n"
@@ -581,6 +779,11 @@ static PyMethodDef methods[] = {
     {"drop_roundoff", (PyCFunction)(void (*)(void))drop_roundoff, METH_FASTCALL,
      "drop_roundoff(values, roundoff): entries of values (rows, c) within roundoff[j] of zero set to 0, in place.\n"
      "See quasistatic.check.motion."},
+    {"assemble_scene", (PyCFunction)(void (*)(void))assemble_scene, METH_FASTCALL,
+     "assemble_scene(normals, points, coms, owners, others, twists, origins, places, driven, wrenches, masses, gravity,\n"
+     "smallest_length, frames, J, b, g_and_scales): a scene's scales and contact laws, the numpy assembly's arithmetic;\n"
+     "fills frames (m, d, d), J (m, d, k bodies; zeros on entry), b (m, d), g_and_scales (k bodies + d + 3,).\n"
+     "See quasistatic.laws.assemble."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -8,7 +8,8 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``HAVE_KERNELS`` whether ``_kernels`` was (:func:`audit_laws`, the audit's
 ``check/audit.py::_laws_2d`` / ``_laws_3d``; :func:`analyse_frictionless`,
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
-``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``). Each wrapper takes its kernel's arguments, makes
+``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`assemble_scene`,
+``laws/assemble.py::assemble_numpy``). Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
 kernels' choices in the kernels' order of arithmetic. ``_lemke`` also runs the fast path's whole kernel
 (:func:`solve_split_lcp`), and ``LEMKE_ADDRESS`` is where its Lemke's method starts as a plain C function on raw
@@ -55,6 +56,7 @@ __all__ = [
     "analyse_frictionless",
     "to_world",
     "drop_roundoff",
+    "assemble_scene",
 ]
 
 HAVE_EXTENSION = extension is not None
@@ -307,3 +309,42 @@ def drop_roundoff(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray:
     """
     kernels.drop_roundoff(values, np.ascontiguousarray(roundoff, np.float64))
     return values
+
+
+def assemble_scene(
+    normals: np.ndarray,
+    points: np.ndarray,
+    coms: np.ndarray,
+    owners: np.ndarray,
+    others: np.ndarray,
+    twists: np.ndarray,
+    origins: np.ndarray,
+    places: np.ndarray,
+    driven: np.ndarray,
+    wrenches: np.ndarray,
+    masses: np.ndarray,
+    gravity: np.ndarray,
+    smallest_length: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, tuple[float, float, float]]:
+    """A scene's contact laws in C, as ``laws/assemble.py::assemble_numpy`` computes them from its numbers: frames
+    (m, d, d), ``J`` (m, d, k bodies), ``b`` (m, d), ``g`` (k bodies,), the scales' origin (d,) and their length,
+    force and velocity.
+
+    The contacts' ``normals``, ``points`` (m, d), ``owners`` and ``others`` (their bodies' indices; -1 for a
+    mover), the movers' parts (``model/kinematics.py::mover_parts``), the bodies' ``coms`` (bodies, d), ``wrenches``
+    (bodies, k) and ``masses``, ``gravity`` (d,), and the least length the scales take for coincident points.
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree, there is no contact, or a contact's body index is outside the bodies.
+    """
+    m, d = normals.shape
+    k, bodies = (3 if d == 2 else 6), len(coms)
+    frames, J, b, out = np.empty((m, d, d)), np.zeros((m, d, k * bodies)), np.empty((m, d)), np.empty(k * bodies + d + 3)
+    floats = [np.ascontiguousarray(a, np.float64) for a in (normals, points, coms)]
+    indices = [np.ascontiguousarray(a, np.int64) for a in (owners, others)]
+    rest = [np.ascontiguousarray(a, np.float64) for a in (twists, origins, places, driven, wrenches, masses, gravity)]
+    kernels.assemble_scene(*floats, *indices, *rest, smallest_length, frames, J, b, out)
+    g, scales = out[: k * bodies], out[k * bodies :]
+    return frames, J, b, g, scales[:d].copy(), (float(scales[d]), float(scales[d + 1]), float(scales[d + 2]))

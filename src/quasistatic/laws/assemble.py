@@ -14,8 +14,11 @@ from typing import Any, TypeVar, cast
 
 import numpy as np
 
+from ..compiled import HAVE_KERNELS
+from ..compiled import assemble_scene as compiled_assemble
 from ..model import FloatArray, FrictionModel, Scales, Scene, scene_scales
-from ..model.kinematics import contact_frames, cross, mover_point_velocities
+from ..model.kinematics import contact_frames, cross, mover_parts, mover_point_velocities
+from ..tolerances import SMALLEST_LENGTH
 
 __all__ = ["Problem", "assemble"]
 
@@ -117,7 +120,33 @@ class Problem:
 
 
 def assemble(scene: Scene) -> Problem:
-    """Build the scene-relative matrices of the contact laws (all contacts at once)."""
+    """Build the scene-relative matrices of the contact laws (all contacts at once).
+
+    In the extension's C where it was built (one call for what costs two dozen small numpy calls on a few
+    contacts), else by :func:`assemble_numpy`: the same arithmetic in the same order, so the same bits.
+    """
+    if not (HAVE_KERNELS and scene.contacts):
+        return assemble_numpy(scene)
+    dim, k = scene.dimension, scene.twist_size
+    contacts, bodies = scene.contacts, scene.bodies
+    m, n_bodies = len(contacts), len(bodies)
+    index = {body.name: i for i, body in enumerate(bodies)}
+    normals = np.array([c.normal for c in contacts], dtype=float).reshape(m, dim)
+    points = np.array([c.point for c in contacts], dtype=float).reshape(m, dim)
+    coms = np.array([body.com for body in bodies], dtype=float).reshape(n_bodies, dim)
+    owners = np.array([index[c.body] for c in contacts], dtype=np.int64)
+    others = np.array([index.get(c.other, -1) for c in contacts], dtype=np.int64)  # -1: a mover
+    wrenches = np.array([body.wrench for body in bodies], dtype=float).reshape(n_bodies, k)  # a Scene fills every wrench
+    masses = np.array([body.mass for body in bodies], dtype=float)
+    laws = compiled_assemble(normals, points, coms, owners, others, *mover_parts(scene), wrenches, masses, scene.gravity, SMALLEST_LENGTH)
+    frames, J, b, g, origin, (length, force, velocity) = laws
+    origin.setflags(write=False)
+    scales = Scales(length=length, force=force, velocity=velocity, origin=origin)
+    return Problem(scene, frames, J, b, g, _friction_coefficients(scene), scene.friction, scales)
+
+
+def assemble_numpy(scene: Scene) -> Problem:
+    """:func:`assemble` in numpy (the C kernel's twin, and what runs where the extension was not built)."""
     dim, k = scene.dimension, scene.twist_size
     movers = mover_point_velocities(scene)
     scales = scene_scales(scene, movers)
@@ -135,10 +164,15 @@ def assemble(scene: Scene) -> Problem:
     pair = other >= 0  # a contact between two free bodies: the other body's motion counts against
     if n_bodies > 1 and pair.any():  # (one free body touches only movers: skip four empty numpy calls)
         _add_blocks(J, rows[pair], other[pair], -_twist_rows(frames[pair], points[pair] - coms[other[pair]]), k)
-    b = np.einsum("mst,mt->ms", frames, movers) / V
+    b = frames[:, :, 0] * movers[:, None, 0]  # summed in order (einsum's order depends on its build)
+    for j in range(1, dim):
+        b += frames[:, :, j] * movers[:, None, j]
     g = np.concatenate([scene.load(body) / scales.wrench_units(dim) for body in scene.bodies])
-    mu = np.array([c.mu for c in scene.contacts]) if scene.friction.kind != "none" else np.zeros(m)
-    return Problem(scene, frames, J, b, g, mu, scene.friction, scales)
+    return Problem(scene, frames, J, b / V, g, _friction_coefficients(scene), scene.friction, scales)
+
+
+def _friction_coefficients(scene: Scene) -> FloatArray:
+    return np.array([c.mu for c in scene.contacts]) if scene.friction.kind != "none" else np.zeros(len(scene.contacts))
 
 
 def _twist_rows(frames: FloatArray, arms: FloatArray) -> FloatArray:

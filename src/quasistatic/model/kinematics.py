@@ -11,7 +11,7 @@ import numpy as np
 
 from .scene import Contact, FloatArray, Scene
 
-__all__ = ["contact_frames", "cross", "mover_point_velocity", "mover_point_velocities"]
+__all__ = ["contact_frames", "cross", "mover_parts", "mover_point_velocity", "mover_point_velocities"]
 
 _TURN = np.array([-1.0, 1.0])  # (r_y, r_x) to (-r_y, r_x): a vector turned a quarter turn counter-clockwise
 _TURN.setflags(write=False)
@@ -55,25 +55,33 @@ def mover_point_velocities(scene: Scene) -> FloatArray:
 
     Rigidly moving movers all at once (``v + omega x r``); robot links through their Jacobians.
     """
+    twists, origins, places, driven = mover_parts(scene)
+    r = places - origins
+    if scene.dimension == 2:
+        spin = twists[:, 2:3] * r[:, ::-1] * _TURN  # omega x r in the plane: omega (-r_y, r_x)
+        return driven + twists[:, :2] + spin
+    return driven + twists[:, :3] + cross(twists[:, 3:], r)
+
+
+def mover_parts(scene: Scene) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """What each contact's mover point velocity is made of: the twist (m, k) and origin (m, d) of a rigidly
+    moving mover with the contact point (m, d), and a robot link's point velocity through its Jacobian (m, d);
+    zero rows where they do not apply (a body-body contact has all four zero)."""
     movers = {m.name: m for m in scene.movers}
     d, k = scene.dimension, scene.twist_size
     m = len(scene.contacts)
-    twists, origins, points = np.zeros((m, k)), np.zeros((m, d)), np.zeros((m, d))
-    velocities = np.zeros((m, d))
+    twists, origins, places = np.zeros((m, k)), np.zeros((m, d)), np.zeros((m, d))
+    driven = np.zeros((m, d))
     for i, contact in enumerate(scene.contacts):
         mover = movers.get(contact.other)
         if mover is None:
             continue
         if mover.robot is not None:
-            velocities[i] = mover_point_velocity(scene, contact)
+            driven[i] = mover_point_velocity(scene, contact)
         else:
             assert mover.twist is not None and mover.origin is not None  # filled in by the Scene
-            twists[i], origins[i], points[i] = mover.twist, mover.origin, contact.point
-    r = points - origins
-    if d == 2:
-        spin = twists[:, 2:3] * r[:, ::-1] * _TURN  # omega x r in the plane: omega (-r_y, r_x)
-        return velocities + twists[:, :2] + spin
-    return velocities + twists[:, :3] + cross(twists[:, 3:], r)
+            twists[i], origins[i], places[i] = mover.twist, mover.origin, contact.point
+    return twists, origins, places, driven
 
 
 def cross(a: FloatArray, b: FloatArray) -> FloatArray:
