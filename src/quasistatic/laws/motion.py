@@ -117,9 +117,8 @@ class WorldLayout:
 
     def __init__(self, problem: Problem) -> None:
         scene, scales = problem.scene, problem.scales
-        k, d = scene.twist_size, scene.dimension
         self.names = tuple(b.name for b in scene.bodies)
-        self.units = np.array([scales.velocity] * d + [scales.velocity / scales.length] * (k - d))
+        self.units = scales.twist_units(scene.dimension)
         self.frames = np.ascontiguousarray(problem.frames, dtype=float)
 
 

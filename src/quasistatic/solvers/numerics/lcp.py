@@ -21,6 +21,8 @@ uses the same kernel without edges.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.linalg.lapack import dgesv
 
@@ -72,10 +74,15 @@ class LemkeInputs:
         if problem.dimension == 2:
             self.base = PLANAR_EDGES
         else:
-            count = FAST_EDGES if self.exact else problem.friction.edges
-            self.base = 2.0 * np.pi * np.arange(count) / count
+            self.base = _edge_angles(FAST_EDGES if self.exact else problem.friction.edges).copy()  # (a copy is cheaper than arange)
         self.J, self.b, self.mu, self.g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.mu, problem.g))
-        self.frictional = np.flatnonzero(self.mu > 0.0)
+        self.frictional = (self.mu > 0.0).nonzero()[0]  # (np.flatnonzero's ravel and dispatch cost twice this)
+
+
+@functools.cache
+def _edge_angles(count: int) -> np.ndarray:
+    """The unrotated angles of a ``count``-edge pyramid (kept per count: every fresh problem derives them)."""
+    return 2.0 * np.pi * np.arange(count) / count
 
 
 def lemke_motion(problem: Problem) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
