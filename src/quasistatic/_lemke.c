@@ -34,6 +34,19 @@
 
 enum { SOLUTION = 0, RAY = 1, PIVOT_LIMIT = 2 };
 
+/* Lemke's two N x N loops (a pivot's update of B^-1, the entering column) compiled twice where the toolchain can (GCC
+ * or clang with glibc's ifunc on x86-64): with AVX2, four doubles an instruction, and for any x86-64; the loader picks
+ * the one the machine runs. AVX2 brings no fused multiply-add (that is FMA, not asked for), so every product and sum
+ * is rounded as in the plain build: the same bits, 1.3-1.5x faster kernels on grasp-3d (docs/performance.md). */
+#if defined(__x86_64__) && defined(__GLIBC__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define WIDE_LOOPS __attribute__((target_clones("avx2", "default")))
+#endif
+#endif
+#ifndef WIDE_LOOPS
+#define WIDE_LOOPS
+#endif
+
 /* One run's state: B^-1 column-major (each step below is a loop down contiguous columns,
  * which the compiler vectorizes), the basic values, the entering column, the basis, and
  * the candidate rows of the ratio test with their values. */
@@ -46,7 +59,7 @@ typedef struct {
 
 /* Eliminate the entering column on `row`, in the kernel's arithmetic: the pivot row times the
  * reciprocal of the pivot, then every row minus its factor (the column, 0 on `row`) times it. */
-static void pivot(Lemke *s, int64_t row) {
+WIDE_LOOPS static void pivot(Lemke *s, int64_t row) {
     const Py_ssize_t n = s->n;
     const double scale = 1.0 / s->col[row];
     double *restrict factors = s->col; /* the column is not needed after this pivot */
@@ -65,7 +78,7 @@ static void pivot(Lemke *s, int64_t row) {
 
 /* B^-1 A_e for the entering variable's column A_e of [I, -M, -d]: each entry summed over j in
  * order, as a dot product of a row of B^-1 would be, then negated for -M and -d. */
-static void entering_column(Lemke *s, int64_t entering) {
+WIDE_LOOPS static void entering_column(Lemke *s, int64_t entering) {
     const Py_ssize_t n = s->n;
     double *restrict col = s->col;
     if (entering < n) {
