@@ -34,6 +34,19 @@
 
 enum { SOLUTION = 0, RAY = 1, PIVOT_LIMIT = 2 };
 
+/* Lemke's two N x N loops (a pivot's update of B^-1, the entering column) compiled twice where the toolchain can (GCC
+ * or clang with glibc's ifunc on x86-64): with AVX2, four doubles an instruction, and for any x86-64; the loader picks
+ * the one the machine runs. AVX2 brings no fused multiply-add (that is FMA, not asked for), so every product and sum
+ * is rounded as in the plain build: the same bits, 1.3-1.5x faster kernels on grasp-3d (docs/performance.md). */
+#if defined(__x86_64__) && defined(__GLIBC__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define WIDE_LOOPS __attribute__((target_clones("avx2", "default")))
+#endif
+#endif
+#ifndef WIDE_LOOPS
+#define WIDE_LOOPS
+#endif
+
 /* One run's state: B^-1 column-major (each step below is a loop down contiguous columns,
  * which the compiler vectorizes), the basic values, the entering column, the basis, and
  * the candidate rows of the ratio test with their values. */
@@ -46,7 +59,7 @@ typedef struct {
 
 /* Eliminate the entering column on `row`, in the kernel's arithmetic: the pivot row times the
  * reciprocal of the pivot, then every row minus its factor (the column, 0 on `row`) times it. */
-static void pivot(Lemke *s, int64_t row) {
+WIDE_LOOPS static void pivot(Lemke *s, int64_t row) {
     const Py_ssize_t n = s->n;
     const double scale = 1.0 / s->col[row];
     double *restrict factors = s->col; /* the column is not needed after this pivot */
@@ -65,7 +78,7 @@ static void pivot(Lemke *s, int64_t row) {
 
 /* B^-1 A_e for the entering variable's column A_e of [I, -M, -d]: each entry summed over j in
  * order, as a dot product of a row of B^-1 would be, then negated for -M and -d. */
-static void entering_column(Lemke *s, int64_t entering) {
+WIDE_LOOPS static void entering_column(Lemke *s, int64_t entering) {
     const Py_ssize_t n = s->n;
     double *restrict col = s->col;
     if (entering < n) {
@@ -282,7 +295,8 @@ done:
 enum { SEPARATING = 0, ROLLING = 1, SLIDING = 2 };
 
 /* The laws' arrays (row-major): J (m, d, n), b (m, d), mu (m,), g (n,), x (size,), kind and
- * column (m,); out: residual (size,), jacobian (size, size), forces (m, d). */
+ * column (m,); out: residual (size,), jacobian (size, size), forces (m, d). A NULL jacobian: the residual
+ * and forces alone (the same bits), for the line search's trial points, most of which are rejected. */
 typedef struct {
     Py_ssize_t m, d, n, size;
     const double *J, *b, *mu, *g, *x;
@@ -302,6 +316,7 @@ static void sliding_friction(const Laws *L, Py_ssize_t i, double cn, Py_ssize_t 
     for (Py_ssize_t s = 0; s < t; s++) e[s] = slip[s] / speed;
     const double k = -mu * cn / speed;
     for (Py_ssize_t s = 0; s < t; s++) L->forces[i * L->d + s] = -mu * cn * e[s];
+    if (L->jacobian == NULL) return;
     for (Py_ssize_t j = 0; j < n; j++) {
         for (Py_ssize_t s = 0; s < t; s++) L->jacobian[j * size + col] += Ji[s * n + j] * (-mu * e[s]);
         for (Py_ssize_t k2 = 0; k2 < n; k2++) {
@@ -313,44 +328,47 @@ static void sliding_friction(const Laws *L, Py_ssize_t i, double cn, Py_ssize_t 
     }
 }
 
-/* The numba kernel laws/fixed_modes.py::system, loop for loop. */
+/* The numba kernel laws/fixed_modes.py::system, its arithmetic in its order (a contact's d velocity sums run side by
+ * side, each in the kernel's order). With L->jacobian NULL, the residual and forces only. */
 static void fixed_mode_laws(const Laws *L) {
     const Py_ssize_t m = L->m, d = L->d, n = L->n, size = L->size, t = d - 1;
     for (Py_ssize_t r = 0; r < size; r++) L->residual[r] = 0.0;
-    for (Py_ssize_t r = 0; r < size * size; r++) L->jacobian[r] = 0.0;
+    double *jacobian = L->jacobian;
+    if (jacobian != NULL)
+        for (Py_ssize_t r = 0; r < size * size; r++) jacobian[r] = 0.0;
     for (Py_ssize_t r = 0; r < m * d; r++) L->forces[r] = 0.0;
     for (Py_ssize_t j = 0; j < n; j++) L->residual[j] = L->g[j];
-    double slip[2];
+    double u[3]; /* the contact's velocity: its slip (t entries), then its normal velocity */
     for (Py_ssize_t i = 0; i < m; i++) {
         if (L->kind[i] == SEPARATING) continue;
         const double *Ji = L->J + i * d * n, *bi = L->b + i * d;
         double *fi = L->forces + i * d;
-        for (Py_ssize_t s = 0; s < t; s++) {
-            slip[s] = -bi[s];
-            for (Py_ssize_t j = 0; j < n; j++) slip[s] += Ji[s * n + j] * L->x[j];
-        }
+        for (Py_ssize_t s = 0; s < d; s++) u[s] = -bi[s];
+        for (Py_ssize_t j = 0; j < n; j++)
+            for (Py_ssize_t s = 0; s < d; s++) u[s] += Ji[s * n + j] * L->x[j];
         const Py_ssize_t col = (Py_ssize_t)L->column[i];
         const double cn = L->x[col];
         fi[t] = cn;
         /* Closed: no normal velocity; the normal force enters equilibrium. */
-        L->residual[col] = -bi[t];
-        for (Py_ssize_t j = 0; j < n; j++) {
-            L->residual[col] += Ji[t * n + j] * L->x[j];
-            L->jacobian[col * size + j] = Ji[t * n + j];
-            L->jacobian[j * size + col] += Ji[t * n + j];
-        }
+        L->residual[col] = u[t];
+        if (jacobian != NULL)
+            for (Py_ssize_t j = 0; j < n; j++) {
+                jacobian[col * size + j] = Ji[t * n + j];
+                jacobian[j * size + col] += Ji[t * n + j];
+            }
         if (L->kind[i] == ROLLING) {
             for (Py_ssize_t s = 0; s < t; s++) {
                 const Py_ssize_t row = col + 1 + s;
                 fi[s] = L->x[row];
-                L->residual[row] = slip[s];
-                for (Py_ssize_t j = 0; j < n; j++) {
-                    L->jacobian[row * size + j] = Ji[s * n + j];
-                    L->jacobian[j * size + row] += Ji[s * n + j];
-                }
+                L->residual[row] = u[s];
+                if (jacobian != NULL)
+                    for (Py_ssize_t j = 0; j < n; j++) {
+                        jacobian[row * size + j] = Ji[s * n + j];
+                        jacobian[j * size + row] += Ji[s * n + j];
+                    }
             }
         } else if (L->mu[i] > 0.0) {
-            sliding_friction(L, i, cn, col, slip);
+            sliding_friction(L, i, cn, col, u);
         }
         for (Py_ssize_t j = 0; j < n; j++)
             for (Py_ssize_t s = 0; s < d; s++) L->residual[j] += Ji[s * n + j] * fi[s];
@@ -648,8 +666,11 @@ static void newton_step(Split *s, Py_ssize_t size) {
         gradient[i] = 0.0;
         for (Py_ssize_t k = 0; k < size; k++) {
             gradient[i] -= jac[k * size + i] * res[k];
-            for (Py_ssize_t j = 0; j < size; j++) normal[i * size + j] += jac[k * size + i] * jac[k * size + j];
+            for (Py_ssize_t j = i; j < size; j++) normal[i * size + j] += jac[k * size + i] * jac[k * size + j];
         }
+        /* J^T J is symmetric: row i left of the diagonal is column i above it, summed over k in the same order of
+         * the same products (a b = b a exactly), so copied, not summed again. */
+        for (Py_ssize_t j = 0; j < i; j++) normal[i * size + j] = normal[j * size + i];
         largest = py_max(largest, normal[i * size + i]);
     }
     for (Py_ssize_t i = 0; i < size; i++) normal[i * size + i] += s->newton_damping * (1.0 + largest);
@@ -682,9 +703,10 @@ static double gauss_newton(Split *s, Py_ssize_t size, long long patience) {
         int improved = 0;
         for (int halving = 0; halving < 30; halving++) {
             for (Py_ssize_t i = 0; i < size; i++) s->trial[i] = s->x[i] + t * s->step[i];
-            laws_at(s, size, s->trial, s->r_trial, s->j_trial, s->f_trial);
+            laws_at(s, size, s->trial, s->r_trial, NULL, s->f_trial); /* most trials fail: their Jacobian is not needed */
             const double n_trial = largest_magnitude(size, s->r_trial);
             if (n_trial < norm) {
+                laws_at(s, size, s->trial, s->r_trial, s->j_trial, s->f_trial); /* the same residual, with the Jacobian */
                 double *swap;
                 swap = s->x, s->x = s->trial, s->trial = swap;
                 swap = s->residual, s->residual = s->r_trial, s->r_trial = swap;

@@ -514,8 +514,10 @@ def _newton_step(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
     for i in range(size):
         for k in range(size):
             gradient[i] -= jacobian[k, i] * residual[k]
-            for j in range(size):
+            for j in range(i, size):
                 normal[i, j] += jacobian[k, i] * jacobian[k, j]
+        for j in range(i):  # symmetric: the same products (a b = b a exactly) summed in the same order, so copied
+            normal[i, j] = normal[j, i]
         largest = max(largest, normal[i, i])
     for i in range(size):
         normal[i, i] += NEWTON_DAMPING * (1.0 + largest)
