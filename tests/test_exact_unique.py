@@ -189,3 +189,15 @@ def test_a_benchmark_grasp_is_certified_on_the_exact_cones() -> None:
     solution = qs.solve(grasp_3d(4, 0))
     assert solution.status == "solved" and solution.certified is True, solution.message
     assert solution.modes.count("sliding") == 2
+
+
+def test_a_second_exact_motion_met_by_the_far_part_makes_the_answer_ambiguous() -> None:
+    """Seed 181: the 8-edge pyramid's only motion tips the box about two table corners, but the circles also let
+    it slide flat on all three (the pyramid misses it). The far part's surviving leaf is no motion itself;
+    Newton's method from it with the leaf's modes reaches that one, so the answer lists both, each audited."""
+    solution = qs.solve(random_scene(3, 181))
+    assert solution.status == "ambiguous", solution.message
+    assert len(solution.solutions) == 2 and all(motion.audit.passed for motion in solution.solutions)
+    assert sorted(motion.modes.count("sliding") for motion in solution.solutions) == [1, 4]
+    assert "incomplete" in solution.message
+

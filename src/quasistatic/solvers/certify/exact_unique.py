@@ -28,8 +28,10 @@ its arc as one sector; the mode branch and bound of
 :func:`~.patterns.relaxation_excluded` then excludes every leaf but those
 inside the arcs with the motion's modes (covered above) and those whose rows
 leave the motion's twist alone, halving the sectors of a leaf that survives,
-as the wedge proof does. A surviving leaf whose twist is an exact motion ends
-the proof: a second motion exists.
+as the wedge proof does. A surviving leaf whose twist is an exact motion, or
+from whose twist Newton's method on the fixed-mode laws with the leaf's modes
+reaches one (the relaxation's point is a vertex of its twist rows, seldom a
+motion itself), ends the proof: a second motion exists.
 
 Both parts hold to the tolerances of their LPs (``LP_FEASIBILITY``, which
 the twist box is widened by) and of the branch and bound's checked Farkas
@@ -46,7 +48,7 @@ import numpy as np
 from ...interval import Interval, KrawczykTest, krawczyk, linear_solutions, matmul, point, unit_vectors
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes
 from ...laws.fixed_modes import FixedModeLaws
-from ...tolerances import DISTINCT_TWIST, JACOBIAN_RANK, LP_FEASIBILITY, SAME_TWIST
+from ...tolerances import DISTINCT_TWIST, FIXED_MODE_RESIDUAL, JACOBIAN_RANK, LP_FEASIBILITY, SAME_TWIST
 from ..numerics.highs import optimise_each
 from ..numerics.line_extent import line_axis_extents
 from ..result import Options
@@ -64,6 +66,7 @@ LAST_ARC = 2.0**-24  # the narrowest arc tried before the near part gives up
 NARROWINGS = 2  # Krawczyk's test tried again on a box narrowed by its operator (the first arc then passes on 8 #1)
 FAR_SECTOR = np.pi / 3  # widest sector outside the arcs (narrower than a half-turn; measured against pi/2, pi/4 and pi/6: fastest)
 FINEST_FRACTION = 1.0 / 64  # a sector is not halved below this fraction of the arc
+LEAF_NEWTON_STEPS = 20  # Newton steps from a surviving leaf's twist towards an exact motion with its modes
 FAR_ROUNDS = 8  # most refinements of the sectors (measured on 73 motions: proofs took 1-4, failures ran to 7-16)
 
 
@@ -258,11 +261,43 @@ def _far(
             return Uniqueness(True, rounds=rounds)
         if proof.sectors is None or proof.q is None:
             return Uniqueness(False, reason="the sector relaxation's branch and bound gave no answer", rounds=rounds)
-        if np.max(np.abs(proof.q - q)) > DISTINCT_TWIST and is_motion(proof.q):
-            return Uniqueness(False, other=proof.q, reason="another exact motion exists", rounds=rounds)
+        other = _other_motion(problem, q, proof.sectors, proof.q, is_motion)
+        if other is not None:
+            return Uniqueness(False, other=other, reason="another exact motion exists", rounds=rounds)
         if not split_sectors(sectors, proof.sectors, FINEST_FRACTION * arc):
             return Uniqueness(False, reason="a leaf of the sector relaxation survives at the finest sectors", rounds=rounds)
     return Uniqueness(False, reason=f"out of time or of refinements ({rounds})", rounds=rounds)
+
+
+def _other_motion(
+    problem: Problem, q: np.ndarray, leaf: tuple[int, ...], twist: np.ndarray, is_motion: Callable[[np.ndarray], bool]
+) -> np.ndarray | None:
+    """An exact motion's twist, distinct from ``q``, that a surviving leaf (its modes, a twist of it) holds: its
+    own twist, or where Newton's method from it on the fixed-mode laws with the leaf's modes goes; None if neither
+    is one (``is_motion`` decides; the caller refines and audits what it gets)."""
+    candidates = (twist, _leaf_newton(problem, leaf, twist))
+    for candidate in candidates:
+        if candidate is not None and np.max(np.abs(candidate - q)) > DISTINCT_TWIST and is_motion(candidate):
+            return candidate
+    return None
+
+
+def _leaf_newton(problem: Problem, leaf: tuple[int, ...], twist: np.ndarray) -> np.ndarray | None:
+    """The twist of a zero of the fixed-mode laws with the leaf's modes (a sector: sliding; closed: rolling;
+    separating), by at most :data:`LEAF_NEWTON_STEPS` least-squares Newton steps from ``twist`` with no force;
+    None where the residual does not fall to ``FIXED_MODE_RESIDUAL``."""
+    names = {CLOSED_LEAF: "rolling", SEPARATING_LEAF: "separating"}
+    modes = np.array([names.get(k, "sliding") for k in leaf], dtype=object)
+    laws = FixedModeLaws(problem, ModeMasks.of(problem, modes))
+    x = laws.start(twist, np.zeros((problem.n_contacts, problem.dimension)), nonnegative=False)
+    for _ in range(LEAF_NEWTON_STEPS):
+        residual = laws.residual(x)
+        if not np.all(np.isfinite(residual)):
+            return None
+        if np.max(np.abs(residual), initial=0.0) <= FIXED_MODE_RESIDUAL:
+            return x[: laws.n].copy()
+        x = x - np.linalg.lstsq(laws.jacobian(x), residual, rcond=None)[0]
+    return None
 
 
 def _first_sectors(angle: float, arc: float) -> np.ndarray:
