@@ -201,3 +201,12 @@ def test_a_second_exact_motion_met_by_the_far_part_makes_the_answer_ambiguous() 
     assert sorted(motion.modes.count("sliding") for motion in solution.solutions) == [1, 4]
     assert "incomplete" in solution.message
 
+
+def test_an_arc_that_passes_after_a_wider_one_failed_is_widened_and_then_closes_the_far_part() -> None:
+    """Seed 111 (three sliding contacts, ill-conditioned): the first arc fails Krawczyk's test and the shrunk one
+    (1.4e-4 rad) leaves the far part a leaf next to it in every round; widened towards the arc that failed
+    (7.3e-4) the far part closes, so the answer is certified."""
+    solution = qs.solve(random_scene(3, 111))
+    assert solution.status == "solved" and solution.certified is True, solution.message
+    assert solution.modes.count("sliding") == 3
+    assert "unique for the exact cones" in solution.message

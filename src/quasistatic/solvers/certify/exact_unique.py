@@ -42,6 +42,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -63,6 +64,7 @@ EXACT_UNIQUENESS_PROOF = (
 )
 FIRST_ARC = 2.0**-8  # half-width [rad] of the first arc tried around each sliding contact's slip
 LAST_ARC = 2.0**-24  # the narrowest arc tried before the near part gives up
+WIDENINGS = 4  # bisections towards the last arc that failed, once a narrower one passed (seed 111: 3.5x wider)
 NARROWINGS = 2  # Krawczyk's test tried again on a box narrowed by its operator (the first arc then passes on 8 #1)
 FAR_SECTOR = np.pi / 3  # widest sector outside the arcs (narrower than a half-turn; measured against pi/2, pi/4 and pi/6: fastest)
 FINEST_FRACTION = 1.0 / 64  # a sector is not halved below this fraction of the arc
@@ -105,30 +107,67 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
 
     The box holds one twist when the rows pin it (every contact rolling or separating, say: the forces may
     still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and an arc whose box fails is
-    shrunk by the test's contraction norm (four times it, at least halved) before the next try.
+    shrunk by the test's contraction norm (four times it, at least halved) before the next try. An arc that
+    passes after one that failed is widened towards it (:func:`_widened`): the far part closes sooner, or only,
+    with a wider arc (its relaxation cannot tell slips just outside a narrow arc from the motion's).
     """
     residual = laws.enclosure(point(x))  # never None: the motion's sliding contacts slip
     sigma = np.linalg.svd(laws.jacobian(x), compute_uv=False)
     singular = sigma[-1] <= JACOBIAN_RANK * sigma[0]  # indeterminate forces: no box passes, only pinned twists
-    arc = FIRST_ARC
+
+    def verdict(arc: float) -> _ArcVerdict:
+        return _arc_verdict(problem, laws, masks, x, angles, arc, None if singular or residual is None else residual[0])
+
+    arc, failed = FIRST_ARC, None
     while arc >= LAST_ARC:
-        twist = _twist_box(problem, masks, angles, arc)
-        if twist is not None and np.max(twist[1] - twist[0]) <= DISTINCT_TWIST:
-            return arc  # one twist (the forces need not be unique)
-        if singular or residual is None:
+        tried = verdict(arc)
+        if tried.proven:
+            return arc if failed is None else _widened(verdict, arc, failed)
+        if tried.shrink == 0.0:
             return None
-        box = None if twist is None else _local_box(laws, x, twist, unit_vectors(angles - arc, angles + arc))
-        if box is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
-            arc /= 2.0
-            continue
-        test = _narrowed_krawczyk(laws, x, residual[0], box)
-        if test is None:
-            arc /= 2.0
-            continue
-        if test.unique:
-            return arc
-        arc /= max(2.0, 4.0 * min(test.contraction, 1e6))
+        failed = arc
+        arc /= tried.shrink
     return None
+
+
+class _ArcVerdict(NamedTuple):
+    """Whether an arc's box holds only the motion; if not, how much narrower the next arc should be (0: none passes)."""
+
+    proven: bool
+    shrink: float = 0.0
+
+
+def _arc_verdict(
+    problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.ndarray, angles: np.ndarray, arc: float, residual: Interval | None
+) -> _ArcVerdict:
+    """The near part's test on one arc (see :func:`_near_arc`); ``residual``: the laws' enclosure at the motion,
+    None where the forces are indeterminate (then only pinned twists pass)."""
+    twist = _twist_box(problem, masks, angles, arc)
+    if twist is not None and np.max(twist[1] - twist[0]) <= DISTINCT_TWIST:
+        return _ArcVerdict(True)  # one twist (the forces need not be unique)
+    if residual is None:
+        return _ArcVerdict(False)
+    box = None if twist is None else _local_box(laws, x, twist, unit_vectors(angles - arc, angles + arc))
+    if box is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
+        return _ArcVerdict(False, 2.0)
+    test = _narrowed_krawczyk(laws, x, residual, box)
+    if test is None:
+        return _ArcVerdict(False, 2.0)
+    if test.unique:
+        return _ArcVerdict(True)
+    return _ArcVerdict(False, max(2.0, 4.0 * min(test.contraction, 1e6)))
+
+
+def _widened(verdict: Callable[[float], _ArcVerdict], passed: float, failed: float) -> float:
+    """The widest arc found between one that passed and a wider one that failed, by :data:`WIDENINGS` geometric
+    bisections (Krawczyk's contraction grows with the arc, so the arcs that pass are about those below one)."""
+    for _ in range(WIDENINGS):
+        middle = float(np.sqrt(passed * failed))
+        if verdict(middle).proven:
+            passed = middle
+        else:
+            failed = middle
+    return passed
 
 
 def _narrowed_krawczyk(laws: FixedModeLaws, x: np.ndarray, residual: Interval, box: Interval) -> KrawczykTest | None:
