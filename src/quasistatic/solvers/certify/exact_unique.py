@@ -304,6 +304,7 @@ def _far(
     """
     sectors = [_first_sectors(float(angles[i]), arc) if masks.sliding[i] else _even_sectors() for i in range(problem.n_contacts)]
     wanted = np.where(masks.closed, CLOSED_LEAF, SEPARATING_LEAF)
+    arc_end = [float(first[0]) + 2.0 * arc * (1.0 + 1e-12) for first in sectors]  # the arcs' sectors end there
     excluded: list[np.ndarray] = []  # slip angle bounds (m, 2) of leaves with the motion's modes holding no zero
 
     def bounds(leaf: tuple[int, ...]) -> np.ndarray | None:
@@ -313,11 +314,10 @@ def _far(
         return np.array([sectors[i][k : k + 2] if masks.sliding[i] else (0.0, 0.0) for i, k in enumerate(leaf)])
 
     def covered(leaf: tuple[int, ...]) -> bool:
-        ends = bounds(leaf)
-        if ends is None:
-            return False
-        inside_arcs = all(not masks.sliding[i] or ends[i, 1] <= sectors[i][0] + 2.0 * arc * (1.0 + 1e-12) for i in range(len(leaf)))
-        return inside_arcs or any(np.all((box[:, 0] <= ends[:, 0]) & (ends[:, 1] <= box[:, 1])) for box in excluded)
+        if all(k >= 0 and sectors[i][k + 1] <= arc_end[i] if masks.sliding[i] else k == wanted[i] for i, k in enumerate(leaf)):
+            return True  # inside the arcs, with the motion's modes
+        ends = None if not excluded else bounds(leaf)
+        return ends is not None and any(bool(np.all((box[:, 0] <= ends[:, 0]) & (ends[:, 1] <= box[:, 1]))) for box in excluded)
 
     def exclude(leaf: tuple[int, ...]) -> bool:
         """Whether a surviving leaf with the motion's modes is proven to hold no zero (then passed over)."""
