@@ -213,8 +213,10 @@ def test_an_arc_that_passes_after_a_wider_one_failed_is_widened_and_then_closes_
     assert "unique for the exact cones" in solution.message
 
 
-def _pieces_near_grasp_motion() -> tuple[exact_unique._NearMotion, ModeMasks, np.ndarray]:
-    """Grasp 4 #0's motion for Krawczyk's exclusion of slip pieces, its masks, and its sliding slip angles."""
+@pytest.fixture(scope="module")
+def near_grasp_motion() -> tuple[exact_unique._NearMotion, ModeMasks, np.ndarray]:
+    """Grasp 4 #0's motion for Krawczyk's exclusion of slip pieces, its masks, and its sliding slip angles (solved
+    once for the module)."""
     problem, laws, x = _solved_grasp()
     residual = laws.enclosure(point(x))
     assert residual is not None
@@ -234,11 +236,11 @@ def _pieces_near_grasp_motion() -> tuple[exact_unique._NearMotion, ModeMasks, np
     ],
 )
 def test_krawczyk_excludes_slip_pieces_beside_the_motion_never_one_that_holds_it(
-    offsets: tuple[tuple[float, float], ...], excluded: bool
+    near_grasp_motion: tuple[exact_unique._NearMotion, ModeMasks, np.ndarray], offsets: tuple[tuple[float, float], ...], excluded: bool
 ) -> None:
     """The far part's exclusion of a leaf next to the arcs: a piece of slip angles (offsets from the motion's, at
     grasp 4 #0's two sliding contacts) is excluded only where the fixed-mode laws have no zero in it."""
-    near, masks, angles = _pieces_near_grasp_motion()
+    near, masks, angles = near_grasp_motion
     sliding = np.flatnonzero(masks.sliding)
     assert sliding.size == len(offsets)
     ends = np.zeros((masks.sliding.size, 2))
