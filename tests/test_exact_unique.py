@@ -13,6 +13,7 @@ from quasistatic.laws import ModeMasks, contact_modes
 from quasistatic.laws.fixed_modes import FixedModeLaws
 from quasistatic.solvers import Options
 from quasistatic.solvers.certified import solve_cheap_certified
+from quasistatic.solvers.certify import exact_unique
 from quasistatic.tools.bench.families import grasp_3d
 from random_scenes import random_scene
 
@@ -189,3 +190,70 @@ def test_a_benchmark_grasp_is_certified_on_the_exact_cones() -> None:
     solution = qs.solve(grasp_3d(4, 0))
     assert solution.status == "solved" and solution.certified is True, solution.message
     assert solution.modes.count("sliding") == 2
+
+
+def test_a_second_exact_motion_met_by_the_far_part_makes_the_answer_ambiguous() -> None:
+    """Seed 181: the 8-edge pyramid's only motion tips the box about two table corners, but the circles also let
+    it slide flat on all three (the pyramid misses it). The far part's surviving leaf is no motion itself;
+    Newton's method from it with the leaf's modes reaches that one, so the answer lists both, each audited."""
+    solution = qs.solve(random_scene(3, 181))
+    assert solution.status == "ambiguous", solution.message
+    assert len(solution.solutions) == 2 and all(motion.audit.passed for motion in solution.solutions)
+    assert sorted(motion.modes.count("sliding") for motion in solution.solutions) == [1, 4]
+    assert "incomplete" in solution.message
+
+
+def test_an_arc_that_passes_after_a_wider_one_failed_is_widened_and_then_closes_the_far_part() -> None:
+    """Seed 111 (three sliding contacts, ill-conditioned): the first arc fails Krawczyk's test and the shrunk one
+    (1.4e-4 rad) leaves the far part a leaf next to it in every round; widened towards the arc that failed
+    (7.3e-4) the far part closes, so the answer is certified."""
+    solution = qs.solve(random_scene(3, 111))
+    assert solution.status == "solved" and solution.certified is True, solution.message
+    assert solution.modes.count("sliding") == 3
+    assert "unique for the exact cones" in solution.message
+
+
+@pytest.fixture(scope="module")
+def near_grasp_motion() -> tuple[exact_unique._NearMotion, ModeMasks, np.ndarray]:
+    """Grasp 4 #0's motion for Krawczyk's exclusion of slip pieces, its masks, and its sliding slip angles (solved
+    once for the module)."""
+    problem, laws, x = _solved_grasp()
+    residual = laws.enclosure(point(x))
+    assert residual is not None
+    slips = problem.velocities(x[: laws.n])[:, :2]
+    return exact_unique._NearMotion(problem, laws, x, residual[0]), laws.masks, np.arctan2(slips[:, 1], slips[:, 0])
+
+
+@pytest.mark.parametrize(
+    ("offsets", "excluded"),
+    [
+        (((-1e-3, 1e-3), (-1e-3, 1e-3)), False),  # holds the motion: never excluded
+        (((-1e-2, 1e-2), (-1e-2, 1e-2)), False),
+        (((1e-3, 2e-3), (-1e-3, 1e-3)), True),  # next to it
+        (((-1e-3, 1e-3), (-3e-3, -1e-3)), True),
+        (((1e-2, 3e-2), (1e-2, 3e-2)), True),
+        (((0.3, 0.5), (-1e-3, 1e-3)), True),
+    ],
+)
+def test_krawczyk_excludes_slip_pieces_beside_the_motion_never_one_that_holds_it(
+    near_grasp_motion: tuple[exact_unique._NearMotion, ModeMasks, np.ndarray], offsets: tuple[tuple[float, float], ...], excluded: bool
+) -> None:
+    """The far part's exclusion of a leaf next to the arcs: a piece of slip angles (offsets from the motion's, at
+    grasp 4 #0's two sliding contacts) is excluded only where the fixed-mode laws have no zero in it."""
+    near, masks, angles = near_grasp_motion
+    sliding = np.flatnonzero(masks.sliding)
+    assert sliding.size == len(offsets)
+    ends = np.zeros((masks.sliding.size, 2))
+    for i, (lo, hi) in zip(sliding, offsets, strict=True):
+        ends[i] = angles[i] + lo, angles[i] + hi
+    assert near.excludes(masks, ends) is excluded
+
+
+def test_an_ill_conditioned_sliding_grasp_is_certified_by_excluding_the_leaves_beside_its_arcs() -> None:
+    """Seed 221 (four sliding contacts, one slipping 40 times slower than the others): a leaf next to the arcs
+    survived every halving of the sector relaxation; Krawczyk's operator excludes those, and the answer is
+    certified."""
+    solution = qs.solve(random_scene(3, 221))
+    assert solution.status == "solved" and solution.certified is True, solution.message
+    assert solution.modes.count("sliding") == 4
+    assert "unique for the exact cones" in solution.message

@@ -28,8 +28,21 @@ its arc as one sector; the mode branch and bound of
 :func:`~.patterns.relaxation_excluded` then excludes every leaf but those
 inside the arcs with the motion's modes (covered above) and those whose rows
 leave the motion's twist alone, halving the sectors of a leaf that survives,
-as the wedge proof does. A surviving leaf whose twist is an exact motion ends
-the proof: a second motion exists.
+as the wedge proof does. A surviving leaf whose twist is an exact motion, or
+from whose twist Newton's method on the fixed-mode laws with the leaf's modes
+reaches one (the relaxation's point is a vertex of its twist rows, seldom a
+motion itself), ends the proof: a second motion exists.
+
+Next to the arcs. The relaxation cannot tell slips just outside a narrow arc
+from the motion's: its LPs meet rows to ``LP_FEASIBILITY``, which an
+ill-conditioned grasp turns into more than the arc, so a leaf with the
+motion's modes next to the arc survives every halving. Such a leaf is
+excluded by Krawczyk's operator instead: a box holds every zero of the
+fixed-mode laws with slips in its sectors (twists by its rows, forces by the
+residual bound), is met with the operator centred at its middle (which holds
+every zero of the box) until empty or until its twists miss one of the leaf's
+rows, its sectors halved where that fails; every leaf inside its sectors is
+then passed over.
 
 Both parts hold to the tolerances of their LPs (``LP_FEASIBILITY``, which
 the twist box is widened by) and of the branch and bound's checked Farkas
@@ -40,14 +53,15 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from ...interval import Interval, KrawczykTest, krawczyk, linear_solutions, matmul, point, unit_vectors
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes
 from ...laws.fixed_modes import FixedModeLaws
-from ...tolerances import DISTINCT_TWIST, JACOBIAN_RANK, LP_FEASIBILITY, SAME_TWIST
-from ..numerics.highs import optimise_each
+from ...tolerances import DISTINCT_TWIST, FIXED_MODE_RESIDUAL, JACOBIAN_RANK, LP_FEASIBILITY, SAME_TWIST
+from ..numerics.highs import optimise_each, solve_lp
 from ..numerics.line_extent import line_axis_extents
 from ..result import Options
 from .patterns import CLOSED_LEAF, SEPARATING_LEAF, relaxation_excluded
@@ -61,9 +75,15 @@ EXACT_UNIQUENESS_PROOF = (
 )
 FIRST_ARC = 2.0**-8  # half-width [rad] of the first arc tried around each sliding contact's slip
 LAST_ARC = 2.0**-24  # the narrowest arc tried before the near part gives up
+WIDENINGS = 4  # bisections towards the last arc that failed, once a narrower one passed (seed 111: 3.5x wider)
 NARROWINGS = 2  # Krawczyk's test tried again on a box narrowed by its operator (the first arc then passes on 8 #1)
 FAR_SECTOR = np.pi / 3  # widest sector outside the arcs (narrower than a half-turn; measured against pi/2, pi/4 and pi/6: fastest)
 FINEST_FRACTION = 1.0 / 64  # a sector is not halved below this fraction of the arc
+LEAF_NEWTON_STEPS = 20  # Newton steps from a surviving leaf's twist towards an exact motion with its modes
+EXCLUDED_LEAVES = 12  # leaves next to the arcs excluded by Krawczyk's operator, at most (each: a round again;
+# measured: seeds 28 and 221 take 5 and 8; seed 16 does not close with 64)
+LEAF_PIECES = 8  # pieces a leaf's sectors are cut into, at most, for that exclusion (those that pass take 1-3)
+LEAF_NARROWINGS = 8  # meets of a piece's box with Krawczyk's operator, at most
 FAR_ROUNDS = 8  # most refinements of the sectors (measured on 73 motions: proofs took 1-4, failures ran to 7-16)
 
 
@@ -94,7 +114,9 @@ def prove_unique_exact(problem: Problem, motion: RawMotion, options: Options, is
     arc = _near_arc(problem, laws, masks, x, angles)
     if arc is None:
         return Uniqueness(False, reason="the fixed-mode equations are not proven to have one zero near the motion")
-    return _far(problem, motion.q, masks, angles, arc, options, is_motion)
+    residual = laws.enclosure(point(x))
+    near = None if residual is None else _NearMotion(problem, laws, x, residual[0])
+    return _far(problem, motion.q, masks, angles, arc, options, is_motion, near)
 
 
 def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.ndarray, angles: np.ndarray) -> float | None:
@@ -102,30 +124,67 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
 
     The box holds one twist when the rows pin it (every contact rolling or separating, say: the forces may
     still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and an arc whose box fails is
-    shrunk by the test's contraction norm (four times it, at least halved) before the next try.
+    shrunk by the test's contraction norm (four times it, at least halved) before the next try. An arc that
+    passes after one that failed is widened towards it (:func:`_widened`): the far part closes sooner, or only,
+    with a wider arc (its relaxation cannot tell slips just outside a narrow arc from the motion's).
     """
     residual = laws.enclosure(point(x))  # never None: the motion's sliding contacts slip
     sigma = np.linalg.svd(laws.jacobian(x), compute_uv=False)
     singular = sigma[-1] <= JACOBIAN_RANK * sigma[0]  # indeterminate forces: no box passes, only pinned twists
-    arc = FIRST_ARC
+
+    def verdict(arc: float) -> _ArcVerdict:
+        return _arc_verdict(problem, laws, masks, x, angles, arc, None if singular or residual is None else residual[0])
+
+    arc, failed = FIRST_ARC, None
     while arc >= LAST_ARC:
-        twist = _twist_box(problem, masks, angles, arc)
-        if twist is not None and np.max(twist[1] - twist[0]) <= DISTINCT_TWIST:
-            return arc  # one twist (the forces need not be unique)
-        if singular or residual is None:
+        tried = verdict(arc)
+        if tried.proven:
+            return arc if failed is None else _widened(verdict, arc, failed)
+        if tried.shrink == 0.0:
             return None
-        box = None if twist is None else _local_box(laws, x, twist, unit_vectors(angles - arc, angles + arc))
-        if box is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
-            arc /= 2.0
-            continue
-        test = _narrowed_krawczyk(laws, x, residual[0], box)
-        if test is None:
-            arc /= 2.0
-            continue
-        if test.unique:
-            return arc
-        arc /= max(2.0, 4.0 * min(test.contraction, 1e6))
+        failed = arc
+        arc /= tried.shrink
     return None
+
+
+class _ArcVerdict(NamedTuple):
+    """Whether an arc's box holds only the motion; if not, how much narrower the next arc should be (0: none passes)."""
+
+    proven: bool
+    shrink: float = 0.0
+
+
+def _arc_verdict(
+    problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.ndarray, angles: np.ndarray, arc: float, residual: Interval | None
+) -> _ArcVerdict:
+    """The near part's test on one arc (see :func:`_near_arc`); ``residual``: the laws' enclosure at the motion,
+    None where the forces are indeterminate (then only pinned twists pass)."""
+    twist = _twist_box(problem, masks, _arc_rays(masks, angles, arc))
+    if twist is not None and np.max(twist[1] - twist[0]) <= DISTINCT_TWIST:
+        return _ArcVerdict(True)  # one twist (the forces need not be unique)
+    if residual is None:
+        return _ArcVerdict(False)
+    box = None if twist is None else _local_box(laws, x, twist, unit_vectors(angles - arc, angles + arc))
+    if box is None or not (np.all(box.lo <= x) and np.all(x <= box.hi)):
+        return _ArcVerdict(False, 2.0)
+    test = _narrowed_krawczyk(laws, x, residual, box)
+    if test is None:
+        return _ArcVerdict(False, 2.0)
+    if test.unique:
+        return _ArcVerdict(True)
+    return _ArcVerdict(False, max(2.0, 4.0 * min(test.contraction, 1e6)))
+
+
+def _widened(verdict: Callable[[float], _ArcVerdict], passed: float, failed: float) -> float:
+    """The widest arc found between one that passed and a wider one that failed, by :data:`WIDENINGS` geometric
+    bisections (Krawczyk's contraction grows with the arc, so the arcs that pass are about those below one)."""
+    for _ in range(WIDENINGS):
+        middle = float(np.sqrt(passed * failed))
+        if verdict(middle).proven:
+            passed = middle
+        else:
+            failed = middle
+    return passed
 
 
 def _narrowed_krawczyk(laws: FixedModeLaws, x: np.ndarray, residual: Interval, box: Interval) -> KrawczykTest | None:
@@ -165,10 +224,17 @@ def _extents(A: np.ndarray, lower: np.ndarray, upper: np.ndarray, count: int, co
     return values[:, 0], values[:, 1]
 
 
-def _twist_box(problem: Problem, masks: ModeMasks, angles: np.ndarray, arc: float) -> Extents | None:
-    """Twist extents: closed contacts shut, rolling ones still, separating ones open, sliding slips in their arcs
-    (read off in closed form where the equalities leave a line, else by LPs)."""
-    rays = [(float(a) - arc, float(a) + arc) if sliding else None for a, sliding in zip(angles, masks.sliding, strict=True)]
+Rays = list[tuple[float, float] | None]  # per contact: the angles [rad] its slip lies between, None if it does not slide
+
+
+def _arc_rays(masks: ModeMasks, angles: np.ndarray, arc: float) -> Rays:
+    """Each sliding contact's arc of half-width ``arc`` around its slip angle."""
+    return [(float(a) - arc, float(a) + arc) if sliding else None for a, sliding in zip(angles, masks.sliding, strict=True)]
+
+
+def _twist_box(problem: Problem, masks: ModeMasks, rays: Rays) -> Extents | None:
+    """Twist extents: closed contacts shut, rolling ones still, separating ones open, sliding slips between their
+    rays (read off in closed form where the equalities leave a line, else by LPs)."""
     A, lower, upper = _twist_rows(problem, masks.closed, masks.rolling, rays)
     equal = lower == upper  # every other row is only bounded below
     on_line = line_axis_extents(A[equal], lower[equal], A[~equal], lower[~equal])
@@ -180,9 +246,7 @@ def _twist_box(problem: Problem, masks: ModeMasks, angles: np.ndarray, arc: floa
     return ends.min(axis=0), ends.max(axis=0)
 
 
-def _twist_rows(
-    problem: Problem, shut: np.ndarray, still: np.ndarray, rays: list[tuple[float, float] | None]
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _twist_rows(problem: Problem, shut: np.ndarray, still: np.ndarray, rays: Rays) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Twist rows ``lower <= A q <= upper``: each contact shut (else open), still, or slipping between two rays."""
     rows, lower, upper = [], [], []
     for i in range(problem.n_contacts):
@@ -229,40 +293,169 @@ def _far(
     arc: float,
     options: Options,
     is_motion: Callable[[np.ndarray], bool],
+    near: _NearMotion | None,
 ) -> Uniqueness:
     """Every leaf of the sector relaxation outside the arcs (or with other modes) excluded, refining the sectors.
 
     A node whose twists are all the motion's (its rows pin them: a rolling contact whose force may reach the
-    circle, say) holds no other motion; the branch and bound passes it over (``twist=q``).
+    circle, say) holds no other motion; the branch and bound passes it over (``twist=q``). A surviving leaf with
+    the motion's modes that ``near`` proves holds no zero of the fixed-mode laws (:meth:`_NearMotion.excludes`)
+    is passed over from then on, with every leaf inside its sectors, and the round is run again unrefined.
     """
     sectors = [_first_sectors(float(angles[i]), arc) if masks.sliding[i] else _even_sectors() for i in range(problem.n_contacts)]
     wanted = np.where(masks.closed, CLOSED_LEAF, SEPARATING_LEAF)
+    arc_end = [float(first[0]) + 2.0 * arc * (1.0 + 1e-12) for first in sectors]  # the arcs' sectors end there
+    excluded: list[np.ndarray] = []  # slip angle bounds (m, 2) of leaves with the motion's modes holding no zero
 
-    def near(leaf: tuple[int, ...]) -> bool:
-        for i, k in enumerate(leaf):
-            if masks.sliding[i]:
-                if k < 0 or sectors[i][k + 1] > sectors[i][0] + 2.0 * arc * (1.0 + 1e-12):
-                    return False
-            elif k != wanted[i]:
-                return False
-        return True
+    def bounds(leaf: tuple[int, ...]) -> np.ndarray | None:
+        """The leaf's sectors as angle bounds (m, 2) (zero rows where no contact slides), if it has the motion's modes."""
+        if any(k < 0 if masks.sliding[i] else k != wanted[i] for i, k in enumerate(leaf)):
+            return None
+        return np.array([sectors[i][k : k + 2] if masks.sliding[i] else (0.0, 0.0) for i, k in enumerate(leaf)])
 
-    rounds = 0
+    def covered(leaf: tuple[int, ...]) -> bool:
+        if all(k >= 0 and sectors[i][k + 1] <= arc_end[i] if masks.sliding[i] else k == wanted[i] for i, k in enumerate(leaf)):
+            return True  # inside the arcs, with the motion's modes
+        ends = None if not excluded else bounds(leaf)
+        return ends is not None and any(bool(np.all((box[:, 0] <= ends[:, 0]) & (ends[:, 1] <= box[:, 1]))) for box in excluded)
+
+    def exclude(leaf: tuple[int, ...]) -> bool:
+        """Whether a surviving leaf with the motion's modes is proven to hold no zero (then passed over)."""
+        ends = bounds(leaf)
+        if near is None or ends is None or len(excluded) >= EXCLUDED_LEAVES or options.remaining() <= 0.0:
+            return False
+        if near.excludes(masks, ends):
+            excluded.append(ends)
+            return True
+        return False
+
+    rounds = refinements = 0
     farkas: tuple[np.ndarray, ...] = ()  # the last round's, tried first on the next
-    while options.remaining() > 0.0 and rounds < FAR_ROUNDS:
+    while options.remaining() > 0.0 and refinements < FAR_ROUNDS:
         rounds += 1
-        proof = relaxation_excluded(problem, sectors, options.remaining, near, twist=q, farkas=farkas)
+        proof = relaxation_excluded(problem, sectors, options.remaining, covered, twist=q, farkas=farkas)
         farkas = proof.farkas
         options.report(1, proof.nodes)  # a long proof shows on the CLI's status line
         if proof.excluded:
             return Uniqueness(True, rounds=rounds)
         if proof.sectors is None or proof.q is None:
             return Uniqueness(False, reason="the sector relaxation's branch and bound gave no answer", rounds=rounds)
-        if np.max(np.abs(proof.q - q)) > DISTINCT_TWIST and is_motion(proof.q):
-            return Uniqueness(False, other=proof.q, reason="another exact motion exists", rounds=rounds)
+        other = _other_motion(problem, q, proof.sectors, proof.q, is_motion)
+        if other is not None:
+            return Uniqueness(False, other=other, reason="another exact motion exists", rounds=rounds)
+        if exclude(proof.sectors):
+            continue  # the same sectors again, this leaf passed over
+        refinements += 1
         if not split_sectors(sectors, proof.sectors, FINEST_FRACTION * arc):
             return Uniqueness(False, reason="a leaf of the sector relaxation survives at the finest sectors", rounds=rounds)
-    return Uniqueness(False, reason=f"out of time or of refinements ({rounds})", rounds=rounds)
+    return Uniqueness(False, reason=f"out of time or of refinements ({refinements})", rounds=rounds)
+
+
+@dataclass(frozen=True)
+class _NearMotion:
+    """The motion ``x`` in the fixed-mode unknowns of ``laws`` (its modes) and the laws' enclosure there, for
+    Krawczyk's exclusion of leaves next to the arcs (:meth:`excludes`)."""
+
+    problem: Problem
+    laws: FixedModeLaws
+    x: np.ndarray
+    residual: Interval
+
+    def excludes(self, masks: ModeMasks, ends: np.ndarray) -> bool:
+        """Whether no zero of the fixed-mode laws other than the motion has its sliding contacts' slips within
+        ``ends`` (m, 2) [rad]. The sectors are cut in halves (the widest first) where a piece's test fails,
+        :data:`LEAF_PIECES` pieces at most; each piece's test is :meth:`_piece_excluded`."""
+        pieces, tried = [ends], 0
+        while pieces:
+            piece = pieces.pop()
+            tried += 1
+            if tried > LEAF_PIECES:
+                return False
+            if self._piece_excluded(masks, piece):
+                continue
+            widths = np.where(masks.sliding, piece[:, 1] - piece[:, 0], 0.0)
+            i = int(np.argmax(widths))
+            middle = 0.5 * (piece[i, 0] + piece[i, 1])
+            low, high = piece.copy(), piece.copy()
+            low[i, 1], high[i, 0] = middle, middle
+            pieces += [high, low]
+        return True
+
+    def _piece_excluded(self, masks: ModeMasks, ends: np.ndarray) -> bool:
+        """Whether the piece holds no zero but the motion's. Its box (twists by its rows, forces by the residual
+        bound over its slip directions) holds every zero of the piece; Krawczyk's operator centred at the box's
+        middle holds every zero of the box, so the box is met with it, :data:`LEAF_NARROWINGS` times at most. The
+        piece is excluded once the meet is empty, or its twists miss one of the piece's rows by more than
+        ``LP_FEASIBILITY`` (the relaxation's own slack): the box then holds no twist of the piece; or at once where
+        no twist meets its rows (:func:`_no_twist`)."""
+        rays: Rays = [(float(lo), float(hi)) if sliding else None for (lo, hi), sliding in zip(ends, masks.sliding, strict=True)]
+        A, lower, upper = _twist_rows(self.problem, masks.closed, masks.rolling, rays)
+        twist = _twist_box(self.problem, masks, rays)
+        if twist is None:
+            return _no_twist(A, lower, upper)
+        box = _local_box(self.laws, self.x, twist, unit_vectors(ends[:, 0], ends[:, 1]))
+        n = self.laws.n
+        for _ in range(LEAF_NARROWINGS):
+            if box is None:
+                return False
+            values = matmul(A, box[:n])
+            if np.any((values.hi < lower - LP_FEASIBILITY) | (values.lo > upper + LP_FEASIBILITY)):
+                return True
+            box = _narrowed(self.laws, box)
+            if box is not None and box.lo.size == 0:
+                return True
+        return False
+
+
+def _no_twist(A: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
+    """Whether no twist meets ``lower <= A q <= upper`` with every row loosened by ``LP_FEASIBILITY`` (HiGHS finds
+    it infeasible), as the relaxation's leaves are pruned by their twist rows."""
+    return solve_lp(np.zeros(A.shape[1]), A, lower - LP_FEASIBILITY, upper + LP_FEASIBILITY).status == "infeasible"
+
+
+def _narrowed(laws: FixedModeLaws, box: Interval) -> Interval | None:
+    """``box`` met with Krawczyk's operator centred at its middle (which holds every zero of the box): an empty
+    interval (no entries) when the meet is empty; None where the laws are not smooth in the box."""
+    centre = box.mid
+    enclosure, residual = laws.enclosure(box), laws.enclosure(point(centre))
+    image = None if enclosure is None or residual is None else krawczyk(centre, box, residual[0], enclosure[1]).image
+    if image is None:
+        return None
+    lo, hi = np.maximum(box.lo, image.lo), np.minimum(box.hi, image.hi)
+    if np.any(lo > hi):
+        return Interval(np.zeros(0), np.zeros(0))
+    return Interval(lo, hi)
+
+
+def _other_motion(
+    problem: Problem, q: np.ndarray, leaf: tuple[int, ...], twist: np.ndarray, is_motion: Callable[[np.ndarray], bool]
+) -> np.ndarray | None:
+    """An exact motion's twist, distinct from ``q``, that a surviving leaf (its modes, a twist of it) holds: its
+    own twist, or where Newton's method from it on the fixed-mode laws with the leaf's modes goes; None if neither
+    is one (``is_motion`` decides; the caller refines and audits what it gets)."""
+    candidates = (twist, _leaf_newton(problem, leaf, twist))
+    for candidate in candidates:
+        if candidate is not None and np.max(np.abs(candidate - q)) > DISTINCT_TWIST and is_motion(candidate):
+            return candidate
+    return None
+
+
+def _leaf_newton(problem: Problem, leaf: tuple[int, ...], twist: np.ndarray) -> np.ndarray | None:
+    """The twist of a zero of the fixed-mode laws with the leaf's modes (a sector: sliding; closed: rolling;
+    separating), by at most :data:`LEAF_NEWTON_STEPS` least-squares Newton steps from ``twist`` with no force;
+    None where the residual does not fall to ``FIXED_MODE_RESIDUAL``."""
+    names = {CLOSED_LEAF: "rolling", SEPARATING_LEAF: "separating"}
+    modes = np.array([names.get(k, "sliding") for k in leaf], dtype=object)
+    laws = FixedModeLaws(problem, ModeMasks.of(problem, modes))
+    x = laws.start(twist, np.zeros((problem.n_contacts, problem.dimension)), nonnegative=False)
+    for _ in range(LEAF_NEWTON_STEPS):
+        residual = laws.residual(x)
+        if not np.all(np.isfinite(residual)):
+            return None
+        if np.max(np.abs(residual), initial=0.0) <= FIXED_MODE_RESIDUAL:
+            return x[: laws.n].copy()
+        x = x - np.linalg.lstsq(laws.jacobian(x), residual, rcond=None)[0]
+    return None
 
 
 def _first_sectors(angle: float, arc: float) -> np.ndarray:
