@@ -16,6 +16,9 @@
  *       laws/motion.py::_to_world_kernel: physical twists T (bodies, k) and world forces (m, d), filled.
  *   drop_roundoff(values, roundoff) -> None
  *       check/motion.py::_drop_roundoff: values (rows, c) within roundoff (c,) of zero set to 0, in place.
+ *   nonnegative_fit(A, keep, b, x) -> residual
+ *       solvers/numerics/nnls.py::nonnegative_fit: non-negative least squares on the kept columns of A
+ *       (Lawson and Hanson's method, Householder reflections), x (N,) filled; |A x - b| returned.
  *
  * The Python C API and buffers only (every array C-contiguous, no numpy headers), so setuptools
  * alone builds it; quasistatic/compiled.py wraps it. Shapes and indices are checked
@@ -566,6 +569,148 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- non-negative least squares */
+
+/* solvers/numerics/nnls.py::_passive_least_squares: z[:p] from the p passive columns of A (m, N) by Householder
+ * reflections; 0 when a column's part off the span of those before it is below `independent` of its norm. */
+static int passive_least_squares(Py_ssize_t m, Py_ssize_t N, const double *A, const int64_t *passive, Py_ssize_t p,
+                                 const double *b, double independent, double *R, double *qb, double *z) {
+    for (Py_ssize_t c = 0; c < p; c++)
+        for (Py_ssize_t i = 0; i < m; i++) R[i * m + c] = A[i * N + passive[c]];
+    for (Py_ssize_t i = 0; i < m; i++) qb[i] = b[i];
+    for (Py_ssize_t c = 0; c < p; c++) {
+        double tail = 0.0;
+        for (Py_ssize_t i = c; i < m; i++) tail += R[i * m + c] * R[i * m + c];
+        tail = sqrt(tail);
+        double whole = tail * tail;
+        for (Py_ssize_t i = 0; i < c; i++) whole += R[i * m + c] * R[i * m + c];
+        if (!(tail > independent * sqrt(whole))) return 0;
+        double head = R[c * m + c] >= 0.0 ? -tail : tail;
+        R[c * m + c] = R[c * m + c] - head;
+        double scale = 0.0;
+        for (Py_ssize_t i = c; i < m; i++) scale += R[i * m + c] * R[i * m + c];
+        for (Py_ssize_t cc = c + 1; cc < p; cc++) {
+            double s = 0.0;
+            for (Py_ssize_t i = c; i < m; i++) s += R[i * m + c] * R[i * m + cc];
+            s = 2.0 * s / scale;
+            for (Py_ssize_t i = c; i < m; i++) R[i * m + cc] -= s * R[i * m + c];
+        }
+        double s = 0.0;
+        for (Py_ssize_t i = c; i < m; i++) s += R[i * m + c] * qb[i];
+        s = 2.0 * s / scale;
+        for (Py_ssize_t i = c; i < m; i++) qb[i] -= s * R[i * m + c];
+        R[c * m + c] = head;
+    }
+    for (Py_ssize_t c = p - 1; c >= 0; c--) {
+        double value = qb[c];
+        for (Py_ssize_t cc = c + 1; cc < p; cc++) value -= R[c * m + cc] * z[cc];
+        z[c] = value / R[c * m + c];
+    }
+    return 1;
+}
+
+/* solvers/numerics/nnls.py::nonnegative_fit, loop for loop; work: 4 m + m m doubles, m int64, N chars. */
+static double nonnegative_fit_loops(Py_ssize_t m, Py_ssize_t N, const double *A, const char *keep, const double *b,
+                                    double independent, double *x, double *work, int64_t *passive, char *rejected) {
+    double *r = work, *qb = work + m, *z = work + 2 * m, *R = work + 3 * m;
+    for (Py_ssize_t k = 0; k < N; k++) { x[k] = 0.0; rejected[k] = 0; }
+    Py_ssize_t p = 0;
+    for (Py_ssize_t i = 0; i < m; i++) r[i] = b[i];
+    for (Py_ssize_t round = 0; round < 3 * N + 1; round++) {
+        double best = 0.0;
+        Py_ssize_t j = -1;
+        for (Py_ssize_t k = 0; k < N; k++) {
+            if (keep[k] && x[k] == 0.0 && !rejected[k]) {
+                double w = 0.0;
+                for (Py_ssize_t i = 0; i < m; i++) w += A[i * N + k] * r[i];
+                if (w > best) { best = w; j = k; }
+            }
+        }
+        if (j < 0 || p == m) break;
+        passive[p++] = j;
+        int entered = 0;
+        while (1) {
+            if (!passive_least_squares(m, N, A, passive, p, b, independent, R, qb, z)) break;
+            if (!entered) {
+                if (z[p - 1] <= 0.0) break;
+                entered = 1;
+                for (Py_ssize_t k = 0; k < N; k++) rejected[k] = 0;
+            }
+            double alpha = 2.0;
+            Py_ssize_t leaving = -1;
+            for (Py_ssize_t c = 0; c < p; c++) {
+                if (z[c] <= 0.0) {
+                    double step = x[passive[c]] / (x[passive[c]] - z[c]);
+                    if (step < alpha) { alpha = step; leaving = c; }
+                }
+            }
+            if (leaving < 0) {
+                for (Py_ssize_t c = 0; c < p; c++) x[passive[c]] = z[c];
+                break;
+            }
+            Py_ssize_t kept = 0;
+            for (Py_ssize_t c = 0; c < p; c++) {
+                int64_t k = passive[c];
+                x[k] = x[k] + alpha * (z[c] - x[k]);
+                if (x[k] > 0.0 && c != leaving) passive[kept++] = k;
+                else x[k] = 0.0;
+            }
+            p = kept;
+        }
+        if (!entered) { p--; rejected[j] = 1; }
+        for (Py_ssize_t i = 0; i < m; i++) {
+            r[i] = b[i];
+            for (Py_ssize_t c = 0; c < p; c++) r[i] -= A[i * N + passive[c]] * x[passive[c]];
+        }
+    }
+    double total = 0.0;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        double value = -b[i];
+        for (Py_ssize_t k = 0; k < N; k++)
+            if (x[k] != 0.0) value += A[i * N + k] * x[k];
+        total += value * value;
+    }
+    return sqrt(total);
+}
+
+static PyObject *nonnegative_fit(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "nonnegative_fit(A, keep, b, x, independent) takes 5 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t A[2] = {-1, -1}, keep[1] = {-1}, rhs[1] = {-1}, x[1] = {-1};
+    double independent, residual = 0.0;
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "A", FLOATS, 0, 2, A) < 0) goto done;
+    keep[0] = x[0] = A[1];
+    rhs[0] = A[0];
+    if (take_next(&b, args[1], "keep", BOOLEANS, 0, 1, keep) < 0) goto done;
+    if (take_next(&b, args[2], "b", FLOATS, 0, 1, rhs) < 0) goto done;
+    if (take_next(&b, args[3], "x", FLOATS, 1, 1, x) < 0) goto done;
+    if (take_floats(args[4], &independent, "independent") < 0) goto done;
+    Py_ssize_t m = A[0], N = A[1];
+    double *work = PyMem_Malloc(sizeof(double) * (size_t)(4 * m + m * m + 1));
+    int64_t *passive = PyMem_Malloc(sizeof(int64_t) * (size_t)(m + 1));
+    char *rejected = PyMem_Malloc((size_t)(N + 1));
+    if (work == NULL || passive == NULL || rejected == NULL) {
+        PyErr_NoMemory();
+    } else {
+        Py_BEGIN_ALLOW_THREADS
+        residual = nonnegative_fit_loops(m, N, b.views[0].buf, b.views[1].buf, b.views[2].buf, independent, b.views[3].buf,
+                                         work, passive, rejected);
+        Py_END_ALLOW_THREADS
+        result = PyFloat_FromDouble(residual);
+    }
+    PyMem_Free(work);
+    PyMem_Free(passive);
+    PyMem_Free(rejected);
+done:
+    release(&b);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"audit_laws", (PyCFunction)(void (*)(void))audit_laws, METH_FASTCALL,
      "audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed, sums, u, slips, normal):\n"
@@ -581,6 +726,9 @@ static PyMethodDef methods[] = {
     {"drop_roundoff", (PyCFunction)(void (*)(void))drop_roundoff, METH_FASTCALL,
      "drop_roundoff(values, roundoff): entries of values (rows, c) within roundoff[j] of zero set to 0, in place.\n"
      "See quasistatic.check.motion."},
+    {"nonnegative_fit", (PyCFunction)(void (*)(void))nonnegative_fit, METH_FASTCALL,
+     "nonnegative_fit(A, keep, b, x, independent) -> residual: non-negative least squares on the kept columns of A (m, N),\n"
+     "the numba kernel's loops; fills x (N,), returns |A x - b|. See quasistatic.solvers.numerics.nnls."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -8,7 +8,8 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``HAVE_KERNELS`` whether ``_kernels`` was (:func:`audit_laws`, the audit's
 ``check/audit.py::_laws_2d`` / ``_laws_3d``; :func:`analyse_frictionless`,
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
-``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``). Each wrapper takes its kernel's arguments, makes
+``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`nonnegative_fit`,
+``solvers/numerics/nnls.py::nonnegative_fit``). Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
 kernels' choices in the kernels' order of arithmetic. ``_lemke`` also runs the fast path's whole kernel
 (:func:`solve_split_lcp`), and ``LEMKE_ADDRESS`` is where its Lemke's method starts as a plain C function on raw
@@ -55,6 +56,7 @@ __all__ = [
     "analyse_frictionless",
     "to_world",
     "drop_roundoff",
+    "nonnegative_fit",
 ]
 
 HAVE_EXTENSION = extension is not None
@@ -307,3 +309,18 @@ def drop_roundoff(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray:
     """
     kernels.drop_roundoff(values, np.ascontiguousarray(roundoff, np.float64))
     return values
+
+
+def nonnegative_fit(A: np.ndarray, keep: np.ndarray, b: np.ndarray, x: np.ndarray, independent: float) -> float:
+    """Non-negative least squares on the columns ``keep`` of ``A`` in C, as ``solvers/numerics/nnls.py::nonnegative_fit``:
+    ``x`` (N,) filled, ``|A x - b|`` returned.
+
+    ``A`` (m, N) C-contiguous float64, ``keep`` (N,) bool, ``b`` (m,), ``x`` (N,) a writable C-contiguous float64
+    array; ``independent``: the kernel's ``INDEPENDENT`` [-].
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, or ``x`` cannot be filled.
+    """
+    return float(kernels.nonnegative_fit(A, keep, b, x, independent))

@@ -151,7 +151,7 @@ from ...tolerances import (
 )
 from ..numerics.highs import WarmLP, solve_lp
 from ..numerics.line_extent import AxisExtents, line_axis_extents
-from ..numerics.optimize import nnls
+from ..numerics.nnls import nonnegative_fit
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
@@ -243,7 +243,7 @@ class _Rows:
     bank: np.ndarray
     rhs: np.ndarray
     norms: np.ndarray  # 2-norm of each bank row
-    loads: np.ndarray
+    loads: np.ndarray  # C-contiguous (the fit's kernel reads it in place)
     g: np.ndarray
     seed: np.ndarray | None  # the seed's twist
     form: LCPForm | None  # None: the sector relaxation of exact cones (:func:`relaxation_excluded`)
@@ -266,6 +266,7 @@ class _Rows:
     by_rank: bool = False  # closed rows of deficient rank still bound the twists (see :func:`_closed_set`)
     seed_rows: _SeedRows | None = None  # the sector relaxation's seed: the rows it meets (see :func:`_seed_alone`)
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
+    target: np.ndarray = field(default_factory=lambda: np.zeros(0))  # what the load columns' forces balance, -g
 
     @classmethod
     def of(cls, layout: _Layout, g: np.ndarray, width: int, budget: int, **search: Any) -> _Rows:
@@ -277,13 +278,14 @@ class _Rows:
             layout.bank,
             layout.rhs,
             np.linalg.norm(layout.bank, axis=1),
-            layout.loads,
+            np.ascontiguousarray(layout.loads),
             g,
             levels=layout.levels,
             budget=budget,
             farkas=_FarkasVectors(layout.loads, g, math.sqrt(g.size) * LP_FEASIBILITY),
             outside=[every & ~(block << (width * i)) for i in range(len(layout.roots))],
             width=width,
+            target=-g,
             **search,
         )
 
@@ -1146,13 +1148,8 @@ def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
     the margin, or None with a checked Farkas vector (kept in ``rows.farkas``: it may exclude the next nodes'
     columns too); a fit that does neither is returned (the node is not excluded)."""
     rows.proof.fits += 1
-    index = rows.columns(columns)
-    G = rows.loads[:, index]
-    lam = np.zeros(index.size)
-    if G.shape[1]:
-        lam[index], residual = nnls(G, -rows.g)
-    else:
-        residual = float(np.linalg.norm(rows.g))
+    lam = np.empty(rows.loads.shape[1])
+    residual = nonnegative_fit(rows.loads, rows.columns(columns), rows.target, lam)
     found = _Fit(lam, _bits(lam > 0.0))
     if residual <= _margin(rows):
         rows.fits.add(found)
