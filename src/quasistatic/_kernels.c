@@ -19,6 +19,9 @@
  *   nonnegative_fit(A, keep, b, x) -> residual
  *       solvers/numerics/nnls.py::nonnegative_fit: non-negative least squares on the kept columns of A
  *       (Lawson and Hanson's method, Householder reflections), x (N,) filled; |A x - b| returned.
+ *   polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) -> count
+ *       solvers/numerics/polygon.py::polygon_vertices: the vertices of a polygon of half-planes (the kept rows
+ *       of rates . x + reserve >= 0), filled in vertices (pairs, 2); their count, or -1 (unbounded).
  *
  * The Python C API and buffers only (every array C-contiguous, no numpy headers), so setuptools
  * alone builds it; quasistatic/compiled.py wraps it. Shapes and indices are checked
@@ -711,6 +714,111 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- a polygon's vertices */
+
+static const double PI = 3.141592653589793; /* Python's math.pi (M_PI is POSIX, not C) */
+
+/* solvers/numerics/polygon.py::polygon_vertices, loop for loop; work: 5 R doubles. */
+static Py_ssize_t polygon_vertices_loops(Py_ssize_t total, const double *rates, const double *reserve, const char *rows,
+                                         double parallel, double skew, double slack, double *vertices, double *work) {
+    double *s0 = work, *s1 = work + total, *offset = work + 2 * total, *norm = work + 3 * total, *angles = work + 4 * total;
+    Py_ssize_t P = 0;
+    for (Py_ssize_t k = 0; k < total; k++) {
+        if (!rows[k]) continue;
+        double size = sqrt(rates[2 * k] * rates[2 * k] + rates[2 * k + 1] * rates[2 * k + 1]);
+        if (size == 0.0) {
+            if (reserve[k] < 0.0) return 0;
+            continue;
+        }
+        s0[P] = rates[2 * k];
+        s1[P] = rates[2 * k + 1];
+        offset[P] = reserve[k];
+        norm[P] = size;
+        P++;
+    }
+    if (P < 3) return -1;
+    for (Py_ssize_t k = 0; k < P; k++) angles[k] = atan2(s1[k], s0[k]);
+    for (Py_ssize_t k = 1; k < P; k++) {
+        double value = angles[k];
+        Py_ssize_t at = k;
+        while (at > 0 && angles[at - 1] > value) {
+            angles[at] = angles[at - 1];
+            at--;
+        }
+        angles[at] = value;
+    }
+    double widest = angles[0] + 2.0 * PI - angles[P - 1];
+    for (Py_ssize_t k = 1; k < P; k++) widest = greater(widest, angles[k] - angles[k - 1]);
+    if (widest >= PI - skew) return -1;
+    for (Py_ssize_t i = 0; i < P; i++)
+        for (Py_ssize_t j = i + 1; j < P; j++) {
+            double sine = fabs(s0[i] * s1[j] - s1[i] * s0[j]) / (norm[i] * norm[j]);
+            if (sine < skew && sine > parallel) return -1;
+        }
+    Py_ssize_t count = 0;
+    for (Py_ssize_t i = 0; i < P; i++)
+        for (Py_ssize_t j = i + 1; j < P; j++) {
+            double det = s0[i] * s1[j] - s1[i] * s0[j];
+            if (!(fabs(det) / (norm[i] * norm[j]) >= skew)) continue;
+            double x = (s1[i] * offset[j] - s1[j] * offset[i]) / det;
+            double y = (s0[j] * offset[i] - s0[i] * offset[j]) / det;
+            double size = sqrt(x * x + y * y);
+            int inside = 1;
+            for (Py_ssize_t k = 0; k < P; k++)
+                if (s0[k] * x + s1[k] * y + offset[k] < -(slack * (norm[k] * size + fabs(offset[k])))) {
+                    inside = 0;
+                    break;
+                }
+            if (inside) {
+                vertices[2 * count] = x;
+                vertices[2 * count + 1] = y;
+                count++;
+            }
+        }
+    return count;
+}
+
+static PyObject *polygon_vertices(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 7) {
+        PyErr_SetString(PyExc_TypeError, "polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) takes 7 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t rates[2] = {-1, 2}, reserve[1] = {-1}, rows[1] = {-1}, vertices[2] = {-1, 2};
+    double parallel, skew, slack;
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "rates", FLOATS, 0, 2, rates) < 0) goto done;
+    reserve[0] = rows[0] = rates[0];
+    if (take_next(&b, args[1], "reserve", FLOATS, 0, 1, reserve) < 0) goto done;
+    if (take_next(&b, args[2], "rows", BOOLEANS, 0, 1, rows) < 0) goto done;
+    if (take_next(&b, args[6], "vertices", FLOATS, 1, 2, vertices) < 0) goto done;
+    if (take_floats(args[3], &parallel, "parallel") < 0 || take_floats(args[4], &skew, "skew") < 0 ||
+        take_floats(args[5], &slack, "slack") < 0)
+        goto done;
+    Py_ssize_t total = rates[0], kept = 0;
+    const char *chosen = b.views[2].buf;
+    for (Py_ssize_t k = 0; k < total; k++) kept += chosen[k] != 0;
+    if (vertices[0] < kept * (kept - 1) / 2) {
+        PyErr_SetString(PyExc_ValueError, "vertices must have a row for every pair of the rows kept");
+        goto done;
+    }
+    double *work = PyMem_Malloc(sizeof(double) * (size_t)(5 * total + 1));
+    if (work == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_ssize_t count;
+    Py_BEGIN_ALLOW_THREADS
+    count = polygon_vertices_loops(total, b.views[0].buf, b.views[1].buf, chosen, parallel, skew, slack, b.views[3].buf, work);
+    Py_END_ALLOW_THREADS
+    PyMem_Free(work);
+    result = PyLong_FromSsize_t(count);
+done:
+    release(&b);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"audit_laws", (PyCFunction)(void (*)(void))audit_laws, METH_FASTCALL,
      "audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed, sums, u, slips, normal):\n"
@@ -729,6 +837,9 @@ static PyMethodDef methods[] = {
     {"nonnegative_fit", (PyCFunction)(void (*)(void))nonnegative_fit, METH_FASTCALL,
      "nonnegative_fit(A, keep, b, x, independent) -> residual: non-negative least squares on the kept columns of A (m, N),\n"
      "the numba kernel's loops; fills x (N,), returns |A x - b|. See quasistatic.solvers.numerics.nnls."},
+    {"polygon_vertices", (PyCFunction)(void (*)(void))polygon_vertices, METH_FASTCALL,
+     "polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) -> count: a polygon's vertices, the numba\n"
+     "kernel's loops; fills vertices (pairs, 2), returns their count or -1. See quasistatic.solvers.numerics.polygon."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -9,7 +9,8 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``check/audit.py::_laws_2d`` / ``_laws_3d``; :func:`analyse_frictionless`,
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
 ``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`nonnegative_fit`,
-``solvers/numerics/nnls.py::nonnegative_fit``). Each wrapper takes its kernel's arguments, makes
+``solvers/numerics/nnls.py::nonnegative_fit``; :func:`polygon_vertices`, ``solvers/numerics/polygon.py::polygon_vertices``).
+Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
 kernels' choices in the kernels' order of arithmetic. ``_lemke`` also runs the fast path's whole kernel
 (:func:`solve_split_lcp`), and ``LEMKE_ADDRESS`` is where its Lemke's method starts as a plain C function on raw
@@ -57,6 +58,7 @@ __all__ = [
     "to_world",
     "drop_roundoff",
     "nonnegative_fit",
+    "polygon_vertices",
 ]
 
 HAVE_EXTENSION = extension is not None
@@ -324,3 +326,19 @@ def nonnegative_fit(A: np.ndarray, keep: np.ndarray, b: np.ndarray, x: np.ndarra
         When the shapes or dtypes disagree, or ``x`` cannot be filled.
     """
     return float(kernels.nonnegative_fit(A, keep, b, x, independent))
+
+
+def polygon_vertices(
+    rates: np.ndarray, reserve: np.ndarray, rows: np.ndarray, parallel: float, skew: float, slack: float, vertices: np.ndarray
+) -> int:
+    """A polygon's vertices in C, as ``solvers/numerics/polygon.py::polygon_vertices``: ``vertices`` filled, their
+    count (or -1: unbounded) returned.
+
+    ``rates`` (R, 2), ``reserve`` (R,) C-contiguous float64, ``rows`` (R,) bool, ``vertices`` (pairs, 2) writable.
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, or ``vertices`` has fewer rows than the kept rows have pairs.
+    """
+    return int(kernels.polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices))

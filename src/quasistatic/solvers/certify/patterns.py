@@ -152,6 +152,7 @@ from ...tolerances import (
 from ..numerics.highs import WarmLP, solve_lp
 from ..numerics.line_extent import AxisExtents, line_axis_extents
 from ..numerics.nnls import nonnegative_fit
+from ..numerics.polygon import UNBOUNDED, polygon_vertices
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
@@ -1270,10 +1271,9 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
         interval = _interval(closed, (-math.inf, math.inf), node.at_least)
         return _PRUNED if interval is None else _line(rows, closed, *interval)
     at_least = rows.row_mask(node.at_least)
-    reserve = closed.reserve[at_least]
     if plane:
-        return _on_plane(rows, closed, rows.bank[at_least] @ closed.plane.T, reserve)
-    if (reserve < 0.0).any():
+        return _on_plane(rows, closed, at_least, node.at_least.bit_count())
+    if (closed.reserve[at_least] < 0.0).any():
         return _PRUNED  # an open gap or slip sign fails on the whole set
     if _near_seed(rows, closed.q0, closed.q0, closed.spread):
         return _PRUNED
@@ -1344,6 +1344,7 @@ class _ClosedSet:
     # row's rate along the line (``slope``) or along each of the plane's directions (on ``n - 2`` rows); else empty.
     row_reserve: list[float]
     row_rates: tuple[list[float], ...]
+    plane_rates: np.ndarray  # (rows, 2): each bank row's rate along the plane's two directions (on n - 2 rows)
 
 
 def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
@@ -1386,11 +1387,17 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     free = n - r
     slope = bank @ direction if free else None
     rates: tuple[list[float], ...] = ()  # for a line or a plane only (a point's children keep it)
+    plane_rates = _NO_RATES
     if free == 1 and slope is not None:
         rates = (slope.tolist(),)
     elif free == 2:
-        rates = ((bank @ vt[-2]).tolist(), (bank @ vt[-1]).tolist())
-    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], free, reserve.tolist() if rates else [], rates)
+        plane_rates = np.stack([bank @ vt[-2], bank @ vt[-1]], axis=1)
+        rates = (plane_rates[:, 0].tolist(), plane_rates[:, 1].tolist())
+    row_reserve = reserve.tolist() if rates else []
+    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], free, row_reserve, rates, plane_rates)
+
+
+_NO_RATES = np.zeros((0, 2))  # a closed set's plane rates where it leaves no plane
 
 
 def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
@@ -1406,39 +1413,22 @@ def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
     return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + closed.radius), shape=shape)
 
 
-def _on_plane(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.ndarray) -> _Twists:
-    """Twists ``q0 + P^T x`` (``P``: the closed set's plane, ``x`` in R^2) with ``slope x + reserve >= 0`` for every
-    inequality row: a polygon, decided exactly in the plane.
+def _on_plane(rows: _Rows, closed: _ClosedSet, at_least: np.ndarray, count: int) -> _Twists:
+    """Twists ``q0 + P^T x`` (``P``: the closed set's plane, ``x`` in R^2) with ``rate x + reserve >= 0`` for each of
+    the ``count`` inequality rows ``at_least`` (a mask of the bank's): a polygon, decided exactly in the plane.
 
     It is bounded when its rows' normals leave no angle of ``pi`` or more between neighbours (they positively
     span the plane); then it is the hull of its vertices, the intersections of two of its lines that meet every
     row (with round-off's leniency): none means it is empty. Lines closer to parallel than :data:`_PARALLEL`
     meet far away or not at all; between that and :data:`_SKEW` a vertex is too close to call (no bound given).
     """
-    norms = np.sqrt(slope[:, 0] ** 2 + slope[:, 1] ** 2)
-    flat = norms == 0.0
-    if flat.any():
-        if (reserve[flat] < 0.0).any():
-            return _PRUNED
-        slope, reserve, norms = slope[~flat], reserve[~flat], norms[~flat]
-    angles = np.sort(np.arctan2(slope[:, 1], slope[:, 0]))
-    if angles.size < 3 or max(float(np.max(np.diff(angles))), float(angles[0] + 2.0 * np.pi - angles[-1])) >= np.pi - _SKEW:
+    vertices = np.empty((count * (count - 1) // 2, 2))
+    found = polygon_vertices(closed.plane_rates, closed.reserve, at_least, _PARALLEL, _SKEW, ROUNDOFF_SLACK, vertices)
+    if found == UNBOUNDED:
         return _UNKNOWN  # unbounded (or too close to call)
-    i, j = _pairs(angles.size)
-    a, b, c, d = slope[i, 0], slope[i, 1], slope[j, 0], slope[j, 1]
-    det = a * d - b * c
-    sine = np.abs(det) / (norms[i] * norms[j])
-    meet = sine >= _SKEW
-    if np.any(~meet & (sine > _PARALLEL)):
-        return _UNKNOWN
-    a, b, c, d, det, ri, rj = a[meet], b[meet], c[meet], d[meet], det[meet], reserve[i[meet]], reserve[j[meet]]
-    points = np.stack([(b * rj - d * ri) / det, (c * ri - a * rj) / det])  # (2, P): where two lines meet
-    values = slope @ points + reserve[:, None]
-    lenient = ROUNDOFF_SLACK * (norms[:, None] * np.sqrt(points[0] ** 2 + points[1] ** 2) + np.abs(reserve)[:, None])
-    vertices = points[:, (values >= -lenient).all(axis=0)].T
-    if not vertices.size:
+    if found == 0:
         return _PRUNED
-    return _polygon(rows, closed, [(x, y) for x, y in vertices.tolist()])
+    return _polygon(rows, closed, [(x, y) for x, y in vertices[:found].tolist()])
 
 
 def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Vertices:
@@ -1470,12 +1460,6 @@ def _polygon(rows: _Rows, closed: _ClosedSet, vertices: _Vertices) -> _Twists:
     center = 0.5 * (twists.min(axis=0) + twists.max(axis=0))
     reach = math.sqrt(float(((twists - center) ** 2).sum(axis=1).max()))
     return _Twists(False, _Ball(center, reach * (1.0 + ROUNDOFF_SLACK) + closed.radius), shape=_Shape(closed, vertices=vertices))
-
-
-@functools.cache
-def _pairs(count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Every pair ``i < j`` of ``count`` indices."""
-    return np.triu_indices(count, 1)
 
 
 def _all_near_seed(rows: _Rows, twists: np.ndarray, spread: np.ndarray) -> bool:
