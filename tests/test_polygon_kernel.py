@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from quasistatic import compiled
-from quasistatic.solvers.numerics import polygon as kernel_module
 from quasistatic.solvers.certify import patterns
+from quasistatic.solvers.numerics import polygon as kernel_module
 from quasistatic.solvers.numerics.polygon import UNBOUNDED, polygon_vertices
 
 PARALLEL, SKEW, SLACK = patterns._PARALLEL, patterns._SKEW, patterns.ROUNDOFF_SLACK  # the branch and bound's

@@ -1110,10 +1110,11 @@ class _ModeFilter:
 
     @classmethod
     def of(cls, rows: _Rows, modes: tuple[_Mode, ...]) -> _ModeFilter:
-        union = sorted({int(r) for mode in modes for r in (*mode.equal, *mode.at_least)})
+        # From the modes' bit sets: iterating their index arrays reads numpy scalars one by one (~20x slower).
+        union = _indices(functools.reduce(lambda bits, mode: bits | mode.equal_bits | mode.at_least_bits, modes, 0))
         where = {r: j for j, r in enumerate(union)}
-        equal = tuple([where[int(r)] for r in mode.equal] for mode in modes)
-        at_least = tuple([where[int(r)] for r in mode.at_least] for mode in modes)
+        equal = tuple([where[r] for r in _indices(mode.equal_bits)] for mode in modes)
+        at_least = tuple([where[r] for r in _indices(mode.at_least_bits)] for mode in modes)
         return cls(rows.bank[union], rows.rhs[union], rows.norms[union], equal, at_least)
 
 
@@ -1193,7 +1194,7 @@ class _FarkasVectors:
 
     def add(self, y: np.ndarray, columns: int) -> bool:
         """Keep ``y`` when it excludes ``columns`` (bits; then True)."""
-        reserve = -float(self.g @ y) - self.margin * float(np.linalg.norm(y))
+        reserve = -float(self.g @ y) - self.margin * math.sqrt(float(y @ y))  # np.linalg.norm's arithmetic, less its overhead
         if not reserve > 0.0:
             return False
         blockers = _bits(self.loads.T @ y * FORCE_CEILING >= reserve)
@@ -1317,7 +1318,7 @@ def _interval(closed: _ClosedSet, interval: tuple[float, float], at_least: int) 
 
 
 def _indices(bits: int) -> list[int]:
-    """The positions of a bit set's bits (few: a node's new rows)."""
+    """The positions of a bit set's bits, ascending (few: a node's new rows, a node's modes' rows)."""
     index = []
     while bits:
         low = bits & -bits
