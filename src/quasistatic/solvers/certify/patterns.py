@@ -812,10 +812,10 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
         child = _past_settled(rows, node.child(contact, mode))
-        child_fit = _known_forces(rows, child.columns, fit)
         child_twists = _child_twists(rows, node, child, mode, twists)
         if child_twists.pruned:
-            continue  # before a new fit: the twists cost less
+            continue  # before any fit, known or new: the twists cost less
+        child_fit = _known_forces(rows, child.columns, fit)
         if child_fit is None:
             child_fit = _fitted_forces(rows, child.columns)
         if child_fit is None:
@@ -1171,7 +1171,11 @@ class _Fits:
 
     def usable(self, columns: int) -> _Fit | None:
         """A kept fit that uses only ``columns`` (bits), or None."""
-        return next((fit for fit in self.kept if not fit.support & ~columns), None)
+        others = ~columns
+        for fit in self.kept:
+            if not fit.support & others:
+                return fit
+        return None
 
 
 @dataclass
