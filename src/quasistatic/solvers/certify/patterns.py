@@ -1345,7 +1345,7 @@ class _ClosedSet:
     plane: np.ndarray  # (2, n): orthonormal directions of what ``n - 2`` rows leave (the last two of E's full ``vt``)
     free: int  # the dimension of what the closed rows leave: 0 a point, 1 a line, 2 a plane
     # The same per bank row as plain floats, read a few at a time by :func:`_narrowed`: ``reserve``, and the
-    # row's rate along the line (``slope``) or along each of the plane's directions (on ``n - 2`` rows); else empty.
+    # row's rate along the line or along each of the plane's directions (on ``n - 2`` rows); else empty.
     row_reserve: list[float]
     row_rates: tuple[list[float], ...]
     plane_rates: np.ndarray  # (rows, 2): each bank row's rate along the plane's two directions (on n - 2 rows)
@@ -1387,7 +1387,7 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     # Each bank row's best slack at q0 (t = 0 on a line), every row loosened by LP_FEASIBILITY; the rows of
     # |bank E+| summed by a product (numpy's sum along a short axis costs 4x more).
     bank = rows.bank
-    reach = np.abs(bank @ pseudo_inverse) @ np.ones(r)
+    reach = np.abs(bank @ pseudo_inverse) @ np.ones(k)
     reserve = bank @ q0 + LP_FEASIBILITY * reach - rows.rhs + LP_FEASIBILITY
     free = n - r
     rates: tuple[list[float], ...] = ()  # for a line or a plane only (a point's children keep it)

@@ -66,7 +66,7 @@ def nonnegative_fit(A: np.ndarray, keep: np.ndarray, b: np.ndarray, x: np.ndarra
     p = 0
     for i in range(m):
         r[i] = b[i]
-    for _ in range(3 * N + 1):
+    for _ in range(3 * N + 1):  # SciPy's cap on the columns tried; past it the fit so far is returned (a candidate)
         best, j = 0.0, -1
         for k in range(N):
             if keep[k] and x[k] == 0.0 and not rejected[k]:
