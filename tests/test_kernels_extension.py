@@ -289,7 +289,8 @@ def test_analysis_rejects_bad_arguments() -> None:
 
 
 def test_without_numba_the_default_install_runs_the_kernels() -> None:
-    """With numba unimportable, the audit's laws and the LP's analysis are the extension's (or, without it, the twins)."""
+    """With numba unimportable, the audit's laws, the LP's analysis and the branch and bound's fit and polygon are the
+    extension's (or, without it, the twins)."""
     code = textwrap.dedent(
         """
         import sys
@@ -298,13 +299,18 @@ def test_without_numba_the_default_install_runs_the_kernels() -> None:
         from quasistatic import compiled
         from quasistatic.check import audit, motion
         from quasistatic.solvers import lp
+        from quasistatic.solvers.numerics import nnls, polygon
         from quasistatic.tools.bench.families import FAMILIES
         if compiled.HAVE_KERNELS:
             assert lp._analyse is lp._analyse_compiled and audit._array_kernel(2, 3) is compiled.audit_laws
             assert motion._drop_roundoff is compiled.drop_roundoff
+            assert nnls.nonnegative_fit is nnls._nonnegative_fit_compiled
+            assert polygon.polygon_vertices is polygon._polygon_vertices_compiled
         else:
             assert lp._analyse is lp._analyse_numpy and audit._array_kernel(2, 3) is None
             assert motion._drop_roundoff is motion._drop_roundoff_numpy
+            assert nnls.nonnegative_fit is nnls._nonnegative_fit_scipy
+            assert polygon.polygon_vertices is polygon._polygon_vertices_numpy
         solution = qs.solve(FAMILIES["grasp-3d-nf"].make(8, 0), method="lp")
         assert solution.status == "solved" and solution.audit.passed, solution.message
         """

@@ -21,6 +21,12 @@
  *       laws/assemble.py::assemble_numpy from the scene's numbers: the movers' point velocities, the scales
  *       (model/scales.py), each contact's frame, rows of J and b, and the loads g; frames, J (zeros on
  *       entry), b and g_and_scales (g, then the origin, length, force and velocity) are filled.
+ *   nonnegative_fit(A, keep, b, x) -> residual
+ *       solvers/numerics/nnls.py::nonnegative_fit: non-negative least squares on the kept columns of A
+ *       (Lawson and Hanson's method, Householder reflections), x (N,) filled; |A x - b| returned.
+ *   polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) -> count
+ *       solvers/numerics/polygon.py::polygon_vertices: the vertices of a polygon of half-planes (the kept rows
+ *       of rates . x + reserve >= 0), filled in vertices (pairs, 2); their count, or -1 (unbounded).
  *
  * The Python C API and buffers only (every array C-contiguous, no numpy headers), so setuptools
  * alone builds it; quasistatic/compiled.py wraps it. Shapes and indices are checked
@@ -742,12 +748,13 @@ static PyObject *assemble_scene(PyObject *module, PyObject *const *args, Py_ssiz
             goto done;
         }
     }
-    double *velocities = PyMem_Malloc((size_t)(m * d) * sizeof(double));
+    double *velocities = PyMem_RawMalloc((size_t)(m * d) * sizeof(double));
     if (velocities == NULL) {
         PyErr_NoMemory();
         goto done;
     }
     double *frame = b.views[12].buf, *Jv = b.views[13].buf, *bo = b.views[14].buf, *g = b.views[15].buf, *scales = g + S.bodies * k;
+    Py_BEGIN_ALLOW_THREADS
     for (Py_ssize_t i = 0; i < m; i++) mover_velocity(&S, i, velocities + i * d);
     scene_scales(&S, velocities, scales);
     const double length = scales[d], force = scales[d + 1];
@@ -757,8 +764,256 @@ static PyObject *assemble_scene(PyObject *module, PyObject *const *args, Py_ssiz
         body_load(&S, a, g + a * k);
         for (Py_ssize_t j = 0; j < k; j++) g[a * k + j] /= j < d ? force : force * length;
     }
-    PyMem_Free(velocities);
+    Py_END_ALLOW_THREADS
+    PyMem_RawFree(velocities);
     result = Py_NewRef(Py_None);
+done:
+    release(&b);
+    return result;
+}
+
+/* ---------------------------------------------------------------- non-negative least squares */
+
+/* solvers/numerics/nnls.py::_passive_least_squares: z[:p] from the p passive columns of A (m, N) by Householder
+ * reflections; 0 when a column's part off the span of those before it is below `independent` of its norm. */
+static int passive_least_squares(Py_ssize_t m, Py_ssize_t N, const double *A, const int64_t *passive, Py_ssize_t p,
+                                 const double *b, double independent, double *R, double *qb, double *z) {
+    for (Py_ssize_t c = 0; c < p; c++)
+        for (Py_ssize_t i = 0; i < m; i++) R[i * m + c] = A[i * N + passive[c]];
+    for (Py_ssize_t i = 0; i < m; i++) qb[i] = b[i];
+    for (Py_ssize_t c = 0; c < p; c++) {
+        double tail = 0.0;
+        for (Py_ssize_t i = c; i < m; i++) tail += R[i * m + c] * R[i * m + c];
+        tail = sqrt(tail);
+        double whole = tail * tail;
+        for (Py_ssize_t i = 0; i < c; i++) whole += R[i * m + c] * R[i * m + c];
+        if (!(tail > independent * sqrt(whole))) return 0;
+        double head = R[c * m + c] >= 0.0 ? -tail : tail;
+        R[c * m + c] = R[c * m + c] - head;
+        double scale = 0.0;
+        for (Py_ssize_t i = c; i < m; i++) scale += R[i * m + c] * R[i * m + c];
+        for (Py_ssize_t cc = c + 1; cc < p; cc++) {
+            double s = 0.0;
+            for (Py_ssize_t i = c; i < m; i++) s += R[i * m + c] * R[i * m + cc];
+            s = 2.0 * s / scale;
+            for (Py_ssize_t i = c; i < m; i++) R[i * m + cc] -= s * R[i * m + c];
+        }
+        double s = 0.0;
+        for (Py_ssize_t i = c; i < m; i++) s += R[i * m + c] * qb[i];
+        s = 2.0 * s / scale;
+        for (Py_ssize_t i = c; i < m; i++) qb[i] -= s * R[i * m + c];
+        R[c * m + c] = head;
+    }
+    for (Py_ssize_t c = p - 1; c >= 0; c--) {
+        double value = qb[c];
+        for (Py_ssize_t cc = c + 1; cc < p; cc++) value -= R[c * m + cc] * z[cc];
+        z[c] = value / R[c * m + c];
+    }
+    return 1;
+}
+
+/* solvers/numerics/nnls.py::nonnegative_fit, loop for loop; work: 4 m + m m doubles, m int64, N chars. */
+static double nonnegative_fit_loops(Py_ssize_t m, Py_ssize_t N, const double *A, const char *keep, const double *b,
+                                    double independent, double *x, double *work, int64_t *passive, char *rejected) {
+    double *r = work, *qb = work + m, *z = work + 2 * m, *R = work + 3 * m;
+    for (Py_ssize_t k = 0; k < N; k++) { x[k] = 0.0; rejected[k] = 0; }
+    Py_ssize_t p = 0;
+    for (Py_ssize_t i = 0; i < m; i++) r[i] = b[i];
+    for (Py_ssize_t round = 0; round < 3 * N + 1; round++) {
+        double best = 0.0;
+        Py_ssize_t j = -1;
+        for (Py_ssize_t k = 0; k < N; k++) {
+            if (keep[k] && x[k] == 0.0 && !rejected[k]) {
+                double w = 0.0;
+                for (Py_ssize_t i = 0; i < m; i++) w += A[i * N + k] * r[i];
+                if (w > best) { best = w; j = k; }
+            }
+        }
+        if (j < 0 || p == m) break;
+        passive[p++] = j;
+        int entered = 0;
+        while (1) {
+            if (!passive_least_squares(m, N, A, passive, p, b, independent, R, qb, z)) break;
+            if (!entered) {
+                if (z[p - 1] <= 0.0) break;
+                entered = 1;
+                for (Py_ssize_t k = 0; k < N; k++) rejected[k] = 0;
+            }
+            double alpha = 2.0;
+            Py_ssize_t leaving = -1;
+            for (Py_ssize_t c = 0; c < p; c++) {
+                if (z[c] <= 0.0) {
+                    double step = x[passive[c]] / (x[passive[c]] - z[c]);
+                    if (step < alpha) { alpha = step; leaving = c; }
+                }
+            }
+            if (leaving < 0) {
+                for (Py_ssize_t c = 0; c < p; c++) x[passive[c]] = z[c];
+                break;
+            }
+            Py_ssize_t kept = 0;
+            for (Py_ssize_t c = 0; c < p; c++) {
+                int64_t k = passive[c];
+                x[k] = x[k] + alpha * (z[c] - x[k]);
+                if (x[k] > 0.0 && c != leaving) passive[kept++] = k;
+                else x[k] = 0.0;
+            }
+            p = kept;
+        }
+        if (!entered) { p--; rejected[j] = 1; }
+        for (Py_ssize_t i = 0; i < m; i++) {
+            r[i] = b[i];
+            for (Py_ssize_t c = 0; c < p; c++) r[i] -= A[i * N + passive[c]] * x[passive[c]];
+        }
+    }
+    double total = 0.0;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        double value = -b[i];
+        for (Py_ssize_t k = 0; k < N; k++)
+            if (x[k] != 0.0) value += A[i * N + k] * x[k];
+        total += value * value;
+    }
+    return sqrt(total);
+}
+
+static PyObject *nonnegative_fit(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "nonnegative_fit(A, keep, b, x, independent) takes 5 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t A[2] = {-1, -1}, keep[1] = {-1}, rhs[1] = {-1}, x[1] = {-1};
+    double independent, residual = 0.0;
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "A", FLOATS, 0, 2, A) < 0) goto done;
+    keep[0] = x[0] = A[1];
+    rhs[0] = A[0];
+    if (take_next(&b, args[1], "keep", BOOLEANS, 0, 1, keep) < 0) goto done;
+    if (take_next(&b, args[2], "b", FLOATS, 0, 1, rhs) < 0) goto done;
+    if (take_next(&b, args[3], "x", FLOATS, 1, 1, x) < 0) goto done;
+    if (take_floats(args[4], &independent, "independent") < 0) goto done;
+    Py_ssize_t m = A[0], N = A[1];
+    double *work = PyMem_Malloc(sizeof(double) * (size_t)(4 * m + m * m + 1));
+    int64_t *passive = PyMem_Malloc(sizeof(int64_t) * (size_t)(m + 1));
+    char *rejected = PyMem_Malloc((size_t)(N + 1));
+    if (work == NULL || passive == NULL || rejected == NULL) {
+        PyErr_NoMemory();
+    } else {
+        Py_BEGIN_ALLOW_THREADS
+        residual = nonnegative_fit_loops(m, N, b.views[0].buf, b.views[1].buf, b.views[2].buf, independent, b.views[3].buf,
+                                         work, passive, rejected);
+        Py_END_ALLOW_THREADS
+        result = PyFloat_FromDouble(residual);
+    }
+    PyMem_Free(work);
+    PyMem_Free(passive);
+    PyMem_Free(rejected);
+done:
+    release(&b);
+    return result;
+}
+
+/* ---------------------------------------------------------------- a polygon's vertices */
+
+static const double PI = 3.141592653589793; /* Python's math.pi (M_PI is POSIX, not C) */
+
+/* solvers/numerics/polygon.py::polygon_vertices, loop for loop; work: 5 R doubles. */
+static Py_ssize_t polygon_vertices_loops(Py_ssize_t total, const double *rates, const double *reserve, const char *rows,
+                                         double parallel, double skew, double slack, double *vertices, double *work) {
+    double *s0 = work, *s1 = work + total, *offset = work + 2 * total, *norm = work + 3 * total, *angles = work + 4 * total;
+    Py_ssize_t P = 0;
+    for (Py_ssize_t k = 0; k < total; k++) {
+        if (!rows[k]) continue;
+        double size = sqrt(rates[2 * k] * rates[2 * k] + rates[2 * k + 1] * rates[2 * k + 1]);
+        if (size == 0.0) {
+            if (reserve[k] < 0.0) return 0;
+            continue;
+        }
+        s0[P] = rates[2 * k];
+        s1[P] = rates[2 * k + 1];
+        offset[P] = reserve[k];
+        norm[P] = size;
+        P++;
+    }
+    if (P < 3) return -1;
+    for (Py_ssize_t k = 0; k < P; k++) angles[k] = atan2(s1[k], s0[k]);
+    for (Py_ssize_t k = 1; k < P; k++) {
+        double value = angles[k];
+        Py_ssize_t at = k;
+        while (at > 0 && angles[at - 1] > value) {
+            angles[at] = angles[at - 1];
+            at--;
+        }
+        angles[at] = value;
+    }
+    double widest = angles[0] + 2.0 * PI - angles[P - 1];
+    for (Py_ssize_t k = 1; k < P; k++) widest = greater(widest, angles[k] - angles[k - 1]);
+    if (widest >= PI - skew) return -1;
+    for (Py_ssize_t i = 0; i < P; i++)
+        for (Py_ssize_t j = i + 1; j < P; j++) {
+            double sine = fabs(s0[i] * s1[j] - s1[i] * s0[j]) / (norm[i] * norm[j]);
+            if (sine < skew && sine > parallel) return -1;
+        }
+    Py_ssize_t count = 0;
+    for (Py_ssize_t i = 0; i < P; i++)
+        for (Py_ssize_t j = i + 1; j < P; j++) {
+            double det = s0[i] * s1[j] - s1[i] * s0[j];
+            if (!(fabs(det) / (norm[i] * norm[j]) >= skew)) continue;
+            double x = (s1[i] * offset[j] - s1[j] * offset[i]) / det;
+            double y = (s0[j] * offset[i] - s0[i] * offset[j]) / det;
+            double size = sqrt(x * x + y * y);
+            int inside = 1;
+            for (Py_ssize_t k = 0; k < P; k++)
+                if (s0[k] * x + s1[k] * y + offset[k] < -(slack * (norm[k] * size + fabs(offset[k])))) {
+                    inside = 0;
+                    break;
+                }
+            if (inside) {
+                vertices[2 * count] = x;
+                vertices[2 * count + 1] = y;
+                count++;
+            }
+        }
+    return count;
+}
+
+static PyObject *polygon_vertices(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 7) {
+        PyErr_SetString(PyExc_TypeError, "polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) takes 7 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t rates[2] = {-1, 2}, reserve[1] = {-1}, rows[1] = {-1}, vertices[2] = {-1, 2};
+    double parallel, skew, slack;
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "rates", FLOATS, 0, 2, rates) < 0) goto done;
+    reserve[0] = rows[0] = rates[0];
+    if (take_next(&b, args[1], "reserve", FLOATS, 0, 1, reserve) < 0) goto done;
+    if (take_next(&b, args[2], "rows", BOOLEANS, 0, 1, rows) < 0) goto done;
+    if (take_next(&b, args[6], "vertices", FLOATS, 1, 2, vertices) < 0) goto done;
+    if (take_floats(args[3], &parallel, "parallel") < 0 || take_floats(args[4], &skew, "skew") < 0 ||
+        take_floats(args[5], &slack, "slack") < 0)
+        goto done;
+    Py_ssize_t total = rates[0], kept = 0;
+    const char *chosen = b.views[2].buf;
+    for (Py_ssize_t k = 0; k < total; k++) kept += chosen[k] != 0;
+    if (vertices[0] < kept * (kept - 1) / 2) {
+        PyErr_SetString(PyExc_ValueError, "vertices must have a row for every pair of the rows kept");
+        goto done;
+    }
+    double *work = PyMem_Malloc(sizeof(double) * (size_t)(5 * total + 1));
+    if (work == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_ssize_t count;
+    Py_BEGIN_ALLOW_THREADS
+    count = polygon_vertices_loops(total, b.views[0].buf, b.views[1].buf, chosen, parallel, skew, slack, b.views[3].buf, work);
+    Py_END_ALLOW_THREADS
+    PyMem_Free(work);
+    result = PyLong_FromSsize_t(count);
 done:
     release(&b);
     return result;
@@ -784,6 +1039,12 @@ static PyMethodDef methods[] = {
      "smallest_length, frames, J, b, g_and_scales): a scene's scales and contact laws, the numpy assembly's arithmetic;\n"
      "fills frames (m, d, d), J (m, d, k bodies; zeros on entry), b (m, d), g_and_scales (k bodies + d + 3,).\n"
      "See quasistatic.laws.assemble."},
+    {"nonnegative_fit", (PyCFunction)(void (*)(void))nonnegative_fit, METH_FASTCALL,
+     "nonnegative_fit(A, keep, b, x, independent) -> residual: non-negative least squares on the kept columns of A (m, N),\n"
+     "the numba kernel's loops; fills x (N,), returns |A x - b|. See quasistatic.solvers.numerics.nnls."},
+    {"polygon_vertices", (PyCFunction)(void (*)(void))polygon_vertices, METH_FASTCALL,
+     "polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) -> count: a polygon's vertices, the numba\n"
+     "kernel's loops; fills vertices (pairs, 2), returns their count or -1. See quasistatic.solvers.numerics.polygon."},
     {NULL, NULL, 0, NULL},
 };
 

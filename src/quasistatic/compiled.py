@@ -8,8 +8,10 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``HAVE_KERNELS`` whether ``_kernels`` was (:func:`audit_laws`, the audit's
 ``check/audit.py::_laws_2d`` / ``_laws_3d``; :func:`analyse_frictionless`,
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
-``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`assemble_scene`,
-``laws/assemble.py::assemble_numpy``). Each wrapper takes its kernel's arguments, makes
+``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`nonnegative_fit`,
+``solvers/numerics/nnls.py::nonnegative_fit``; :func:`polygon_vertices`, ``solvers/numerics/polygon.py::polygon_vertices``;
+:func:`assemble_scene`, ``laws/assemble.py::assemble_numpy``).
+Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
 kernels' choices in the kernels' order of arithmetic. ``_lemke`` also runs the fast path's whole kernel
 (:func:`solve_split_lcp`), and ``LEMKE_ADDRESS`` is where its Lemke's method starts as a plain C function on raw
@@ -56,6 +58,8 @@ __all__ = [
     "analyse_frictionless",
     "to_world",
     "drop_roundoff",
+    "nonnegative_fit",
+    "polygon_vertices",
     "assemble_scene",
 ]
 
@@ -309,6 +313,37 @@ def drop_roundoff(values: np.ndarray, roundoff: np.ndarray) -> np.ndarray:
     """
     kernels.drop_roundoff(values, np.ascontiguousarray(roundoff, np.float64))
     return values
+
+
+def nonnegative_fit(A: np.ndarray, keep: np.ndarray, b: np.ndarray, x: np.ndarray, independent: float) -> float:
+    """Non-negative least squares on the columns ``keep`` of ``A`` in C, as ``solvers/numerics/nnls.py::nonnegative_fit``:
+    ``x`` (N,) filled, ``|A x - b|`` returned.
+
+    ``A`` (m, N) C-contiguous float64, ``keep`` (N,) bool, ``b`` (m,), ``x`` (N,) a writable C-contiguous float64
+    array; ``independent``: the kernel's ``INDEPENDENT`` [-].
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, or ``x`` cannot be filled.
+    """
+    return float(kernels.nonnegative_fit(A, keep, b, x, independent))
+
+
+def polygon_vertices(
+    rates: np.ndarray, reserve: np.ndarray, rows: np.ndarray, parallel: float, skew: float, slack: float, vertices: np.ndarray
+) -> int:
+    """A polygon's vertices in C, as ``solvers/numerics/polygon.py::polygon_vertices``: ``vertices`` filled, their
+    count (or -1: unbounded) returned.
+
+    ``rates`` (R, 2), ``reserve`` (R,) C-contiguous float64, ``rows`` (R,) bool, ``vertices`` (pairs, 2) writable.
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, or ``vertices`` has fewer rows than the kept rows have pairs.
+    """
+    return int(kernels.polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices))
 
 
 def assemble_scene(

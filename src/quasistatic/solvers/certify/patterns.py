@@ -151,7 +151,8 @@ from ...tolerances import (
 )
 from ..numerics.highs import WarmLP, solve_lp
 from ..numerics.line_extent import AxisExtents, line_axis_extents
-from ..numerics.optimize import nnls
+from ..numerics.nnls import nonnegative_fit
+from ..numerics.polygon import UNBOUNDED, polygon_vertices
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
@@ -243,7 +244,7 @@ class _Rows:
     bank: np.ndarray
     rhs: np.ndarray
     norms: np.ndarray  # 2-norm of each bank row
-    loads: np.ndarray
+    loads: np.ndarray  # C-contiguous (the fit's kernel reads it in place)
     g: np.ndarray
     seed: np.ndarray | None  # the seed's twist
     form: LCPForm | None  # None: the sector relaxation of exact cones (:func:`relaxation_excluded`)
@@ -266,6 +267,7 @@ class _Rows:
     by_rank: bool = False  # closed rows of deficient rank still bound the twists (see :func:`_closed_set`)
     seed_rows: _SeedRows | None = None  # the sector relaxation's seed: the rows it meets (see :func:`_seed_alone`)
     found: list[_Found] = field(default_factory=list)  # the leaves' motions other than the seed's, distinct
+    target: np.ndarray = field(default_factory=lambda: np.zeros(0))  # what the load columns' forces balance, -g
 
     @classmethod
     def of(cls, layout: _Layout, g: np.ndarray, width: int, budget: int, **search: Any) -> _Rows:
@@ -277,13 +279,14 @@ class _Rows:
             layout.bank,
             layout.rhs,
             np.linalg.norm(layout.bank, axis=1),
-            layout.loads,
+            np.ascontiguousarray(layout.loads),
             g,
             levels=layout.levels,
             budget=budget,
             farkas=_FarkasVectors(layout.loads, g, math.sqrt(g.size) * LP_FEASIBILITY),
             outside=[every & ~(block << (width * i)) for i in range(len(layout.roots))],
             width=width,
+            target=-g,
             **search,
         )
 
@@ -809,10 +812,10 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists) -> bool:
             blocked |= not mode.separating
             continue  # no equilibrium below this node
         child = _past_settled(rows, node.child(contact, mode))
-        child_fit = _known_forces(rows, child.columns, fit)
         child_twists = _child_twists(rows, node, child, mode, twists)
         if child_twists.pruned:
-            continue  # before a new fit: the twists cost less
+            continue  # before any fit, known or new: the twists cost less
+        child_fit = _known_forces(rows, child.columns, fit)
         if child_fit is None:
             child_fit = _fitted_forces(rows, child.columns)
         if child_fit is None:
@@ -1107,10 +1110,11 @@ class _ModeFilter:
 
     @classmethod
     def of(cls, rows: _Rows, modes: tuple[_Mode, ...]) -> _ModeFilter:
-        union = sorted({int(r) for mode in modes for r in (*mode.equal, *mode.at_least)})
+        # From the modes' bit sets: iterating their index arrays reads numpy scalars one by one (~20x slower).
+        union = _indices(functools.reduce(lambda bits, mode: bits | mode.equal_bits | mode.at_least_bits, modes, 0))
         where = {r: j for j, r in enumerate(union)}
-        equal = tuple([where[int(r)] for r in mode.equal] for mode in modes)
-        at_least = tuple([where[int(r)] for r in mode.at_least] for mode in modes)
+        equal = tuple([where[r] for r in _indices(mode.equal_bits)] for mode in modes)
+        at_least = tuple([where[r] for r in _indices(mode.at_least_bits)] for mode in modes)
         return cls(rows.bank[union], rows.rhs[union], rows.norms[union], equal, at_least)
 
 
@@ -1146,13 +1150,8 @@ def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
     the margin, or None with a checked Farkas vector (kept in ``rows.farkas``: it may exclude the next nodes'
     columns too); a fit that does neither is returned (the node is not excluded)."""
     rows.proof.fits += 1
-    index = rows.columns(columns)
-    G = rows.loads[:, index]
-    lam = np.zeros(index.size)
-    if G.shape[1]:
-        lam[index], residual = nnls(G, -rows.g)
-    else:
-        residual = float(np.linalg.norm(rows.g))
+    lam = np.empty(rows.loads.shape[1])
+    residual = nonnegative_fit(rows.loads, rows.columns(columns), rows.target, lam)
     found = _Fit(lam, _bits(lam > 0.0))
     if residual <= _margin(rows):
         rows.fits.add(found)
@@ -1172,7 +1171,11 @@ class _Fits:
 
     def usable(self, columns: int) -> _Fit | None:
         """A kept fit that uses only ``columns`` (bits), or None."""
-        return next((fit for fit in self.kept if not fit.support & ~columns), None)
+        others = ~columns
+        for fit in self.kept:
+            if not fit.support & others:
+                return fit
+        return None
 
 
 @dataclass
@@ -1195,7 +1198,7 @@ class _FarkasVectors:
 
     def add(self, y: np.ndarray, columns: int) -> bool:
         """Keep ``y`` when it excludes ``columns`` (bits; then True)."""
-        reserve = -float(self.g @ y) - self.margin * float(np.linalg.norm(y))
+        reserve = -float(self.g @ y) - self.margin * math.sqrt(float(y @ y))  # np.linalg.norm's arithmetic, less its overhead
         if not reserve > 0.0:
             return False
         blockers = _bits(self.loads.T @ y * FORCE_CEILING >= reserve)
@@ -1273,10 +1276,9 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
         interval = _interval(closed, (-math.inf, math.inf), node.at_least)
         return _PRUNED if interval is None else _line(rows, closed, *interval)
     at_least = rows.row_mask(node.at_least)
-    reserve = closed.reserve[at_least]
     if plane:
-        return _on_plane(rows, closed, rows.bank[at_least] @ closed.plane.T, reserve)
-    if (reserve < 0.0).any():
+        return _on_plane(rows, closed, at_least, node.at_least.bit_count())
+    if (closed.reserve[at_least] < 0.0).any():
         return _PRUNED  # an open gap or slip sign fails on the whole set
     if _near_seed(rows, closed.q0, closed.q0, closed.spread):
         return _PRUNED
@@ -1320,7 +1322,7 @@ def _interval(closed: _ClosedSet, interval: tuple[float, float], at_least: int) 
 
 
 def _indices(bits: int) -> list[int]:
-    """The positions of a bit set's bits (few: a node's new rows)."""
+    """The positions of a bit set's bits, ascending (few: a node's new rows, a node's modes' rows)."""
     index = []
     while bits:
         low = bits & -bits
@@ -1333,20 +1335,20 @@ def _indices(bits: int) -> list[int]:
 class _ClosedSet:
     """The twists the closed rows leave: ``q0`` (a point, or a point of the line ``q0 + t direction``), within
     ``radius`` (2-norm) and ``spread`` (per entry) of the loosened and the ``ZERO``-exact sets; for every bank row,
-    its best slack at ``q0`` (``reserve``) and its rate along the line (``slope``, None for a point)."""
+    its best slack at ``q0`` (``reserve``) and its rates along the line or plane (``row_rates``, ``plane_rates``)."""
 
     q0: np.ndarray
     radius: float
     spread: np.ndarray
     reserve: np.ndarray
     direction: np.ndarray
-    slope: np.ndarray | None
     plane: np.ndarray  # (2, n): orthonormal directions of what ``n - 2`` rows leave (the last two of E's full ``vt``)
     free: int  # the dimension of what the closed rows leave: 0 a point, 1 a line, 2 a plane
     # The same per bank row as plain floats, read a few at a time by :func:`_narrowed`: ``reserve``, and the
-    # row's rate along the line (``slope``) or along each of the plane's directions (on ``n - 2`` rows); else empty.
+    # row's rate along the line or along each of the plane's directions (on ``n - 2`` rows); else empty.
     row_reserve: list[float]
     row_rates: tuple[list[float], ...]
+    plane_rates: np.ndarray  # (rows, 2): each bank row's rate along the plane's two directions (on n - 2 rows)
 
 
 def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
@@ -1382,18 +1384,24 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
         return _PRUNED
     spread = ZERO * np.abs(pseudo_inverse).sum(axis=1)  # as far as a twist meeting the rows as the seed does may lie
     radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
-    # Each bank row's best slack at q0 (t = 0 on a line), every row loosened by LP_FEASIBILITY.
+    # Each bank row's best slack at q0 (t = 0 on a line), every row loosened by LP_FEASIBILITY; the rows of
+    # |bank E+| summed by a product (numpy's sum along a short axis costs 4x more).
     bank = rows.bank
-    reserve = bank @ q0 + LP_FEASIBILITY * np.abs(bank @ pseudo_inverse).sum(axis=1) - rows.rhs + LP_FEASIBILITY
-    direction = vt[-1]
+    reach = np.abs(bank @ pseudo_inverse) @ np.ones(k)
+    reserve = bank @ q0 + LP_FEASIBILITY * reach - rows.rhs + LP_FEASIBILITY
     free = n - r
-    slope = bank @ direction if free else None
     rates: tuple[list[float], ...] = ()  # for a line or a plane only (a point's children keep it)
-    if free == 1 and slope is not None:
-        rates = (slope.tolist(),)
+    plane_rates = _NO_RATES
+    if free == 1:
+        rates = ((bank @ vt[-1]).tolist(),)
     elif free == 2:
-        rates = ((bank @ vt[-2]).tolist(), (bank @ vt[-1]).tolist())
-    return _ClosedSet(q0, radius, spread, reserve, direction, slope, vt[-2:], free, reserve.tolist() if rates else [], rates)
+        plane_rates = bank @ vt[-2:].T
+        rates = (plane_rates[:, 0].tolist(), plane_rates[:, 1].tolist())
+    row_reserve = reserve.tolist() if rates else []
+    return _ClosedSet(q0, radius, spread, reserve, vt[-1], vt[-2:], free, row_reserve, rates, plane_rates)
+
+
+_NO_RATES = np.zeros((0, 2))  # a closed set's plane rates where it leaves no plane
 
 
 def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
@@ -1409,39 +1417,22 @@ def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
     return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + closed.radius), shape=shape)
 
 
-def _on_plane(rows: _Rows, closed: _ClosedSet, slope: np.ndarray, reserve: np.ndarray) -> _Twists:
-    """Twists ``q0 + P^T x`` (``P``: the closed set's plane, ``x`` in R^2) with ``slope x + reserve >= 0`` for every
-    inequality row: a polygon, decided exactly in the plane.
+def _on_plane(rows: _Rows, closed: _ClosedSet, at_least: np.ndarray, count: int) -> _Twists:
+    """Twists ``q0 + P^T x`` (``P``: the closed set's plane, ``x`` in R^2) with ``rate x + reserve >= 0`` for each of
+    the ``count`` inequality rows ``at_least`` (a mask of the bank's): a polygon, decided exactly in the plane.
 
     It is bounded when its rows' normals leave no angle of ``pi`` or more between neighbours (they positively
     span the plane); then it is the hull of its vertices, the intersections of two of its lines that meet every
     row (with round-off's leniency): none means it is empty. Lines closer to parallel than :data:`_PARALLEL`
     meet far away or not at all; between that and :data:`_SKEW` a vertex is too close to call (no bound given).
     """
-    norms = np.sqrt(slope[:, 0] ** 2 + slope[:, 1] ** 2)
-    flat = norms == 0.0
-    if flat.any():
-        if (reserve[flat] < 0.0).any():
-            return _PRUNED
-        slope, reserve, norms = slope[~flat], reserve[~flat], norms[~flat]
-    angles = np.sort(np.arctan2(slope[:, 1], slope[:, 0]))
-    if angles.size < 3 or max(float(np.max(np.diff(angles))), float(angles[0] + 2.0 * np.pi - angles[-1])) >= np.pi - _SKEW:
+    vertices = np.empty((count * (count - 1) // 2, 2))
+    found = polygon_vertices(closed.plane_rates, closed.reserve, at_least, _PARALLEL, _SKEW, ROUNDOFF_SLACK, vertices)
+    if found == UNBOUNDED:
         return _UNKNOWN  # unbounded (or too close to call)
-    i, j = _pairs(angles.size)
-    a, b, c, d = slope[i, 0], slope[i, 1], slope[j, 0], slope[j, 1]
-    det = a * d - b * c
-    sine = np.abs(det) / (norms[i] * norms[j])
-    meet = sine >= _SKEW
-    if np.any(~meet & (sine > _PARALLEL)):
-        return _UNKNOWN
-    a, b, c, d, det, ri, rj = a[meet], b[meet], c[meet], d[meet], det[meet], reserve[i[meet]], reserve[j[meet]]
-    points = np.stack([(b * rj - d * ri) / det, (c * ri - a * rj) / det])  # (2, P): where two lines meet
-    values = slope @ points + reserve[:, None]
-    lenient = ROUNDOFF_SLACK * (norms[:, None] * np.sqrt(points[0] ** 2 + points[1] ** 2) + np.abs(reserve)[:, None])
-    vertices = points[:, (values >= -lenient).all(axis=0)].T
-    if not vertices.size:
+    if found == 0:
         return _PRUNED
-    return _polygon(rows, closed, [(x, y) for x, y in vertices.tolist()])
+    return _polygon(rows, closed, [(x, y) for x, y in vertices[:found].tolist()])
 
 
 def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Vertices:
@@ -1473,12 +1464,6 @@ def _polygon(rows: _Rows, closed: _ClosedSet, vertices: _Vertices) -> _Twists:
     center = 0.5 * (twists.min(axis=0) + twists.max(axis=0))
     reach = math.sqrt(float(((twists - center) ** 2).sum(axis=1).max()))
     return _Twists(False, _Ball(center, reach * (1.0 + ROUNDOFF_SLACK) + closed.radius), shape=_Shape(closed, vertices=vertices))
-
-
-@functools.cache
-def _pairs(count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Every pair ``i < j`` of ``count`` indices."""
-    return np.triu_indices(count, 1)
 
 
 def _all_near_seed(rows: _Rows, twists: np.ndarray, spread: np.ndarray) -> bool:
