@@ -127,18 +127,10 @@ def assemble(scene: Scene) -> Problem:
     """
     if not (HAVE_KERNELS and scene.contacts):
         return assemble_numpy(scene)
-    dim, k = scene.dimension, scene.twist_size
-    contacts, bodies = scene.contacts, scene.bodies
-    m, n_bodies = len(contacts), len(bodies)
-    index = {body.name: i for i, body in enumerate(bodies)}
-    normals = np.array([c.normal for c in contacts], dtype=float).reshape(m, dim)
-    points = np.array([c.point for c in contacts], dtype=float).reshape(m, dim)
-    coms = np.array([body.com for body in bodies], dtype=float).reshape(n_bodies, dim)
-    owners = np.array([index[c.body] for c in contacts], dtype=np.int64)
-    others = np.array([index.get(c.other, -1) for c in contacts], dtype=np.int64)  # -1: a mover
-    wrenches = np.array([body.wrench for body in bodies], dtype=float).reshape(n_bodies, k)  # a Scene fills every wrench
+    bodies = scene.bodies
+    wrenches = np.array([body.wrench for body in bodies], dtype=float).reshape(len(bodies), scene.twist_size)  # a Scene fills each
     masses = np.array([body.mass for body in bodies], dtype=float)
-    laws = compiled_assemble(normals, points, coms, owners, others, *mover_parts(scene), wrenches, masses, scene.gravity, SMALLEST_LENGTH)
+    laws = compiled_assemble(*_contact_numbers(scene), *mover_parts(scene), wrenches, masses, scene.gravity, SMALLEST_LENGTH)
     frames, J, b, g, origin, (length, force, velocity) = laws
     origin.setflags(write=False)
     scales = Scales(length=length, force=force, velocity=velocity, origin=origin)
@@ -151,16 +143,13 @@ def assemble_numpy(scene: Scene) -> Problem:
     movers = mover_point_velocities(scene)
     scales = scene_scales(scene, movers)
     L, V = scales.length, scales.velocity
-    m, n_bodies = len(scene.contacts), len(scene.bodies)
-    index = {body.name: i for i, body in enumerate(scene.bodies)}
-    coms = (np.array([body.com for body in scene.bodies], dtype=float).reshape(n_bodies, dim) - scales.origin) / L
-    points = (np.array([c.point for c in scene.contacts], dtype=float).reshape(m, dim) - scales.origin) / L
-    frames = contact_frames(np.array([c.normal for c in scene.contacts], dtype=float).reshape(m, dim))
+    normals, points, coms, body, other = _contact_numbers(scene)
+    m, n_bodies = len(normals), len(coms)
+    coms, points = (coms - scales.origin) / L, (points - scales.origin) / L
+    frames = contact_frames(normals)
     J = np.zeros((m, dim, k * n_bodies))
     rows = np.arange(m)
-    body = np.array([index[c.body] for c in scene.contacts], dtype=int)
     _add_blocks(J, rows, body, _twist_rows(frames, points - coms[body]), k)
-    other = np.array([index.get(c.other, -1) for c in scene.contacts], dtype=int)
     pair = other >= 0  # a contact between two free bodies: the other body's motion counts against
     if n_bodies > 1 and pair.any():  # (one free body touches only movers: skip four empty numpy calls)
         _add_blocks(J, rows[pair], other[pair], -_twist_rows(frames[pair], points[pair] - coms[other[pair]]), k)
@@ -169,6 +158,19 @@ def assemble_numpy(scene: Scene) -> Problem:
         b += frames[:, :, j] * movers[:, None, j]
     g = np.concatenate([scene.load(body) / scales.wrench_units(dim) for body in scene.bodies])
     return Problem(scene, frames, J, b / V, g, _friction_coefficients(scene), scene.friction, scales)
+
+
+def _contact_numbers(scene: Scene) -> tuple[FloatArray, FloatArray, FloatArray, np.ndarray, np.ndarray]:
+    """World normals and points (m, d), the bodies' coms (bodies, d), and each contact's body and other body as
+    indices into the bodies (-1: a mover), as both assemblies read them."""
+    dim, contacts, bodies = scene.dimension, scene.contacts, scene.bodies
+    index = {body.name: i for i, body in enumerate(bodies)}
+    normals = np.array([c.normal for c in contacts], dtype=float).reshape(len(contacts), dim)
+    points = np.array([c.point for c in contacts], dtype=float).reshape(len(contacts), dim)
+    coms = np.array([body.com for body in bodies], dtype=float).reshape(len(bodies), dim)
+    owners = np.array([index[c.body] for c in contacts], dtype=np.int64)
+    others = np.array([index.get(c.other, -1) for c in contacts], dtype=np.int64)
+    return normals, points, coms, owners, others
 
 
 def _friction_coefficients(scene: Scene) -> FloatArray:
