@@ -414,3 +414,24 @@ def test_assembly_kernel_refuses_what_it_cannot_read() -> None:
         compiled.assemble_scene(normals, np.zeros((m + 1, d)), coms, owners, others, *movers, *loads, 1e-150)
     with pytest.raises(ValueError, match="m >= 1"):
         compiled.assemble_scene(np.zeros((0, d)), points[:0], coms, owners[:0], others[:0], *(a[:0] for a in movers), *loads, 1e-150)
+
+
+@needs_kernels
+def test_stacked_rows_are_numpys_array_of_them(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``stack_rows`` copies contiguous float rows in C, gives numpy's array where a row is not one (a strided view,
+    another length, integers), and numpy's everywhere when the extension was not built."""
+    rows = [np.array([1.5, -0.0, 2.0]), np.arange(3.0), np.linspace(0.0, 1.0, 6)[::2]]
+    stacked = compiled.stack_rows(rows, 3)
+    np.testing.assert_array_equal(stacked, np.array(rows))
+    assert np.signbit(stacked[0, 1]) and stacked.flags.c_contiguous
+    assert compiled.stack_rows([], 3).shape == (0, 3)
+    out = np.empty((1, 3))
+    with pytest.raises(ValueError, match="a row must have 1 dimensions"):
+        compiled.kernels.stack_rows([np.ones(2)], out)
+    with pytest.raises(ValueError, match="a row must be a C-contiguous float64"):
+        compiled.kernels.stack_rows([np.arange(3)], out)
+    with pytest.raises(TypeError, match="rows must be a sequence"):
+        compiled.kernels.stack_rows(7, out)
+    np.testing.assert_array_equal(compiled.stack_rows([np.arange(3)], 3), [[0.0, 1.0, 2.0]])  # integers: numpy's copy
+    monkeypatch.setattr(compiled, "kernels", None)
+    np.testing.assert_array_equal(compiled.stack_rows(rows, 3), np.array(rows))

@@ -21,6 +21,8 @@
  *       laws/assemble.py::assemble_numpy from the scene's numbers: the movers' point velocities, the scales
  *       (model/scales.py), each contact's frame, rows of J and b, and the loads g; frames, J (zeros on
  *       entry), b and g_and_scales (g, then the origin, length, force and velocity) are filled.
+ *   stack_rows(rows, out) -> None
+ *       numpy's array() of a list of 1-D float arrays of one width, into out (len(rows), width).
  *   nonnegative_fit(A, keep, b, x) -> residual
  *       solvers/numerics/nnls.py::nonnegative_fit: non-negative least squares on the kept columns of A
  *       (Lawson and Hanson's method, Householder reflections), x (N,) filled; |A x - b| returned.
@@ -577,6 +579,39 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- gathering a scene's vectors */
+
+/* stack_rows(rows, out): each item of the sequence `rows` (a 1-D C-contiguous float64 buffer of out's width)
+ * copied into its row of out (len(rows), width); numpy's array() of a list of small arrays costs ~10x more. */
+static PyObject *stack_rows(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "stack_rows(rows, out) takes 2 arguments");
+        return NULL;
+    }
+    PyObject *items = PySequence_Fast(args[0], "rows must be a sequence");
+    if (items == NULL) return NULL;
+    Buffers b = {.taken = 0};
+    PyObject *result = NULL;
+    const Py_ssize_t count = PySequence_Fast_GET_SIZE(items);
+    Py_ssize_t out[2] = {count, -1};
+    if (take_next(&b, args[1], "out", FLOATS, 1, 2, out) < 0) goto done;
+    double *target = b.views[0].buf;
+    PyObject **row = PySequence_Fast_ITEMS(items);
+    for (Py_ssize_t i = 0; i < count; i++) {
+        Py_ssize_t width[1] = {out[1]};
+        Py_buffer view;
+        if (take(row[i], &view, "a row", FLOATS, 0, 1, width) < 0) goto done;
+        memcpy(target + i * out[1], view.buf, (size_t)out[1] * sizeof(double));
+        PyBuffer_Release(&view);
+    }
+    result = Py_NewRef(Py_None);
+done:
+    release(&b);
+    Py_DECREF(items);
+    return result;
+}
+
 /* ---------------------------------------------------------------- assembly */
 
 static inline void cross3(const double *a, const double *b, double *out) {
@@ -1034,6 +1069,9 @@ static PyMethodDef methods[] = {
     {"drop_roundoff", (PyCFunction)(void (*)(void))drop_roundoff, METH_FASTCALL,
      "drop_roundoff(values, roundoff): entries of values (rows, c) within roundoff[j] of zero set to 0, in place.\n"
      "See quasistatic.check.motion."},
+    {"stack_rows", (PyCFunction)(void (*)(void))stack_rows, METH_FASTCALL,
+     "stack_rows(rows, out): copies each row (a 1-D float64 array of out's width) into out (len(rows), width).\n"
+     "See quasistatic.laws.assemble."},
     {"assemble_scene", (PyCFunction)(void (*)(void))assemble_scene, METH_FASTCALL,
      "assemble_scene(normals, points, coms, owners, others, twists, origins, places, driven, wrenches, masses, gravity,\n"
      "smallest_length, frames, J, b, g_and_scales): a scene's scales and contact laws, the numpy assembly's arithmetic;\n"

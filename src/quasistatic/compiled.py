@@ -10,7 +10,8 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
 ``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`nonnegative_fit`,
 ``solvers/numerics/nnls.py::nonnegative_fit``; :func:`polygon_vertices`, ``solvers/numerics/polygon.py::polygon_vertices``;
-:func:`assemble_scene`, ``laws/assemble.py::assemble_numpy``).
+:func:`assemble_scene`, ``laws/assemble.py::assemble_numpy``; :func:`stack_rows`, numpy's ``array`` of small
+vectors).
 Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
 kernels' choices in the kernels' order of arithmetic. ``_lemke`` also runs the fast path's whole kernel
@@ -22,6 +23,7 @@ from __future__ import annotations
 
 import importlib
 import warnings
+from collections.abc import Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -61,6 +63,7 @@ __all__ = [
     "nonnegative_fit",
     "polygon_vertices",
     "assemble_scene",
+    "stack_rows",
 ]
 
 HAVE_EXTENSION = extension is not None
@@ -383,3 +386,17 @@ def assemble_scene(
     kernels.assemble_scene(*floats, *indices, *rest, smallest_length, frames, J, b, out)
     g, scales = out[: k * bodies], out[k * bodies :]
     return frames, J, b, g, scales[:d].copy(), (float(scales[d]), float(scales[d + 1]), float(scales[d + 2]))
+
+
+def stack_rows(rows: Sequence[np.ndarray], width: int) -> np.ndarray:
+    """``np.array(rows, dtype=float)`` of 1-D float vectors of length ``width``, (len(rows), width), copied in C
+    (numpy's conversion of a list of small arrays costs ~10x more); numpy's where the extension was not built or a
+    row is not a C-contiguous float64 vector of that length."""
+    out = np.empty((len(rows), width))
+    if kernels is None:  # not built: numpy's, the same numbers
+        return np.array(rows, dtype=float).reshape(len(rows), width)
+    try:
+        kernels.stack_rows(rows, out)
+    except ValueError:
+        return np.array(rows, dtype=float).reshape(len(rows), width)
+    return out

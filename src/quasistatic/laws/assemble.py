@@ -14,7 +14,7 @@ from typing import Any, TypeVar, cast
 
 import numpy as np
 
-from ..compiled import HAVE_KERNELS
+from ..compiled import HAVE_KERNELS, stack_rows
 from ..compiled import assemble_scene as compiled_assemble
 from ..model import FloatArray, FrictionModel, Scales, Scene, scene_scales
 from ..model.kinematics import contact_frames, cross, mover_parts, mover_point_velocities
@@ -128,7 +128,7 @@ def assemble(scene: Scene) -> Problem:
     if not (HAVE_KERNELS and scene.contacts):
         return assemble_numpy(scene)
     bodies = scene.bodies
-    wrenches = np.array([body.wrench for body in bodies], dtype=float).reshape(len(bodies), scene.twist_size)  # a Scene fills each
+    wrenches = stack_rows([cast(FloatArray, body.wrench) for body in bodies], scene.twist_size)  # a Scene fills each
     masses = np.array([body.mass for body in bodies], dtype=float)
     laws = compiled_assemble(*_contact_numbers(scene), *mover_parts(scene), wrenches, masses, scene.gravity, SMALLEST_LENGTH)
     frames, J, b, g, origin, (length, force, velocity) = laws
@@ -165,9 +165,9 @@ def _contact_numbers(scene: Scene) -> tuple[FloatArray, FloatArray, FloatArray, 
     indices into the bodies (-1: a mover), as both assemblies read them."""
     dim, contacts, bodies = scene.dimension, scene.contacts, scene.bodies
     index = {body.name: i for i, body in enumerate(bodies)}
-    normals = np.array([c.normal for c in contacts], dtype=float).reshape(len(contacts), dim)
-    points = np.array([c.point for c in contacts], dtype=float).reshape(len(contacts), dim)
-    coms = np.array([body.com for body in bodies], dtype=float).reshape(len(bodies), dim)
+    normals = stack_rows([c.normal for c in contacts], dim)
+    points = stack_rows([c.point for c in contacts], dim)
+    coms = stack_rows([body.com for body in bodies], dim)
     owners = np.array([index[c.body] for c in contacts], dtype=np.int64)
     others = np.array([index.get(c.other, -1) for c in contacts], dtype=np.int64)
     return normals, points, coms, owners, others

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..compiled import stack_rows
 from .scene import Contact, FloatArray, Scene
 
 __all__ = ["contact_frames", "cross", "mover_parts", "mover_point_velocity", "mover_point_velocities"]
@@ -69,19 +70,21 @@ def mover_parts(scene: Scene) -> tuple[FloatArray, FloatArray, FloatArray, Float
     zero rows where they do not apply (a body-body contact has all four zero)."""
     movers = {m.name: m for m in scene.movers}
     d, k = scene.dimension, scene.twist_size
-    m = len(scene.contacts)
-    twists, origins, places = np.zeros((m, k)), np.zeros((m, d)), np.zeros((m, d))
-    driven = np.zeros((m, d))
-    for i, contact in enumerate(scene.contacts):
+    no_twist, no_point = np.zeros(k), np.zeros(d)
+    twists, origins, places, driven = [], [], [], []  # rows, stacked at the end (cheaper than filling arrays row by row)
+    for contact in scene.contacts:
         mover = movers.get(contact.other)
-        if mover is None:
-            continue
-        if mover.robot is not None:
-            driven[i] = mover_point_velocity(scene, contact)
-        else:
+        twist, origin, place, through_joints = no_twist, no_point, no_point, no_point
+        if mover is not None and mover.robot is not None:
+            through_joints = mover_point_velocity(scene, contact)
+        elif mover is not None:
             assert mover.twist is not None and mover.origin is not None  # filled in by the Scene
-            twists[i], origins[i], places[i] = mover.twist, mover.origin, contact.point
-    return twists, origins, places, driven
+            twist, origin, place = mover.twist, mover.origin, contact.point
+        twists.append(twist)
+        origins.append(origin)
+        places.append(place)
+        driven.append(through_joints)
+    return stack_rows(twists, k), stack_rows(origins, d), stack_rows(places, d), stack_rows(driven, d)
 
 
 def cross(a: FloatArray, b: FloatArray) -> FloatArray:
