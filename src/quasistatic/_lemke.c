@@ -317,12 +317,22 @@ static void sliding_friction(const Laws *L, Py_ssize_t i, double cn, Py_ssize_t 
     const double k = -mu * cn / speed;
     for (Py_ssize_t s = 0; s < t; s++) L->forces[i * L->d + s] = -mu * cn * e[s];
     if (L->jacobian == NULL) return;
+    /* The kernel's factors of each term, computed once rather than in its innermost loop: the same values, the same sums. */
+    double pull[2], bend[2][2];
+    for (Py_ssize_t s = 0; s < t; s++) {
+        pull[s] = -mu * e[s];
+        for (Py_ssize_t r = 0; r < t; r++) bend[s][r] = k * ((s == r ? 1.0 : 0.0) - e[s] * e[r]);
+    }
     for (Py_ssize_t j = 0; j < n; j++) {
-        for (Py_ssize_t s = 0; s < t; s++) L->jacobian[j * size + col] += Ji[s * n + j] * (-mu * e[s]);
+        double left[2][2]; /* each term's first product, Ji[s, j] bend[s][r] */
+        for (Py_ssize_t s = 0; s < t; s++) {
+            L->jacobian[j * size + col] += Ji[s * n + j] * pull[s];
+            for (Py_ssize_t r = 0; r < t; r++) left[s][r] = Ji[s * n + j] * bend[s][r];
+        }
         for (Py_ssize_t k2 = 0; k2 < n; k2++) {
             double total = 0.0;
             for (Py_ssize_t s = 0; s < t; s++)
-                for (Py_ssize_t r = 0; r < t; r++) total += Ji[s * n + j] * (k * ((s == r ? 1.0 : 0.0) - e[s] * e[r])) * Ji[r * n + k2];
+                for (Py_ssize_t r = 0; r < t; r++) total += left[s][r] * Ji[r * n + k2];
             L->jacobian[j * size + k2] += total;
         }
     }
@@ -665,8 +675,10 @@ static void newton_step(Split *s, Py_ssize_t size) {
     for (Py_ssize_t i = 0; i < size; i++) {
         gradient[i] = 0.0;
         for (Py_ssize_t k = 0; k < size; k++) {
-            gradient[i] -= jac[k * size + i] * res[k];
-            for (Py_ssize_t j = i; j < size; j++) normal[i * size + j] += jac[k * size + i] * jac[k * size + j];
+            const double a = jac[k * size + i];
+            if (a == 0.0) continue; /* a force column is zero in the contacts' rows: x - 0 y is x for finite y, +0 + -0 is +0 */
+            gradient[i] -= a * res[k];
+            for (Py_ssize_t j = i; j < size; j++) normal[i * size + j] += a * jac[k * size + j];
         }
         /* J^T J is symmetric: row i left of the diagonal is column i above it, summed over k in the same order of
          * the same products (a b = b a exactly), so copied, not summed again. */
