@@ -21,10 +21,10 @@ refinement that did not converge), a complete method takes over. A ray is no
 proof that no motion exists: Lemke's path reaches only solutions of index +1
 (``sgn det M_SS``), and some scenes' motions all have index -1 (docs/performance.md).
 On exact 3-D cones the point where the path ended is tried first as a start of
-Newton's method, as above (with quick mode switches, then with the contacts the
-path held closed, penetrating by its artificial variable, closed: it converges on
-some scenes whose pyramid LCP has no solution Lemke reaches; a motion it returns
-keeps every mode and inequality).
+Newton's method, as above (with quick mode switches, then quick rounds that switch
+one contact at a time, then with the contacts the path held closed, penetrating by
+its artificial variable, closed: it converges on some scenes whose pyramid LCP has
+no solution Lemke reaches; a motion it returns keeps every mode and inequality).
 
 - One planar body: a motion at a vertex of the contacts' gap-rate and slip
   planes (:func:`~.certify.arrangement.motion_vertex`); where no vertex holds
