@@ -11,7 +11,6 @@ is installed, else the numpy twin (itself checked against the kernel in ``test_f
 
 from __future__ import annotations
 
-import itertools
 import os
 import subprocess
 import sys
@@ -407,8 +406,8 @@ def test_the_extensions_newton_is_the_numba_kernels() -> None:
     verdicts = set()
     for name, data, q, c in _newton_starts():
         depth = max(0.0, -float((data.J[:, 2] @ q - data.b[:, 2]).min()))  # the penetration Lemke's point allows (a ray's)
-        starts = ((0.0, lcp.NEWTON_ITERATIONS), (depth, lcp.NEWTON_ITERATIONS), (depth, lcp.QUICK_PATIENCE), (0.0, lcp.QUICK_PATIENCE))
-        for (start_depth, patience), one_switch in itertools.product(starts, (False, True)):
+        every_switch = ((0.0, lcp.NEWTON_ITERATIONS, False), (depth, lcp.NEWTON_ITERATIONS, False), (depth, lcp.QUICK_PATIENCE, False))
+        for start_depth, patience, one_switch in (*every_switch, (0.0, lcp.QUICK_PATIENCE, True), (depth, lcp.NEWTON_ITERATIONS, True)):
             arguments = (data.J, data.b, data.mu, data.g, q, c, start_depth, patience, one_switch, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
             got, want = lcp._newton_compiled(*arguments), lcp._newton(*arguments)
             assert got[0] == want[0], name
