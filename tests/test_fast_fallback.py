@@ -290,15 +290,48 @@ def test_newton_from_the_rays_last_point_answers_grasp_3d_6_3(monkeypatch: pytes
         assert np.allclose(twist, _twist(problem, other.twists), rtol=0.0, atol=1e-9 * np.abs(twist).max())
 
 
+def _without_one_switch(patch: pytest.MonkeyPatch) -> None:
+    """The fast path's Newton starts from Lemke's end without the one that switches one contact a round."""
+    exact_from = fast._exact_from
+
+    def every_switch(
+        problem: qs.Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0, patience: int = NEWTON_ITERATIONS, one_switch: bool = False
+    ) -> RawMotion | None:
+        return None if one_switch else exact_from(problem, q, c, depth, patience)
+
+    patch.setattr(fast, "_exact_from", every_switch)
+
+
+def test_newton_switching_one_contact_a_round_answers_grasp_3d_8_0(monkeypatch: pytest.MonkeyPatch) -> None:
+    """grasp-3d 8 #0: from Lemke's ray point, Newton's quick rounds that switch every contact that must switch fail
+    (the first round ends with three closed contacts pulling, all opened at once); a round that switches only the
+    first of them reaches, in one switch, the motion that the full rounds from the ray's depth reach in ~1,000
+    evaluations of the laws (one of the scene's two motions, the one the mode branch and bound gave before)."""
+    problem = qs.assemble(FAMILIES["grasp-3d"].make(8, 0))
+    assert lemke_motion(problem)[0] == RAY
+    answer = qs.solve(problem, method="fast")
+    notes = dict(answer.notes)
+    assert answer.status == "solved" and notes["method"] == FROM_LEMKE_END, answer.message
+    assert notes["newton_switches"] == "first" and notes["newton_patience"] == QUICK_PATIENCE
+    assert answer.motion is not None and answer.motion.audit.passed and not answer.certified
+    with monkeypatch.context() as patch:
+        _without_one_switch(patch)
+        full_rounds = qs.solve(problem, method="fast")
+    assert dict(full_rounds.notes)["newton_patience"] == NEWTON_ITERATIONS and dict(full_rounds.notes)["newton_switches"] == "all"
+    twist = _twist(problem, answer.twists)
+    assert np.allclose(twist, _twist(problem, full_rounds.twists), rtol=0.0, atol=1e-9 * np.abs(twist).max())
+
+
 def test_newton_from_the_rays_last_point_with_its_depth_answers_grasp_3d_8_0(monkeypatch: pytest.MonkeyPatch) -> None:
-    """grasp-3d 8 #0: Lemke's ray point solves the laws with every gap rate raised by the artificial variable, so
-    the contacts the path holds closed penetrate by it. Newton's method started with those contacts closed
-    reaches the motion the mode branch and bound gave before (one of its two; ~100x slower); read with no depth
-    (those contacts open), it fails and the branch and bound answers."""
+    """grasp-3d 8 #0 without the start that switches one contact a round: Lemke's ray point solves the laws with
+    every gap rate raised by the artificial variable, so the contacts the path holds closed penetrate by it.
+    Newton's method started with those contacts closed reaches the motion the mode branch and bound gave before
+    (one of its two; ~100x slower); read with no depth (those contacts open), it fails and the branch and bound answers."""
     scene = FAMILIES["grasp-3d"].make(8, 0)
     problem = qs.assemble(scene)
     status, _, q, _, _, _ = lemke_motion(problem)
     assert status == RAY and lemke_depth(problem, q) > 0.0
+    _without_one_switch(monkeypatch)
     answer = qs.solve(problem, method="fast")
     assert answer.status == "solved" and dict(answer.notes)["method"] == FROM_LEMKE_END, answer.message
     assert dict(answer.notes)["newton_patience"] == NEWTON_ITERATIONS  # quick mode switches miss this one

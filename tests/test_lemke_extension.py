@@ -401,12 +401,14 @@ def _newton_starts() -> Iterator[tuple[str, lcp.LemkeInputs, np.ndarray, np.ndar
 @needs_extension
 @pytest.mark.skipif(not HAVE_NUMBA, reason="the reference is the numba kernel")
 def test_the_extensions_newton_is_the_numba_kernels() -> None:
-    """The same verdict and the same point to 1e-9 relative (the same loops: in practice to the bit), converged or not."""
+    """The same verdict and the same point to 1e-9 relative (the same loops: in practice to the bit), converged or not,
+    with every contact that must switch switched after a round, or only the first."""
     verdicts = set()
     for name, data, q, c in _newton_starts():
         depth = max(0.0, -float((data.J[:, 2] @ q - data.b[:, 2]).min()))  # the penetration Lemke's point allows (a ray's)
-        for start_depth, patience in ((0.0, lcp.NEWTON_ITERATIONS), (depth, lcp.NEWTON_ITERATIONS), (depth, lcp.QUICK_PATIENCE)):
-            arguments = (data.J, data.b, data.mu, data.g, q, c, start_depth, patience, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
+        every_switch = ((0.0, lcp.NEWTON_ITERATIONS, False), (depth, lcp.NEWTON_ITERATIONS, False), (depth, lcp.QUICK_PATIENCE, False))
+        for start_depth, patience, one_switch in (*every_switch, (0.0, lcp.QUICK_PATIENCE, True), (depth, lcp.NEWTON_ITERATIONS, True)):
+            arguments = (data.J, data.b, data.mu, data.g, q, c, start_depth, patience, one_switch, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
             got, want = lcp._newton_compiled(*arguments), lcp._newton(*arguments)
             assert got[0] == want[0], name
             for g, w in ((got[1], want[1]), (got[2], want[2])):
@@ -430,7 +432,7 @@ def test_exact_newton_runs_the_extensions_newton(monkeypatch: pytest.MonkeyPatch
 def test_the_extensions_newton_checks_its_arrays() -> None:
     data = qs.assemble(FAMILIES["grasp-3d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
     q, c = np.zeros(data.J.shape[2]), np.zeros(data.J.shape[:2])
-    tolerances = (0.0, lcp.NEWTON_ITERATIONS, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
+    tolerances = (0.0, lcp.NEWTON_ITERATIONS, False, lcp.MODE_SPEED, lcp.FRICTION_ALIGNMENT)
     with pytest.raises(ValueError, match=r"J must have shape \(m, 3, n\)"):
         lcp._newton_compiled(data.J[:, 1:], data.b[:, 1:], data.mu, data.g, q, c[:, 1:], *tolerances)
     with pytest.raises(ValueError, match="b must have shape"):

@@ -10,12 +10,12 @@
  *   lemke_address
  *       The address of quasistatic_lemke, the same method on raw pointers (no Python objects):
  *       the numba install's kernels call it from compiled code.
- *   exact_newton(J, b, mu, g, q, c, depth, patience, mode_tol, tol, cone_roundoff, newton_damping, newton_stop, q_out, c_out)
- *       -> bool
+ *   exact_newton(J, b, mu, g, q, c, depth, patience, one_switch, mode_tol, tol, cone_roundoff, newton_damping, newton_stop,
+ *                q_out, c_out) -> bool
  *       Newton's method on the exact 3-D fixed-mode laws from (q, c), solvers/numerics/lcp.py::_newton step
  *       for step (the kernel's own Newton, called alone); q_out (n,) and c_out (m, 3) are filled.
  *   api_version
- *       5; quasistatic/compiled.py runs without a .so built from an older source.
+ *       6; quasistatic/compiled.py runs without a .so built from an older source.
  *   fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces) -> None
  *       The fixed-mode laws at x, laws/fixed_modes.py::system loop for loop (the 3-D fast
  *       path's Newton iterations call it); the last three arrays are filled.
@@ -317,12 +317,22 @@ static void sliding_friction(const Laws *L, Py_ssize_t i, double cn, Py_ssize_t 
     const double k = -mu * cn / speed;
     for (Py_ssize_t s = 0; s < t; s++) L->forces[i * L->d + s] = -mu * cn * e[s];
     if (L->jacobian == NULL) return;
+    /* The kernel's factors of each term, computed once rather than in its innermost loop: the same values, the same sums. */
+    double pull[2], bend[2][2];
+    for (Py_ssize_t s = 0; s < t; s++) {
+        pull[s] = -mu * e[s];
+        for (Py_ssize_t r = 0; r < t; r++) bend[s][r] = k * ((s == r ? 1.0 : 0.0) - e[s] * e[r]);
+    }
     for (Py_ssize_t j = 0; j < n; j++) {
-        for (Py_ssize_t s = 0; s < t; s++) L->jacobian[j * size + col] += Ji[s * n + j] * (-mu * e[s]);
+        double left[2][2]; /* each term's first product, Ji[s, j] bend[s][r] */
+        for (Py_ssize_t s = 0; s < t; s++) {
+            L->jacobian[j * size + col] += Ji[s * n + j] * pull[s];
+            for (Py_ssize_t r = 0; r < t; r++) left[s][r] = Ji[s * n + j] * bend[s][r];
+        }
         for (Py_ssize_t k2 = 0; k2 < n; k2++) {
             double total = 0.0;
             for (Py_ssize_t s = 0; s < t; s++)
-                for (Py_ssize_t r = 0; r < t; r++) total += Ji[s * n + j] * (k * ((s == r ? 1.0 : 0.0) - e[s] * e[r])) * Ji[r * n + k2];
+                for (Py_ssize_t r = 0; r < t; r++) total += left[s][r] * Ji[r * n + k2];
             L->jacobian[j * size + k2] += total;
         }
     }
@@ -665,8 +675,10 @@ static void newton_step(Split *s, Py_ssize_t size) {
     for (Py_ssize_t i = 0; i < size; i++) {
         gradient[i] = 0.0;
         for (Py_ssize_t k = 0; k < size; k++) {
-            gradient[i] -= jac[k * size + i] * res[k];
-            for (Py_ssize_t j = i; j < size; j++) normal[i * size + j] += jac[k * size + i] * jac[k * size + j];
+            const double a = jac[k * size + i];
+            if (a == 0.0) continue; /* a force column is zero in the contacts' rows: x - 0 y is x for finite y, +0 + -0 is +0 */
+            gradient[i] -= a * res[k];
+            for (Py_ssize_t j = i; j < size; j++) normal[i * size + j] += a * jac[k * size + j];
         }
         /* J^T J is symmetric: row i left of the diagonal is column i above it, summed over k in the same order of
          * the same products (a b = b a exactly), so copied, not summed again. */
@@ -730,9 +742,9 @@ static double gauss_newton(Split *s, Py_ssize_t size, long long patience) {
 }
 
 /* The exact 3-D laws with the contact modes of (q, c), by lcp.py::_newton's rules (a contact closed where its gap rate
- * is at most depth below mode_tol); the result in s->newton_q and s->forces (m, 3). Returns whether it converged with every
- * mode and inequality kept. */
-static int newton(Split *s, const double *q, const double *c, double depth, long long patience, double tol) {
+ * is at most depth below mode_tol; with one_switch, a round switches only the first contact that must switch); the result
+ * in s->newton_q and s->forces (m, 3). Returns whether it converged with every mode and inequality kept. */
+static int newton(Split *s, const double *q, const double *c, double depth, long long patience, int one_switch, double tol) {
     const Py_ssize_t m = s->m, n = s->n;
     double u_n, speed;
     for (Py_ssize_t i = 0; i < m; i++) {
@@ -760,7 +772,7 @@ static int newton(Split *s, const double *q, const double *c, double depth, long
         const double norm = gauss_newton(s, size, patience);
         for (Py_ssize_t j = 0; j < n; j++) s->newton_q[j] = s->x[j];
         int changed = 0;
-        for (Py_ssize_t i = 0; i < m; i++) {
+        for (Py_ssize_t i = 0; i < m && !(changed && one_switch); i++) {
             double *fi = s->forces + i * 3;
             contact_speeds(s, s->newton_q, i, &u_n, &speed);
             if (s->kind[i] == SEPARATING && u_n < 0.0) {
@@ -833,7 +845,7 @@ static SplitResult split_lcp(Split *s, int exact, int64_t max_realignments, doub
         }
         if (out.realignments == 0 || out.realignments == max_realignments || error > 0.5 * previous) {
             /* First, and whenever re-alignment stalls: the exact laws with these contact modes. */
-            if (newton(s, q, c, 0.0, NEWTON_ITERATIONS, s->dissipation_tol)) {
+            if (newton(s, q, c, 0.0, NEWTON_ITERATIONS, 0, s->dissipation_tol)) {
                 for (Py_ssize_t j = 0; j < s->n; j++) q[j] = s->newton_q[j];
                 for (Py_ssize_t i = 0; i < s->m * 3; i++) c[i] = s->forces[i];
                 out.stage = 2;
@@ -996,9 +1008,9 @@ done:
 
 static PyObject *exact_newton(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
     (void)module;
-    if (nargs != 15) {
-        PyErr_SetString(PyExc_TypeError, "exact_newton(J, b, mu, g, q, c, depth, patience, mode_tol, tol, cone_roundoff,"
-                                         " newton_damping, newton_stop, q_out, c_out) takes 15 arguments");
+    if (nargs != 16) {
+        PyErr_SetString(PyExc_TypeError, "exact_newton(J, b, mu, g, q, c, depth, patience, one_switch, mode_tol, tol, cone_roundoff,"
+                                         " newton_damping, newton_stop, q_out, c_out) takes 16 arguments");
         return NULL;
     }
     Split s;
@@ -1006,8 +1018,10 @@ static PyObject *exact_newton(PyObject *module, PyObject *const *args, Py_ssize_
     double depth, tol;
     const long long patience = PyLong_AsLongLong(args[7]);
     if (patience == -1 && PyErr_Occurred()) return NULL;
-    if (take_double(args, 6, &depth) || take_double(args, 8, &s.mode_tol) || take_double(args, 9, &tol) ||
-        take_double(args, 10, &s.cone_roundoff) || take_double(args, 11, &s.newton_damping) || take_double(args, 12, &s.newton_stop))
+    const int one_switch = PyObject_IsTrue(args[8]);
+    if (one_switch < 0) return NULL;
+    if (take_double(args, 6, &depth) || take_double(args, 9, &s.mode_tol) || take_double(args, 10, &tol) ||
+        take_double(args, 11, &s.cone_roundoff) || take_double(args, 12, &s.newton_damping) || take_double(args, 13, &s.newton_stop))
         return NULL;
     Py_buffer probe;
     if (PyObject_GetBuffer(args[0], &probe, PyBUF_STRIDES) < 0) return NULL;
@@ -1027,7 +1041,7 @@ static PyObject *exact_newton(PyObject *module, PyObject *const *args, Py_ssize_
     PyObject *result = NULL;
     double *memory = NULL;
     int64_t *integers = NULL;
-    const int indices[8] = {0, 1, 2, 3, 4, 5, 13, 14};
+    const int indices[8] = {0, 1, 2, 3, 4, 5, 14, 15};
     for (; taken < 8; taken++)
         if (take_buffer(args[indices[taken]], &views[taken], names[taken], "d", taken >= 6, ndims[taken], shapes[taken]) < 0) goto done;
     s.J = views[0].buf, s.b = views[1].buf, s.mu = views[2].buf, s.g = views[3].buf;
@@ -1035,7 +1049,7 @@ static PyObject *exact_newton(PyObject *module, PyObject *const *args, Py_ssize_
     if (allocate(&s, &memory, &integers) < 0) goto done;
     int converged;
     Py_BEGIN_ALLOW_THREADS
-    converged = newton(&s, views[4].buf, views[5].buf, depth, patience, tol);
+    converged = newton(&s, views[4].buf, views[5].buf, depth, patience, one_switch, tol);
     double *q_out = views[6].buf, *c_out = views[7].buf;
     for (Py_ssize_t j = 0; j < n; j++) q_out[j] = s.newton_q[j];
     for (Py_ssize_t i = 0; i < m * 3; i++) c_out[i] = s.forces[i];
@@ -1060,8 +1074,8 @@ static PyMethodDef methods[] = {
      "feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) -> (status, stage, pivots, realignments):\n"
      "the fast path's kernel, the numba kernel's steps; fills q (n,) and c (m, d). See quasistatic.solvers.numerics.lcp."},
     {"exact_newton", (PyCFunction)(void (*)(void))exact_newton, METH_FASTCALL,
-     "exact_newton(J, b, mu, g, q, c, depth, patience, mode_tol, tol, cone_roundoff, newton_damping, newton_stop, q_out, c_out)"
-     " -> bool:\n"
+     "exact_newton(J, b, mu, g, q, c, depth, patience, one_switch, mode_tol, tol, cone_roundoff, newton_damping, newton_stop,"
+     " q_out, c_out) -> bool:\n"
      "Newton's method on the exact 3-D fixed-mode laws from (q, c), the numba kernel's steps; fills q_out (n,) and c_out (m, 3).\n"
      "See quasistatic.solvers.numerics.lcp.exact_newton."},
     {NULL, NULL, 0, NULL},
@@ -1081,7 +1095,7 @@ PyMODINIT_FUNC PyInit__lemke(void) {
         return NULL;
     }
     /* what quasistatic/compiled.py checks: a .so built from an older source is not used */
-    if (PyModule_AddIntConstant(module, "api_version", 5) < 0) {
+    if (PyModule_AddIntConstant(module, "api_version", 6) < 0) {
         Py_DECREF(module);
         return NULL;
     }

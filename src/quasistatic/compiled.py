@@ -28,7 +28,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-API_VERSION = 5  # the _lemke.c these wrappers call (its module attribute api_version)
+API_VERSION = 6  # the _lemke.c these wrappers call (its module attribute api_version)
 
 
 def _load(name: str) -> Any:
@@ -196,6 +196,7 @@ def exact_newton(
     c: np.ndarray,
     depth: float,
     patience: int,
+    one_switch: bool,
     mode_tol: float,
     tol: float,
     newton: NewtonTolerances,
@@ -204,7 +205,8 @@ def exact_newton(
 
     ``J`` (m, 3, n), ``b`` (m, 3), ``mu`` (m,), ``g`` (n,), the start ``q`` (n,) and ``c`` (m, 3), the start's
     penetration counted as closed ``depth``, the iterations without progress before a due mode switch ``patience``,
-    the mode and convergence tolerances, and the Newton iterations' tolerances.
+    whether a round switches only the first contact that must switch ``one_switch``, the mode and convergence
+    tolerances, and the Newton iterations' tolerances.
 
     Raises
     ------
@@ -215,7 +217,7 @@ def exact_newton(
         raise ValueError(f"J must have shape (m, 3, n), not {J.shape}")
     q_out, c_out = np.empty(J.shape[2]), np.empty(J.shape[:2])
     arrays = (np.ascontiguousarray(a, np.float64) for a in (J, b, mu, g, q, c))
-    converged = extension.exact_newton(*arrays, depth, patience, mode_tol, tol, *newton, q_out, c_out)
+    converged = extension.exact_newton(*arrays, depth, patience, one_switch, mode_tol, tol, *newton, q_out, c_out)
     return bool(converged), q_out, c_out
 
 

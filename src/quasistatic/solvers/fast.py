@@ -21,10 +21,10 @@ refinement that did not converge), a complete method takes over. A ray is no
 proof that no motion exists: Lemke's path reaches only solutions of index +1
 (``sgn det M_SS``), and some scenes' motions all have index -1 (docs/performance.md).
 On exact 3-D cones the point where the path ended is tried first as a start of
-Newton's method, as above (with quick mode switches, then with the contacts the
-path held closed, penetrating by its artificial variable, closed: it converges on
-some scenes whose pyramid LCP has no solution Lemke reaches; a motion it returns
-keeps every mode and inequality).
+Newton's method, as above (with quick mode switches, then quick rounds that switch
+one contact at a time, then with the contacts the path held closed, penetrating by
+its artificial variable, closed: it converges on some scenes whose pyramid LCP has
+no solution Lemke reaches; a motion it returns keeps every mode and inequality).
 
 - One planar body: a motion at a vertex of the contacts' gap-rate and slip
   planes (:func:`~.certify.arrangement.motion_vertex`); where no vertex holds
@@ -246,11 +246,13 @@ def _is_exact(problem: Problem) -> bool:
     return problem.dimension == 3 and not problem.friction.is_polyhedral(3)
 
 
-def _exact_from(problem: Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0, patience: int = NEWTON_ITERATIONS) -> RawMotion | None:
+def _exact_from(
+    problem: Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0, patience: int = NEWTON_ITERATIONS, one_switch: bool = False
+) -> RawMotion | None:
     """The exact laws solved by Newton's method with the contact modes of ``(q, c)`` (any point, no law checked; a
-    contact penetrating by at most ``depth`` counts as closed; ``patience`` as :func:`.numerics.lcp.exact_newton`),
-    or None where it does not converge with every mode and inequality kept."""
-    converged, q_exact, c_exact = exact_newton(problem, q, c, depth, patience)
+    contact penetrating by at most ``depth`` counts as closed; ``patience`` and ``one_switch`` as
+    :func:`.numerics.lcp.exact_newton`), or None where it does not converge with every mode and inequality kept."""
+    converged, q_exact, c_exact = exact_newton(problem, q, c, depth, patience, one_switch)
     return RawMotion(q_exact, c_exact) if converged else None
 
 
@@ -258,21 +260,27 @@ def _from_lemke_end(problem: Problem, q: np.ndarray, c: np.ndarray, notes: tuple
     """Exact cones: a motion by Newton's method from where a Lemke path ended (a ray's last point, or a pyramid's
     solution), often near an exact motion that no pyramid's Lemke path reaches; None where it does not converge.
 
-    Two starts, the note ``newton_patience`` says which converged. First the point's own contact modes, with
-    rounds that switch modes as soon as two iterations stall (:data:`QUICK_PATIENCE`: grasp-3d 8 #1's motion, and
-    6 #3's in ~15x fewer evaluations of the laws). Then the contacts the path held closed start closed (a ray's
-    last point solves the laws with every gap rate raised by the artificial variable, so they penetrate by it,
-    :func:`lemke_depth`), with the kernel's full rounds: grasp-3d 8 #0's motion, which neither the point's own
-    modes nor quick switches reach. (With the depth first, random scene 7139 got a third motion, audited, that
-    SCIP's list misses; this order keeps the earlier one.)"""
-    patience = QUICK_PATIENCE
+    Three starts, the notes ``newton_patience`` and ``newton_switches`` say which converged. First the point's own
+    contact modes, with rounds that switch modes as soon as two iterations stall (:data:`QUICK_PATIENCE`: grasp-3d
+    8 #1's motion, and 6 #3's in ~15x fewer evaluations of the laws); every contact that must switch does. Then
+    the same, a round switching only the first of them (grasp-3d 8 #0's motion in ~45 evaluations: switching all
+    three of its pulling contacts at once leads elsewhere). Then the contacts the path held closed start closed
+    (a ray's last point solves the laws with every gap rate raised by the artificial variable, so they penetrate
+    by it, :func:`lemke_depth`), with the kernel's full rounds (8 #0's motion too, in ~1,000 evaluations). (With
+    the depth first, random scene 7139 got a third motion, audited, that SCIP's list misses; this order keeps the
+    earlier one.)"""
+    patience, switches = QUICK_PATIENCE, "all"
     motion = _exact_from(problem, q, c, 0.0, patience)
-    if motion is None:  # the depth only where the quick start failed (8 #1 and 6 #3 never read it)
-        patience = NEWTON_ITERATIONS
+    if motion is None:
+        switches = "first"
+        motion = _exact_from(problem, q, c, 0.0, patience, one_switch=True)
+    if motion is None:  # the depth only where the quick starts failed (8 #0, 8 #1 and 6 #3 never read it)
+        patience, switches = NEWTON_ITERATIONS, "all"
         motion = _exact_from(problem, q, c, lemke_depth(problem, q), patience)
     if motion is None:
         return None
-    return _found(motion, notes + (("exact_cone", _EXACT_FROM_LEMKE_END), ("newton_patience", patience)))
+    notes += (("exact_cone", _EXACT_FROM_LEMKE_END), ("newton_patience", patience), ("newton_switches", switches))
+    return _found(motion, notes)
 
 
 def _found(motion: RawMotion, notes: tuple[tuple[str, object], ...]) -> BackendResult:

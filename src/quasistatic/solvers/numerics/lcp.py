@@ -110,7 +110,7 @@ def lemke_motion(problem: Problem) -> tuple[int, int, np.ndarray, np.ndarray, in
 
 
 def exact_newton(
-    problem: Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0, patience: int = NEWTON_ITERATIONS
+    problem: Problem, q: np.ndarray, c: np.ndarray, depth: float = 0.0, patience: int = NEWTON_ITERATIONS, one_switch: bool = False
 ) -> tuple[bool, np.ndarray, np.ndarray]:
     """The exact 3-D laws with the contact modes of a pyramid's motion ``(q, c)``, by the kernel's Newton method
     (the one :func:`solve_split_lcp` runs on Lemke's motion). Returns whether it converged with every mode and
@@ -122,13 +122,16 @@ def exact_newton(
     normal force turned negative, a penetration, a slip stopped) ends the round, rather than after
     :data:`NEWTON_ITERATIONS` (the kernel's own Newton): 2 (:data:`QUICK_PATIENCE`) reaches grasp-3d 8 #1's motion
     from Lemke's ray point and takes 6 #3's in ~15x fewer evaluations of the laws, but misses 8 #0's.
+    ``one_switch``: a round switches only the first contact that must switch (in index order), not all of them at
+    once; with quick rounds it reaches grasp-3d 8 #0's motion from Lemke's ray point in ~45 evaluations of the laws
+    (docs/performance.md), where switching all of them fails.
 
     Its C twin runs where the extension was built, with numba or without: about 3x faster than the numba
     kernel called from Python, 25x faster than the kernel as plain Python (grasp-3d 6 #3 and 8 #0-#3, from
     where Lemke's path ended; docs/performance.md)."""
     data = problem.derived("fast", LemkeInputs)
     newton = _newton_compiled if HAVE_EXTENSION else _newton
-    return newton(data.J, data.b, data.mu, data.g, q, c, depth, patience, MODE_SPEED, FRICTION_ALIGNMENT)
+    return newton(data.J, data.b, data.mu, data.g, q, c, depth, patience, one_switch, MODE_SPEED, FRICTION_ALIGNMENT)
 
 
 def lemke_depth(problem: Problem, q: np.ndarray) -> float:
@@ -222,7 +225,7 @@ def solve_split_lcp(
         if realignments == 0 or realignments == max_realignments or error > 0.5 * previous:
             # First, and whenever re-alignment stalls (a pyramid lets a slip turn within its
             # vertex's fan at no change of force): the exact laws with these contact modes.
-            converged, q_exact, c_exact = _newton(J, b, mu, g, q, c, 0.0, NEWTON_ITERATIONS, mode_tol, dissipation_tol)
+            converged, q_exact, c_exact = _newton(J, b, mu, g, q, c, 0.0, NEWTON_ITERATIONS, False, mode_tol, dissipation_tol)
             if converged:
                 return SOLUTION, 2, q_exact, c_exact, pivots, realignments
             if realignments == max_realignments:
@@ -330,11 +333,12 @@ def _newton_compiled(
     c: np.ndarray,
     depth: float,
     patience: int,
+    one_switch: bool,
     mode_tol: float,
     tol: float,
 ) -> tuple[bool, np.ndarray, np.ndarray]:
     """:func:`_newton` in the extension's C, step for step, to the bit (:func:`exact_newton` calls it where it was built)."""
-    return compiled_exact_newton(J, b, mu, g, q, c, depth, patience, mode_tol, tol, _NEWTON)
+    return compiled_exact_newton(J, b, mu, g, q, c, depth, patience, one_switch, mode_tol, tol, _NEWTON)
 
 
 @njit
@@ -347,6 +351,7 @@ def _newton(
     c: np.ndarray,
     depth: float,
     patience: int,
+    one_switch: bool,
     mode_tol: float,
     tol: float,
 ) -> tuple[bool, np.ndarray, np.ndarray]:
@@ -360,7 +365,9 @@ def _newton(
     zero or below (a Lemke point's penetration, :func:`lemke_depth`); a closed contact whose normal force turns negative opens,
     an open one that would penetrate closes and a sliding one that stops rolls,
     and the equations are solved again (a few times at most); such a switch ends
-    a round early once ``patience`` iterations have not halved the residual. Returns whether
+    a round early once ``patience`` iterations have not halved the residual. With
+    ``one_switch`` a round switches only the first such contact (in index order),
+    the others left to the next round's answer. Returns whether
     a solution kept every mode and inequality (normal forces >= 0, rolling
     forces in their cones, sliding contacts sliding, open ones apart), and it.
     """
@@ -385,6 +392,8 @@ def _newton(
         q = x[:n].copy()
         changed = False
         for i in range(m):
+            if changed and one_switch:
+                break
             switched = _switched_kind(J, b, mu, q, kind, forces, i, mode_tol)
             if switched >= 0:
                 kind[i] = switched
