@@ -9,7 +9,8 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``check/audit.py::_laws_2d`` / ``_laws_3d``; :func:`analyse_frictionless`,
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
 ``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`nonnegative_fit`,
-``solvers/numerics/nnls.py::nonnegative_fit``; :func:`polygon_vertices`, ``solvers/numerics/polygon.py::polygon_vertices``;
+``solvers/numerics/nnls.py::nonnegative_fit``; :func:`polygon_vertices` and :func:`polygon_ball`,
+``solvers/numerics/polygon.py``; :func:`row_bounds`, ``solvers/numerics/row_bounds.py::row_bounds``;
 :func:`assemble_scene`, ``laws/assemble.py::assemble_numpy``).
 Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
@@ -60,6 +61,8 @@ __all__ = [
     "drop_roundoff",
     "nonnegative_fit",
     "polygon_vertices",
+    "polygon_ball",
+    "row_bounds",
     "assemble_scene",
 ]
 
@@ -344,6 +347,55 @@ def polygon_vertices(
         When the shapes or dtypes disagree, or ``vertices`` has fewer rows than the kept rows have pairs.
     """
     return int(kernels.polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices))
+
+
+def polygon_ball(
+    q0: np.ndarray,
+    directions: np.ndarray,
+    vertices: np.ndarray,
+    seed: np.ndarray,
+    spread: np.ndarray,
+    same: float,
+    distinct: float,
+    center: np.ndarray,
+) -> float:
+    """The ball around a polygon of twists in C, as ``solvers/numerics/polygon.py::polygon_ball``: ``center`` filled,
+    the radius returned (-1: every twist in the seed's box).
+
+    ``q0`` (n,), ``directions`` (2, n), ``vertices`` (V, 2) with ``V >= 1``, ``seed`` (n,) or (0,), ``spread`` (n,)
+    C-contiguous float64; ``center`` (n,) writable.
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, there is no vertex, or ``center`` cannot be filled.
+    """
+    return float(kernels.polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center))
+
+
+def row_bounds(
+    bank: np.ndarray,
+    rhs: np.ndarray,
+    inverse: np.ndarray,
+    q0: np.ndarray,
+    directions: np.ndarray,
+    rows: np.ndarray,
+    slack: float,
+    reserve: np.ndarray,
+    rates: np.ndarray,
+) -> None:
+    """Bank rows' best slacks and rates over a closed set in C, as ``solvers/numerics/row_bounds.py::row_bounds``:
+    ``reserve`` and ``rates`` filled at ``rows``.
+
+    ``bank`` (R, n), ``rhs`` (R,), ``inverse`` (n, k), ``q0`` (n,), ``directions`` (f, n) with ``f <= 2`` float64,
+    ``rows`` (I,) int64 in ``[0, R)``; ``reserve`` (R,) and ``rates`` (R, 2) writable C-contiguous float64.
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, a row is out of range, or ``reserve`` or ``rates`` cannot be filled.
+    """
+    kernels.row_bounds(bank, rhs, inverse, q0, directions, rows, slack, reserve, rates)
 
 
 def assemble_scene(
