@@ -27,8 +27,11 @@
  *   polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) -> count
  *       solvers/numerics/polygon.py::polygon_vertices: the vertices of a polygon of half-planes (the kept rows
  *       of rates . x + reserve >= 0), filled in vertices (pairs, 2); their count, or -1 (unbounded).
+ *   closed_rows(E, e, by_rank, rank, orthogonal, zero, sigma, basis, inverse, q0, spread) -> (r, residual_square)
+ *       solvers/numerics/closed_set.py::closed_rows: closed rows factored by one-sided Jacobi rotations (singular
+ *       values, right singular vectors, the pseudo-inverse truncated to r ranks, q0, spread), filled.
  *   row_bounds(bank, rhs, inverse, q0, directions, rows, slack, reserve, rates) -> None
- *       solvers/numerics/row_bounds.py::row_bounds: for the bank rows listed in rows, the best slack at q0 with
+ *       solvers/numerics/closed_set.py::row_bounds: for the bank rows listed in rows, the best slack at q0 with
  *       every closed row loosened by slack (reserve[j]) and the rates along the free directions (rates[j, c]), filled.
  *   polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center) -> reach
  *       solvers/numerics/polygon.py::polygon_ball: the twists q0 + vertices directions, -1 when all lie in the seed's box,
@@ -1025,9 +1028,140 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- a closed set's factors */
+
+/* solvers/numerics/closed_set.py::closed_rows, loop for loop: E (k, n), e (k,); sigma (n,), basis (n, n), inverse
+ * (n, k), q0 (n,), spread (n,) filled; work: k n + n n + n doubles, n integers and n flags. Returns r, the square in
+ * *square (0 and 0.0 when no rank is kept). */
+static Py_ssize_t closed_rows_loops(Py_ssize_t k, Py_ssize_t n, const double *E, const double *e, int by_rank, double rank,
+                                    double orthogonal, double zero, double *sigma, double *basis, double *inverse, double *q0,
+                                    double *spread, double *square, double *W, double *V, double *norms, Py_ssize_t *order,
+                                    char *taken) {
+    memcpy(W, E, sizeof(double) * (size_t)(k * n));
+    for (Py_ssize_t i = 0; i < n; i++)
+        for (Py_ssize_t j = 0; j < n; j++) V[i * n + j] = i == j ? 1.0 : 0.0;
+    for (int sweep = 0; sweep < 60; sweep++) {
+        int rotated = 0;
+        for (Py_ssize_t p = 0; p + 1 < n; p++)
+            for (Py_ssize_t q = p + 1; q < n; q++) {
+                double alpha = 0.0, beta = 0.0, gamma = 0.0;
+                for (Py_ssize_t i = 0; i < k; i++) {
+                    alpha += W[i * n + p] * W[i * n + p];
+                    beta += W[i * n + q] * W[i * n + q];
+                    gamma += W[i * n + p] * W[i * n + q];
+                }
+                if (gamma == 0.0 || fabs(gamma) <= orthogonal * sqrt(alpha * beta)) continue;
+                rotated = 1;
+                const double diff = beta - alpha;
+                const double sign = diff == 0.0 || (diff > 0.0) == (gamma > 0.0) ? 1.0 : -1.0;
+                const double t = sign * 2.0 * fabs(gamma) / (fabs(diff) + hypot(2.0 * gamma, diff));
+                const double cos = 1.0 / sqrt(1.0 + t * t), sin = cos * t;
+                for (Py_ssize_t i = 0; i < k; i++) {
+                    const double a = W[i * n + p], b = W[i * n + q];
+                    W[i * n + p] = cos * a - sin * b;
+                    W[i * n + q] = sin * a + cos * b;
+                }
+                for (Py_ssize_t i = 0; i < n; i++) {
+                    const double a = V[i * n + p], b = V[i * n + q];
+                    V[i * n + p] = cos * a - sin * b;
+                    V[i * n + q] = sin * a + cos * b;
+                }
+            }
+        if (!rotated) break;
+    }
+    for (Py_ssize_t j = 0; j < n; j++) {
+        double total = 0.0;
+        for (Py_ssize_t i = 0; i < k; i++) total += W[i * n + j] * W[i * n + j];
+        norms[j] = sqrt(total);
+        taken[j] = 0;
+    }
+    for (Py_ssize_t slot = 0; slot < n; slot++) {
+        Py_ssize_t best = -1;
+        for (Py_ssize_t j = 0; j < n; j++)
+            if (!taken[j] && (best < 0 || norms[j] > norms[best])) best = j;
+        taken[best] = 1;
+        order[slot] = best;
+    }
+    const Py_ssize_t full = k < n ? k : n;
+    Py_ssize_t r = 0;
+    for (Py_ssize_t slot = 0; slot < n; slot++) {
+        const Py_ssize_t j = order[slot];
+        sigma[slot] = slot < full ? norms[j] : 0.0;
+        for (Py_ssize_t i = 0; i < n; i++) basis[slot * n + i] = V[i * n + j];
+        if (slot < full && (!by_rank || norms[j] > rank)) r = slot + 1;
+    }
+    *square = 0.0;
+    if (r == 0 || sigma[r - 1] <= rank) return 0;
+    for (Py_ssize_t i = 0; i < n; i++)
+        for (Py_ssize_t c = 0; c < k; c++) {
+            double value = 0.0;
+            for (Py_ssize_t slot = 0; slot < r; slot++) {
+                const Py_ssize_t j = order[slot];
+                value += V[i * n + j] * (W[c * n + j] / (norms[j] * norms[j]));
+            }
+            inverse[i * k + c] = value;
+        }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        double value = 0.0, size = 0.0;
+        for (Py_ssize_t c = 0; c < k; c++) {
+            value += inverse[i * k + c] * e[c];
+            size += fabs(inverse[i * k + c]);
+        }
+        q0[i] = value;
+        spread[i] = zero * size;
+    }
+    for (Py_ssize_t c = 0; c < k; c++) {
+        double value = 0.0;
+        for (Py_ssize_t i = 0; i < n; i++) value += E[c * n + i] * q0[i];
+        *square += (value - e[c]) * (value - e[c]);
+    }
+    return r;
+}
+
+static PyObject *closed_rows(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 11) {
+        PyErr_SetString(PyExc_TypeError, "closed_rows(E, e, by_rank, rank, orthogonal, zero, sigma, basis, inverse, q0, spread) takes 11 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t E[2] = {-1, -1}, e[1], sigma[1], basis[2], inverse[2], q0[1], spread[1];
+    double rank, orthogonal, zero;
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "E", FLOATS, 0, 2, E) < 0) goto done;
+    e[0] = inverse[1] = E[0];
+    sigma[0] = basis[0] = basis[1] = inverse[0] = q0[0] = spread[0] = E[1];
+    int by_rank = PyObject_IsTrue(args[2]);
+    if (by_rank < 0 || take_next(&b, args[1], "e", FLOATS, 0, 1, e) < 0 || take_next(&b, args[6], "sigma", FLOATS, 1, 1, sigma) < 0 ||
+        take_next(&b, args[7], "basis", FLOATS, 1, 2, basis) < 0 || take_next(&b, args[8], "inverse", FLOATS, 1, 2, inverse) < 0 ||
+        take_next(&b, args[9], "q0", FLOATS, 1, 1, q0) < 0 || take_next(&b, args[10], "spread", FLOATS, 1, 1, spread) < 0 ||
+        take_floats(args[3], &rank, "rank") < 0 || take_floats(args[4], &orthogonal, "orthogonal") < 0 ||
+        take_floats(args[5], &zero, "zero") < 0)
+        goto done;
+    Py_ssize_t k = E[0], n = E[1];
+    double *work = PyMem_Malloc(sizeof(double) * (size_t)(k * n + n * n + n + 1) + sizeof(Py_ssize_t) * (size_t)(n + 1) + (size_t)(n + 1));
+    if (work == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_ssize_t *order = (Py_ssize_t *)(work + k * n + n * n + n + 1);
+    char *taken = (char *)(order + n + 1);
+    Py_ssize_t r;
+    double square;
+    Py_BEGIN_ALLOW_THREADS
+    r = closed_rows_loops(k, n, b.views[0].buf, b.views[1].buf, by_rank, rank, orthogonal, zero, b.views[2].buf, b.views[3].buf,
+                          b.views[4].buf, b.views[5].buf, b.views[6].buf, &square, work, work + k * n, work + k * n + n * n, order, taken);
+    Py_END_ALLOW_THREADS
+    PyMem_Free(work);
+    result = Py_BuildValue("(nd)", r, square);
+done:
+    release(&b);
+    return result;
+}
+
 /* ---------------------------------------------------------------- a closed set's bank rows */
 
-/* solvers/numerics/row_bounds.py::row_bounds, loop for loop: bank (R, n), rhs (R,), inverse (n, k), q0 (n,),
+/* solvers/numerics/closed_set.py::row_bounds, loop for loop: bank (R, n), rhs (R,), inverse (n, k), q0 (n,),
  * directions (f, n), rows (I,); reserve (R,) and rates (R, 2) filled at the rows listed. */
 static void row_bounds_loops(Py_ssize_t n, Py_ssize_t k, Py_ssize_t free, Py_ssize_t count, const double *bank, const double *rhs,
                              const double *inverse, const double *q0, const double *directions, const int64_t *rows, double slack,
@@ -1201,10 +1335,14 @@ static PyMethodDef methods[] = {
     {"polygon_vertices", (PyCFunction)(void (*)(void))polygon_vertices, METH_FASTCALL,
      "polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) -> count: a polygon's vertices, the numba\n"
      "kernel's loops; fills vertices (pairs, 2), returns their count or -1. See quasistatic.solvers.numerics.polygon."},
+    {"closed_rows", (PyCFunction)(void (*)(void))closed_rows, METH_FASTCALL,
+     "closed_rows(E, e, by_rank, rank, orthogonal, zero, sigma, basis, inverse, q0, spread) -> (r, residual_square): closed\n"
+     "rows factored by Jacobi rotations, the numba kernel's loops; fills sigma (n,), basis (n, n), inverse (n, k), q0 and\n"
+     "spread (n,). See quasistatic.solvers.numerics.closed_set."},
     {"row_bounds", (PyCFunction)(void (*)(void))row_bounds, METH_FASTCALL,
      "row_bounds(bank, rhs, inverse, q0, directions, rows, slack, reserve, rates): the listed bank rows' best slack at q0\n"
      "and rates along the directions, the numba kernel's loops; fills reserve (R,) and rates (R, 2) at those rows.\n"
-     "See quasistatic.solvers.numerics.row_bounds."},
+     "See quasistatic.solvers.numerics.closed_set."},
     {"polygon_ball", (PyCFunction)(void (*)(void))polygon_ball, METH_FASTCALL,
      "polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center) -> reach: the ball around a polygon of\n"
      "twists, the numba kernel's loops; fills center (n,), returns its radius, or -1 when every twist is the seed's.\n"

@@ -10,7 +10,7 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
 ``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`nonnegative_fit`,
 ``solvers/numerics/nnls.py::nonnegative_fit``; :func:`polygon_vertices` and :func:`polygon_ball`,
-``solvers/numerics/polygon.py``; :func:`row_bounds`, ``solvers/numerics/row_bounds.py::row_bounds``;
+``solvers/numerics/polygon.py``; :func:`closed_rows` and :func:`row_bounds`, ``solvers/numerics/closed_set.py``;
 :func:`assemble_scene`, ``laws/assemble.py::assemble_numpy``).
 Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
@@ -62,6 +62,7 @@ __all__ = [
     "nonnegative_fit",
     "polygon_vertices",
     "polygon_ball",
+    "closed_rows",
     "row_bounds",
     "assemble_scene",
 ]
@@ -373,6 +374,34 @@ def polygon_ball(
     return float(kernels.polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center))
 
 
+def closed_rows(
+    E: np.ndarray,
+    e: np.ndarray,
+    by_rank: bool,
+    rank: float,
+    orthogonal: float,
+    zero: float,
+    sigma: np.ndarray,
+    basis: np.ndarray,
+    inverse: np.ndarray,
+    q0: np.ndarray,
+    spread: np.ndarray,
+) -> tuple[int, float]:
+    """Closed rows factored by Jacobi rotations in C, as ``solvers/numerics/closed_set.py::closed_rows``: the arrays
+    filled, the ranks kept and the squared residual returned.
+
+    ``E`` (k, n), ``e`` (k,) C-contiguous float64; ``sigma`` (n,), ``basis`` (n, n), ``inverse`` (n, k), ``q0`` and
+    ``spread`` (n,) writable C-contiguous float64.
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, or an output cannot be filled.
+    """
+    r, square = kernels.closed_rows(E, e, by_rank, rank, orthogonal, zero, sigma, basis, inverse, q0, spread)
+    return int(r), float(square)
+
+
 def row_bounds(
     bank: np.ndarray,
     rhs: np.ndarray,
@@ -384,7 +413,7 @@ def row_bounds(
     reserve: np.ndarray,
     rates: np.ndarray,
 ) -> None:
-    """Bank rows' best slacks and rates over a closed set in C, as ``solvers/numerics/row_bounds.py::row_bounds``:
+    """Bank rows' best slacks and rates over a closed set in C, as ``solvers/numerics/closed_set.py::row_bounds``:
     ``reserve`` and ``rates`` filled at ``rows``.
 
     ``bank`` (R, n), ``rhs`` (R,), ``inverse`` (n, k), ``q0`` (n,), ``directions`` (f, n) with ``f <= 2`` float64,

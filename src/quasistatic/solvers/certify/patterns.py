@@ -142,6 +142,7 @@ from ...laws.polyhedral import LCPForm
 from ...tolerances import (
     DISTINCT_TWIST,
     FORCE_CEILING,
+    JACOBI_ORTHOGONAL,
     LP_FEASIBILITY,
     MOTION_RANK,
     PATTERN_NODES,
@@ -149,11 +150,11 @@ from ...tolerances import (
     SAME_TWIST,
     ZERO,
 )
+from ..numerics.closed_set import closed_rows, row_bounds
 from ..numerics.highs import WarmLP, solve_lp
 from ..numerics.line_extent import AxisExtents, line_axis_extents
 from ..numerics.nnls import nonnegative_fit
 from ..numerics.polygon import NEAR_SEED, UNBOUNDED, polygon_ball, polygon_vertices
-from ..numerics.row_bounds import row_bounds
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
@@ -1277,9 +1278,9 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
         interval = _interval(rows, closed, (-math.inf, math.inf), node.at_least)
         return _PRUNED if interval is None else _line(rows, closed, *interval)
     if plane:
-        return _on_plane(rows, closed, rows.row_mask(node.at_least), node.at_least.bit_count())
-    at_least = closed.read(rows, _indices(node.at_least))
-    if (closed.reserve[at_least] < 0.0).any():
+        return _on_plane(rows, closed, node.at_least)
+    closed.read(rows, node.at_least)
+    if (closed.reserve[_indices(node.at_least)] < 0.0).any():
         return _PRUNED  # an open gap or slip sign fails on the whole set
     if _near_seed(rows, closed.q0, closed.q0, closed.spread):
         return _PRUNED
@@ -1299,7 +1300,8 @@ def _narrowed(rows: _Rows, parent: _Twists, shape: _Shape, new_rows: int) -> _Tw
     reserve, rates = closed.reserve, closed.rates
     vertices = shape.vertices
     assert vertices is not None
-    for j in closed.read(rows, _indices(new_rows)).tolist():
+    closed.read(rows, new_rows)
+    for j in _indices(new_rows):
         vertices = _cut(vertices, (rates.item(j, 0), rates.item(j, 1)), reserve.item(j))
         if not vertices:
             return _PRUNED
@@ -1311,7 +1313,8 @@ def _interval(rows: _Rows, closed: _ClosedSet, interval: tuple[float, float], at
     ``rate t + reserve >= 0`` each; None when it is empty."""
     low, high = interval
     reserve, rates = closed.reserve, closed.rates
-    for j in closed.read(rows, _indices(at_least)).tolist():
+    closed.read(rows, at_least)
+    for j in _indices(at_least):
         rate, slack = rates.item(j, 0), reserve.item(j)
         if rate > 0.0:
             low = max(low, -slack / rate)
@@ -1344,21 +1347,24 @@ class _ClosedSet:
     inverse: np.ndarray  # (n, r): the closed rows' pseudo-inverse (truncated to the ranks kept)
     directions: np.ndarray  # (free, n), C-contiguous: orthonormal directions of a line or a plane (the last rows of E's full vt)
     free: int  # the dimension of what the closed rows leave: 0 a point, 1 a line, 2 a plane (more: not bounded here)
-    reserve: np.ndarray  # (bank rows,): filled at the rows read, never read elsewhere
+    reserve: np.ndarray  # (bank rows,): filled at the rows read (``known``), never read elsewhere
     rates: np.ndarray  # (bank rows, 2): the same, along ``directions``
+    known: int = 0  # the bank rows filled so far (bits)
 
     @property
     def direction(self) -> np.ndarray:
         """A line's direction."""
         return self.directions[-1]
 
-    def read(self, rows: _Rows, chosen: list[int] | np.ndarray) -> np.ndarray:
-        """The bank rows ``chosen`` (ascending) as an index array, their ``reserve`` and ``rates`` filled: a node reads a
-        few of the bank's hundreds of rows (measured: ~10 per closed set on the bench grasps' relaxations, of 126-1048),
-        so each is worked out when read, not for the whole bank."""
-        index = np.asarray(chosen, dtype=np.int64)
-        row_bounds(rows.bank, rows.rhs, self.inverse, self.q0, self.directions, index, LP_FEASIBILITY, self.reserve, self.rates)
-        return index
+    def read(self, rows: _Rows, bits: int) -> None:
+        """Fill ``reserve`` and ``rates`` at the bank rows ``bits`` not read before: a node reads a few of the bank's
+        hundreds of rows (measured: ~10 per closed set on the bench grasps' relaxations, of 126-1048), so each is
+        worked out when first read, not for the whole bank."""
+        missing = bits & ~self.known
+        if missing:
+            index = np.array(_indices(missing), dtype=np.int64)
+            row_bounds(rows.bank, rows.rhs, self.inverse, self.q0, self.directions, index, LP_FEASIBILITY, self.reserve, self.rates)
+            self.known |= missing
 
 
 def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
@@ -1382,20 +1388,16 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     """
     n = rows.g.size
     E, e = rows.bank[equal], rows.rhs[equal]  # ``equal``: a boolean mask of the bank's rows
-    u, sigma, vt = np.linalg.svd(E, full_matrices=k < n)  # a line's direction is the last row of the full vt
-    full = min(k, n)
-    r = int(np.count_nonzero(sigma > MOTION_RANK)) if rows.by_rank else full
-    if r == 0 or sigma[r - 1] <= MOTION_RANK:
-        return _UNKNOWN
-    pseudo_inverse = (vt[:r].T / sigma[:r]) @ u[:, :r].T
-    q0 = pseudo_inverse @ e
-    residual = E @ q0 - e
-    if r == full and residual @ residual > k * LP_FEASIBILITY**2:
+    sigma, basis, pseudo_inverse, q0, spread = np.empty(n), np.empty((n, n)), np.empty((n, k)), np.empty(n), np.empty(n)
+    # spread: as far as a twist meeting the rows as the seed does may lie, per entry
+    r, square = closed_rows(E, e, rows.by_rank, MOTION_RANK, JACOBI_ORTHOGONAL, ZERO, sigma, basis, pseudo_inverse, q0, spread)
+    if r == 0:
+        return _UNKNOWN  # no singular value above MOTION_RANK (with by_rank), or the closed rows' rank is deficient
+    if r == min(k, n) and square > k * LP_FEASIBILITY**2:
         return _PRUNED
-    spread = ZERO * np.abs(pseudo_inverse).sum(axis=1)  # as far as a twist meeting the rows as the seed does may lie
     radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
     free = n - r
-    directions = np.ascontiguousarray(vt[r:n] if free <= 2 else vt[:0])  # a line's or a plane's (last rows of vt)
+    directions = basis[r:n] if free <= 2 else basis[:0]  # a line's or a plane's (the last right singular vectors)
     R = rows.bank.shape[0]
     return _ClosedSet(q0, radius, spread, pseudo_inverse, directions, free, np.empty(R), np.empty((R, 2)))
 
@@ -1414,18 +1416,19 @@ def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
     return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + closed.radius), shape=shape)
 
 
-def _on_plane(rows: _Rows, closed: _ClosedSet, at_least: np.ndarray, count: int) -> _Twists:
+def _on_plane(rows: _Rows, closed: _ClosedSet, at_least: int) -> _Twists:
     """Twists ``q0 + P^T x`` (``P``: the closed set's plane, ``x`` in R^2) with ``rate x + reserve >= 0`` for each of
-    the ``count`` inequality rows ``at_least`` (a mask of the bank's): a polygon, decided exactly in the plane.
+    the inequality rows ``at_least`` (bits): a polygon, decided exactly in the plane.
 
     It is bounded when its rows' normals leave no angle of ``pi`` or more between neighbours (they positively
     span the plane); then it is the hull of its vertices, the intersections of two of its lines that meet every
     row (with round-off's leniency): none means it is empty. Lines closer to parallel than :data:`_PARALLEL`
     meet far away or not at all; between that and :data:`_SKEW` a vertex is too close to call (no bound given).
     """
+    count = at_least.bit_count()
     vertices = np.empty((count * (count - 1) // 2, 2))
-    closed.read(rows, np.flatnonzero(at_least))
-    found = polygon_vertices(closed.rates, closed.reserve, at_least, _PARALLEL, _SKEW, ROUNDOFF_SLACK, vertices)
+    closed.read(rows, at_least)
+    found = polygon_vertices(closed.rates, closed.reserve, rows.row_mask(at_least), _PARALLEL, _SKEW, ROUNDOFF_SLACK, vertices)
     if found == UNBOUNDED:
         return _UNKNOWN  # unbounded (or too close to call)
     if found == 0:
