@@ -1268,7 +1268,7 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
         return _UNKNOWN
     closed = rows.closed_sets.get(node.equal)
     if closed is None:
-        closed = rows.closed_sets[node.equal] = _closed_set(rows, rows.row_mask(node.equal), k)
+        closed = rows.closed_sets[node.equal] = _closed_set(rows, _indices(node.equal), k)
     if isinstance(closed, _Twists):
         return closed
     if closed.free > widest:
@@ -1279,8 +1279,7 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
         return _PRUNED if interval is None else _line(rows, closed, *interval)
     if plane:
         return _on_plane(rows, closed, node.at_least)
-    closed.read(rows, node.at_least)
-    if (closed.reserve[_indices(node.at_least)] < 0.0).any():
+    if (closed.reserve[closed.read(rows, node.at_least)] < 0.0).any():
         return _PRUNED  # an open gap or slip sign fails on the whole set
     if _near_seed(rows, closed.q0, closed.q0, closed.spread):
         return _PRUNED
@@ -1300,8 +1299,7 @@ def _narrowed(rows: _Rows, parent: _Twists, shape: _Shape, new_rows: int) -> _Tw
     reserve, rates = closed.reserve, closed.rates
     vertices = shape.vertices
     assert vertices is not None
-    closed.read(rows, new_rows)
-    for j in _indices(new_rows):
+    for j in closed.read(rows, new_rows):
         vertices = _cut(vertices, (rates.item(j, 0), rates.item(j, 1)), reserve.item(j))
         if not vertices:
             return _PRUNED
@@ -1313,8 +1311,7 @@ def _interval(rows: _Rows, closed: _ClosedSet, interval: tuple[float, float], at
     ``rate t + reserve >= 0`` each; None when it is empty."""
     low, high = interval
     reserve, rates = closed.reserve, closed.rates
-    closed.read(rows, at_least)
-    for j in _indices(at_least):
+    for j in closed.read(rows, at_least):
         rate, slack = rates.item(j, 0), reserve.item(j)
         if rate > 0.0:
             low = max(low, -slack / rate)
@@ -1356,18 +1353,20 @@ class _ClosedSet:
         """A line's direction."""
         return self.directions[-1]
 
-    def read(self, rows: _Rows, bits: int) -> None:
-        """Fill ``reserve`` and ``rates`` at the bank rows ``bits`` not read before: a node reads a few of the bank's
-        hundreds of rows (measured: ~10 per closed set on the bench grasps' relaxations, of 126-1048), so each is
-        worked out when first read, not for the whole bank."""
+    def read(self, rows: _Rows, bits: int) -> list[int]:
+        """The bank rows ``bits`` (ascending), with ``reserve`` and ``rates`` filled at those not read before: a node
+        reads a few of the bank's hundreds of rows (measured: ~10 per closed set on the bench grasps' relaxations, of
+        126-1048), so each is worked out when first read, not for the whole bank."""
+        index = _indices(bits)
         missing = bits & ~self.known
         if missing:
-            index = np.array(_indices(missing), dtype=np.int64)
-            row_bounds(rows.bank, rows.rhs, self.inverse, self.q0, self.directions, index, LP_FEASIBILITY, self.reserve, self.rates)
+            chosen = np.array(index if missing == bits else _indices(missing), dtype=np.int64)
+            row_bounds(rows.bank, rows.rhs, self.inverse, self.q0, self.directions, chosen, LP_FEASIBILITY, self.reserve, self.rates)
             self.known |= missing
+        return index
 
 
-def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
+def _closed_set(rows: _Rows, equal: list[int], k: int) -> _ClosedSet | _Twists:
     """What the ``k`` closed rows ``E q = e`` leave, every row loosened by ``LP_FEASIBILITY``.
 
     With ``E+`` the pseudo-inverse of the ``k`` rows and ``q0 = E+ e``, the part of ``q - q0`` in E's row space
@@ -1387,7 +1386,7 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     small singular values join may disagree in round-off), so no set is pruned for it.
     """
     n = rows.g.size
-    E, e = rows.bank[equal], rows.rhs[equal]  # ``equal``: a boolean mask of the bank's rows
+    E, e = rows.bank[equal], rows.rhs[equal]  # ``equal``: the closed bank rows, ascending
     sigma, basis, pseudo_inverse, q0, spread = np.empty(n), np.empty((n, n)), np.empty((n, k)), np.empty(n), np.empty(n)
     # spread: as far as a twist meeting the rows as the seed does may lie, per entry
     r, square = closed_rows(E, e, rows.by_rank, MOTION_RANK, JACOBI_ORTHOGONAL, ZERO, sigma, basis, pseudo_inverse, q0, spread)
