@@ -360,6 +360,16 @@ done:
 
 /* ---------------------------------------------------------------- the frictionless LP's analysis */
 
+/* The rotation that makes two columns orthogonal (squared norms alpha and beta, product gamma): its tan in the
+ * kernels' overflow-free form (see solvers/lp.py::_singular_values), then cos and sin. */
+static inline void jacobi_rotation(double alpha, double beta, double gamma, double *cos, double *sin) {
+    const double diff = beta - alpha;
+    const double sign = diff == 0.0 || (diff > 0.0) == (gamma > 0.0) ? 1.0 : -1.0;
+    const double t = sign * 2.0 * fabs(gamma) / (fabs(diff) + hypot(2.0 * gamma, diff));
+    *cos = 1.0 / sqrt(1.0 + t * t);
+    *sin = *cos * t;
+}
+
 /* Singular values of the (rows, cols) matrix W, column-major, rows >= cols, by one-sided Jacobi rotations
  * (Hestenes), solvers/lp.py::_singular_values sweep for sweep; W is rotated in place, sigma (cols) filled. */
 static void singular_values(double *W, Py_ssize_t rows, Py_ssize_t cols, double orthogonal, double *sigma) {
@@ -376,11 +386,8 @@ static void singular_values(double *W, Py_ssize_t rows, Py_ssize_t cols, double 
                 }
                 if (gamma == 0.0 || fabs(gamma) <= orthogonal * sqrt(alpha * beta)) continue;
                 rotated = 1;
-                /* tan of the rotation in the kernel's overflow-free form (see _singular_values) */
-                const double diff = beta - alpha;
-                const double sign = diff == 0.0 || (diff > 0.0) == (gamma > 0.0) ? 1.0 : -1.0;
-                const double t = sign * 2.0 * fabs(gamma) / (fabs(diff) + hypot(2.0 * gamma, diff));
-                const double cos = 1.0 / sqrt(1.0 + t * t), sin = cos * t;
+                double cos, sin;
+                jacobi_rotation(alpha, beta, gamma, &cos, &sin);
                 for (Py_ssize_t i = 0; i < rows; i++) {
                     const double a = wp[i], b = wq[i];
                     wp[i] = cos * a - sin * b;
@@ -1052,10 +1059,8 @@ static Py_ssize_t closed_rows_loops(Py_ssize_t k, Py_ssize_t n, const double *E,
                 }
                 if (gamma == 0.0 || fabs(gamma) <= orthogonal * sqrt(alpha * beta)) continue;
                 rotated = 1;
-                const double diff = beta - alpha;
-                const double sign = diff == 0.0 || (diff > 0.0) == (gamma > 0.0) ? 1.0 : -1.0;
-                const double t = sign * 2.0 * fabs(gamma) / (fabs(diff) + hypot(2.0 * gamma, diff));
-                const double cos = 1.0 / sqrt(1.0 + t * t), sin = cos * t;
+                double cos, sin;
+                jacobi_rotation(alpha, beta, gamma, &cos, &sin);
                 for (Py_ssize_t i = 0; i < k; i++) {
                     const double a = W[i * n + p], b = W[i * n + q];
                     W[i * n + p] = cos * a - sin * b;
