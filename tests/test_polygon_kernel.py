@@ -15,7 +15,7 @@ import pytest
 from quasistatic import compiled
 from quasistatic.solvers.certify import patterns
 from quasistatic.solvers.numerics import polygon as kernel_module
-from quasistatic.solvers.numerics.polygon import UNBOUNDED, polygon_vertices
+from quasistatic.solvers.numerics.polygon import NEAR_SEED, UNBOUNDED, polygon_ball, polygon_vertices
 
 PARALLEL, SKEW, SLACK = patterns._PARALLEL, patterns._SKEW, patterns.ROUNDOFF_SLACK  # the branch and bound's
 
@@ -95,3 +95,69 @@ def test_the_c_loops_reject_bad_arguments() -> None:
         compiled.polygon_vertices(np.ones((4, 3)), reserve, rows, PARALLEL, SKEW, SLACK, np.empty((6, 2)))
     with pytest.raises(ValueError, match="rows must be a C-contiguous bool"):
         compiled.polygon_vertices(rates, reserve, np.ones(4), PARALLEL, SKEW, SLACK, np.empty((6, 2)))
+
+
+def _balls() -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """``(q0, directions, vertices, seed, spread)``: random planes of twists and polygons on them, without a seed, with
+    one far from them, and with one at their middle (the polygon shrunk into its box, or not)."""
+    rng = np.random.default_rng(8)
+    for count in (1, 3, 7):
+        q0 = rng.standard_normal(6)
+        directions = np.ascontiguousarray(np.linalg.qr(rng.standard_normal((6, 2)))[0].T)
+        for size in (1.0, 1e-9):
+            vertices = size * rng.standard_normal((count, 2))
+            middle = q0 + vertices.mean(axis=0) @ directions
+            for seed in (np.zeros(0), middle + 1.0, middle):
+                yield q0, directions, vertices, seed, np.full(6, 1e-10)
+
+
+def _ball(kernel: Callable[..., float], case: tuple[np.ndarray, ...]) -> tuple[float, np.ndarray]:
+    center = np.full(6, np.nan)
+    return kernel(*case, patterns.SAME_TWIST, patterns.DISTINCT_TWIST, center), center
+
+
+def test_the_ball_holds_the_polygons_twists_or_they_are_the_seeds() -> None:
+    answers = set()
+    for case in _balls():
+        q0, directions, vertices, seed, spread = case
+        reach, center = _ball(polygon_ball, case)
+        twists = q0 + vertices @ directions
+        near = bool(seed.size) and np.abs(twists - seed).max() <= 0.5 * patterns.SAME_TWIST
+        if reach == NEAR_SEED:
+            assert near
+        else:
+            assert not near
+            assert np.linalg.norm(twists - center, axis=1).max() <= reach * (1.0 + 1e-12)
+        answers.add(reach == NEAR_SEED)
+    assert answers == {True, False}
+
+
+def test_the_ball_kernel_and_its_numpy_twin_agree() -> None:
+    for case in _balls():
+        reach, center = _ball(polygon_ball, case)
+        reach_twin, center_twin = _ball(kernel_module._polygon_ball_numpy, case)
+        assert (reach == NEAR_SEED) == (reach_twin == NEAR_SEED)
+        if reach != NEAR_SEED:
+            np.testing.assert_allclose(reach, reach_twin, rtol=1e-12, atol=1e-15)
+            np.testing.assert_allclose(center, center_twin, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.skipif(not compiled.HAVE_KERNELS, reason="built without the C extensions")
+def test_the_ball_c_loops_give_the_numba_kernels_bits() -> None:
+    numba = pytest.importorskip("numba")
+    assert isinstance(polygon_ball, numba.core.registry.CPUDispatcher)
+    for case in _balls():
+        reach, center = _ball(polygon_ball, case)
+        reach_c, center_c = _ball(compiled.polygon_ball, case)
+        assert reach_c == reach
+        if reach != NEAR_SEED:
+            np.testing.assert_array_equal(center_c, center)
+
+
+@pytest.mark.skipif(not compiled.HAVE_KERNELS, reason="built without the C extensions")
+def test_the_ball_c_loops_reject_bad_arguments() -> None:
+    q0, directions, spread, center = np.zeros(6), np.zeros((2, 6)), np.zeros(6), np.empty(6)
+    with pytest.raises(ValueError, match="vertices must hold a vertex"):
+        compiled.polygon_ball(q0, directions, np.zeros((0, 2)), np.zeros(0), spread, 1.0, 1.0, center)
+    with pytest.raises(ValueError, match="seed must be shaped as q0"):
+        compiled.polygon_ball(q0, directions, np.zeros((1, 2)), np.zeros(3), spread, 1.0, 1.0, center)

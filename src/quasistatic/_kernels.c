@@ -29,6 +29,15 @@
  *   polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) -> count
  *       solvers/numerics/polygon.py::polygon_vertices: the vertices of a polygon of half-planes (the kept rows
  *       of rates . x + reserve >= 0), filled in vertices (pairs, 2); their count, or -1 (unbounded).
+ *   closed_rows(E, e, by_rank, rank, orthogonal, zero, sigma, basis, inverse, q0, spread) -> (r, residual_square)
+ *       solvers/numerics/closed_set.py::closed_rows: closed rows factored by one-sided Jacobi rotations (singular
+ *       values, right singular vectors, the pseudo-inverse truncated to r ranks, q0, spread), filled.
+ *   row_bounds(bank, rhs, inverse, q0, directions, rows, slack, reserve, rates) -> None
+ *       solvers/numerics/closed_set.py::row_bounds: for the bank rows listed in rows, the best slack at q0 with
+ *       every closed row loosened by slack (reserve[j]) and the rates along the free directions (rates[j, c]), filled.
+ *   polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center) -> reach
+ *       solvers/numerics/polygon.py::polygon_ball: the twists q0 + vertices directions, -1 when all lie in the seed's box,
+ *       else the ball around them: center (n,) filled, its radius returned.
  *
  * The Python C API and buffers only (every array C-contiguous, no numpy headers), so setuptools
  * alone builds it; quasistatic/compiled.py wraps it. Shapes and indices are checked
@@ -353,6 +362,16 @@ done:
 
 /* ---------------------------------------------------------------- the frictionless LP's analysis */
 
+/* The rotation that makes two columns orthogonal (squared norms alpha and beta, product gamma): its tan in the
+ * kernels' overflow-free form (see solvers/lp.py::_singular_values), then cos and sin. */
+static inline void jacobi_rotation(double alpha, double beta, double gamma, double *cos, double *sin) {
+    const double diff = beta - alpha;
+    const double sign = diff == 0.0 || (diff > 0.0) == (gamma > 0.0) ? 1.0 : -1.0;
+    const double t = sign * 2.0 * fabs(gamma) / (fabs(diff) + hypot(2.0 * gamma, diff));
+    *cos = 1.0 / sqrt(1.0 + t * t);
+    *sin = *cos * t;
+}
+
 /* Singular values of the (rows, cols) matrix W, column-major, rows >= cols, by one-sided Jacobi rotations
  * (Hestenes), solvers/lp.py::_singular_values sweep for sweep; W is rotated in place, sigma (cols) filled. */
 static void singular_values(double *W, Py_ssize_t rows, Py_ssize_t cols, double orthogonal, double *sigma) {
@@ -369,11 +388,8 @@ static void singular_values(double *W, Py_ssize_t rows, Py_ssize_t cols, double 
                 }
                 if (gamma == 0.0 || fabs(gamma) <= orthogonal * sqrt(alpha * beta)) continue;
                 rotated = 1;
-                /* tan of the rotation in the kernel's overflow-free form (see _singular_values) */
-                const double diff = beta - alpha;
-                const double sign = diff == 0.0 || (diff > 0.0) == (gamma > 0.0) ? 1.0 : -1.0;
-                const double t = sign * 2.0 * fabs(gamma) / (fabs(diff) + hypot(2.0 * gamma, diff));
-                const double cos = 1.0 / sqrt(1.0 + t * t), sin = cos * t;
+                double cos, sin;
+                jacobi_rotation(alpha, beta, gamma, &cos, &sin);
                 for (Py_ssize_t i = 0; i < rows; i++) {
                     const double a = wp[i], b = wq[i];
                     wp[i] = cos * a - sin * b;
@@ -1054,6 +1070,285 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- a closed set's factors */
+
+/* solvers/numerics/closed_set.py::closed_rows, loop for loop: E (k, n), e (k,); sigma (n,), basis (n, n), inverse
+ * (n, k), q0 (n,), spread (n,) filled; work: k n + n n + n doubles, n integers and n flags. Returns r, the square in
+ * *square (0 and 0.0 when no rank is kept). */
+static Py_ssize_t closed_rows_loops(Py_ssize_t k, Py_ssize_t n, const double *E, const double *e, int by_rank, double rank,
+                                    double orthogonal, double zero, double *sigma, double *basis, double *inverse, double *q0,
+                                    double *spread, double *square, double *W, double *V, double *norms, Py_ssize_t *order,
+                                    char *taken) {
+    memcpy(W, E, sizeof(double) * (size_t)(k * n));
+    for (Py_ssize_t i = 0; i < n; i++)
+        for (Py_ssize_t j = 0; j < n; j++) V[i * n + j] = i == j ? 1.0 : 0.0;
+    for (int sweep = 0; sweep < 60; sweep++) {
+        int rotated = 0;
+        for (Py_ssize_t p = 0; p + 1 < n; p++)
+            for (Py_ssize_t q = p + 1; q < n; q++) {
+                double alpha = 0.0, beta = 0.0, gamma = 0.0;
+                for (Py_ssize_t i = 0; i < k; i++) {
+                    alpha += W[i * n + p] * W[i * n + p];
+                    beta += W[i * n + q] * W[i * n + q];
+                    gamma += W[i * n + p] * W[i * n + q];
+                }
+                if (gamma == 0.0 || fabs(gamma) <= orthogonal * sqrt(alpha * beta)) continue;
+                rotated = 1;
+                double cos, sin;
+                jacobi_rotation(alpha, beta, gamma, &cos, &sin);
+                for (Py_ssize_t i = 0; i < k; i++) {
+                    const double a = W[i * n + p], b = W[i * n + q];
+                    W[i * n + p] = cos * a - sin * b;
+                    W[i * n + q] = sin * a + cos * b;
+                }
+                for (Py_ssize_t i = 0; i < n; i++) {
+                    const double a = V[i * n + p], b = V[i * n + q];
+                    V[i * n + p] = cos * a - sin * b;
+                    V[i * n + q] = sin * a + cos * b;
+                }
+            }
+        if (!rotated) break;
+    }
+    for (Py_ssize_t j = 0; j < n; j++) {
+        double total = 0.0;
+        for (Py_ssize_t i = 0; i < k; i++) total += W[i * n + j] * W[i * n + j];
+        norms[j] = sqrt(total);
+        taken[j] = 0;
+    }
+    for (Py_ssize_t slot = 0; slot < n; slot++) {
+        Py_ssize_t best = -1;
+        for (Py_ssize_t j = 0; j < n; j++)
+            if (!taken[j] && (best < 0 || norms[j] > norms[best])) best = j;
+        taken[best] = 1;
+        order[slot] = best;
+    }
+    const Py_ssize_t full = k < n ? k : n;
+    Py_ssize_t r = 0;
+    for (Py_ssize_t slot = 0; slot < n; slot++) {
+        const Py_ssize_t j = order[slot];
+        sigma[slot] = slot < full ? norms[j] : 0.0;
+        for (Py_ssize_t i = 0; i < n; i++) basis[slot * n + i] = V[i * n + j];
+        if (slot < full && (!by_rank || norms[j] > rank)) r = slot + 1;
+    }
+    *square = 0.0;
+    if (r == 0 || sigma[r - 1] <= rank) return 0;
+    for (Py_ssize_t i = 0; i < n; i++)
+        for (Py_ssize_t c = 0; c < k; c++) {
+            double value = 0.0;
+            for (Py_ssize_t slot = 0; slot < r; slot++) {
+                const Py_ssize_t j = order[slot];
+                value += V[i * n + j] * (W[c * n + j] / (norms[j] * norms[j]));
+            }
+            inverse[i * k + c] = value;
+        }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        double value = 0.0, size = 0.0;
+        for (Py_ssize_t c = 0; c < k; c++) {
+            value += inverse[i * k + c] * e[c];
+            size += fabs(inverse[i * k + c]);
+        }
+        q0[i] = value;
+        spread[i] = zero * size;
+    }
+    for (Py_ssize_t c = 0; c < k; c++) {
+        double value = 0.0;
+        for (Py_ssize_t i = 0; i < n; i++) value += E[c * n + i] * q0[i];
+        *square += (value - e[c]) * (value - e[c]);
+    }
+    return r;
+}
+
+static PyObject *closed_rows(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 11) {
+        PyErr_SetString(PyExc_TypeError, "closed_rows(E, e, by_rank, rank, orthogonal, zero, sigma, basis, inverse, q0, spread) takes 11 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t E[2] = {-1, -1}, e[1], sigma[1], basis[2], inverse[2], q0[1], spread[1];
+    double rank, orthogonal, zero;
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "E", FLOATS, 0, 2, E) < 0) goto done;
+    e[0] = inverse[1] = E[0];
+    sigma[0] = basis[0] = basis[1] = inverse[0] = q0[0] = spread[0] = E[1];
+    int by_rank = PyObject_IsTrue(args[2]);
+    if (by_rank < 0 || take_next(&b, args[1], "e", FLOATS, 0, 1, e) < 0 || take_next(&b, args[6], "sigma", FLOATS, 1, 1, sigma) < 0 ||
+        take_next(&b, args[7], "basis", FLOATS, 1, 2, basis) < 0 || take_next(&b, args[8], "inverse", FLOATS, 1, 2, inverse) < 0 ||
+        take_next(&b, args[9], "q0", FLOATS, 1, 1, q0) < 0 || take_next(&b, args[10], "spread", FLOATS, 1, 1, spread) < 0 ||
+        take_floats(args[3], &rank, "rank") < 0 || take_floats(args[4], &orthogonal, "orthogonal") < 0 ||
+        take_floats(args[5], &zero, "zero") < 0)
+        goto done;
+    Py_ssize_t k = E[0], n = E[1];
+    double *work = PyMem_Malloc(sizeof(double) * (size_t)(k * n + n * n + n + 1) + sizeof(Py_ssize_t) * (size_t)(n + 1) + (size_t)(n + 1));
+    if (work == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_ssize_t *order = (Py_ssize_t *)(work + k * n + n * n + n + 1);
+    char *taken = (char *)(order + n + 1);
+    Py_ssize_t r;
+    double square;
+    Py_BEGIN_ALLOW_THREADS
+    r = closed_rows_loops(k, n, b.views[0].buf, b.views[1].buf, by_rank, rank, orthogonal, zero, b.views[2].buf, b.views[3].buf,
+                          b.views[4].buf, b.views[5].buf, b.views[6].buf, &square, work, work + k * n, work + k * n + n * n, order, taken);
+    Py_END_ALLOW_THREADS
+    PyMem_Free(work);
+    result = Py_BuildValue("(nd)", r, square);
+done:
+    release(&b);
+    return result;
+}
+
+/* ---------------------------------------------------------------- a closed set's bank rows */
+
+/* solvers/numerics/closed_set.py::row_bounds, loop for loop: bank (R, n), rhs (R,), inverse (n, k), q0 (n,),
+ * directions (f, n), rows (I,); reserve (R,) and rates (R, 2) filled at the rows listed. */
+static void row_bounds_loops(Py_ssize_t n, Py_ssize_t k, Py_ssize_t free, Py_ssize_t count, const double *bank, const double *rhs,
+                             const double *inverse, const double *q0, const double *directions, const int64_t *rows, double slack,
+                             double *reserve, double *rates) {
+    for (Py_ssize_t t = 0; t < count; t++) {
+        const int64_t j = rows[t];
+        const double *row = bank + j * n;
+        double value = 0.0, reach = 0.0;
+        for (Py_ssize_t l = 0; l < n; l++) value += row[l] * q0[l];
+        for (Py_ssize_t i = 0; i < k; i++) {
+            double product = 0.0;
+            for (Py_ssize_t l = 0; l < n; l++) product += row[l] * inverse[l * k + i];
+            reach += fabs(product);
+        }
+        reserve[j] = value + slack * reach - rhs[j] + slack;
+        for (Py_ssize_t c = 0; c < free; c++) {
+            double rate = 0.0;
+            for (Py_ssize_t l = 0; l < n; l++) rate += row[l] * directions[c * n + l];
+            rates[2 * j + c] = rate;
+        }
+    }
+}
+
+static PyObject *row_bounds(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 9) {
+        PyErr_SetString(PyExc_TypeError, "row_bounds(bank, rhs, inverse, q0, directions, rows, slack, reserve, rates) takes 9 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t bank[2] = {-1, -1}, rhs[1], inverse[2] = {-1, -1}, q0[1], directions[2] = {-1, -1}, rows[1] = {-1}, reserve[1],
+               rates[2];
+    double slack;
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "bank", FLOATS, 0, 2, bank) < 0) goto done;
+    rhs[0] = reserve[0] = rates[0] = bank[0];
+    inverse[0] = q0[0] = bank[1];
+    rates[1] = 2;
+    if (take_next(&b, args[1], "rhs", FLOATS, 0, 1, rhs) < 0 || take_next(&b, args[2], "inverse", FLOATS, 0, 2, inverse) < 0 ||
+        take_next(&b, args[3], "q0", FLOATS, 0, 1, q0) < 0 || take_next(&b, args[4], "directions", FLOATS, 0, 2, directions) < 0 ||
+        take_next(&b, args[5], "rows", INTEGERS, 0, 1, rows) < 0 || take_next(&b, args[7], "reserve", FLOATS, 1, 1, reserve) < 0 ||
+        take_next(&b, args[8], "rates", FLOATS, 1, 2, rates) < 0 || take_floats(args[6], &slack, "slack") < 0)
+        goto done;
+    if (directions[1] != bank[1] || directions[0] > 2) {
+        PyErr_SetString(PyExc_ValueError, "directions must be (f, n) with f <= 2 and n the bank's columns");
+        goto done;
+    }
+    const int64_t *chosen = b.views[5].buf;
+    for (Py_ssize_t t = 0; t < rows[0]; t++)
+        if (chosen[t] < 0 || chosen[t] >= bank[0]) {
+            PyErr_SetString(PyExc_ValueError, "rows must index the bank's rows");
+            goto done;
+        }
+    Py_BEGIN_ALLOW_THREADS
+    row_bounds_loops(bank[1], inverse[1], directions[0], rows[0], b.views[0].buf, b.views[1].buf, b.views[2].buf, b.views[3].buf,
+                     b.views[4].buf, chosen, slack, b.views[6].buf, b.views[7].buf);
+    Py_END_ALLOW_THREADS
+    result = Py_NewRef(Py_None);
+done:
+    release(&b);
+    return result;
+}
+
+/* ---------------------------------------------------------------- a polygon of twists' ball */
+
+/* solvers/numerics/polygon.py::polygon_ball, loop for loop: q0 (n,), directions (2, n), vertices (V, 2), seed (n,) or
+ * NULL, spread (n,); center (n,) filled; work: V n doubles. */
+static double polygon_ball_loops(Py_ssize_t n, Py_ssize_t V, const double *q0, const double *directions, const double *vertices,
+                                 const double *seed, const double *spread, double same, double distinct, double *center, double *work) {
+    for (Py_ssize_t v = 0; v < V; v++)
+        for (Py_ssize_t l = 0; l < n; l++)
+            work[v * n + l] = q0[l] + (vertices[2 * v] * directions[l] + vertices[2 * v + 1] * directions[n + l]);
+    if (seed != NULL) {
+        double farthest = 0.0, widest = 0.0;
+        for (Py_ssize_t l = 0; l < n; l++) {
+            double offset = 0.0;
+            for (Py_ssize_t v = 0; v < V; v++) offset = greater(offset, fabs(work[v * n + l] - seed[l]));
+            farthest = greater(farthest, offset);
+            widest = greater(widest, offset + spread[l]);
+        }
+        if (farthest <= 0.5 * same && widest <= 0.5 * distinct) return -1.0;
+    }
+    for (Py_ssize_t l = 0; l < n; l++) {
+        double low = work[l], high = work[l];
+        for (Py_ssize_t v = 1; v < V; v++) {
+            double value = work[v * n + l];
+            if (value < low) low = value;
+            if (value > high) high = value;
+        }
+        center[l] = 0.5 * (low + high);
+    }
+    double reach = 0.0;
+    for (Py_ssize_t v = 0; v < V; v++) {
+        double square = 0.0;
+        for (Py_ssize_t l = 0; l < n; l++) {
+            double offset = work[v * n + l] - center[l];
+            square += offset * offset;
+        }
+        reach = greater(reach, square);
+    }
+    return sqrt(reach);
+}
+
+static PyObject *polygon_ball(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 8) {
+        PyErr_SetString(PyExc_TypeError, "polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center) takes 8 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t q0[1] = {-1}, directions[2] = {2, -1}, vertices[2] = {-1, 2}, seed[1] = {-1}, spread[1], center[1];
+    double same, distinct;
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "q0", FLOATS, 0, 1, q0) < 0) goto done;
+    directions[1] = spread[0] = center[0] = q0[0];
+    if (take_next(&b, args[1], "directions", FLOATS, 0, 2, directions) < 0 || take_next(&b, args[2], "vertices", FLOATS, 0, 2, vertices) < 0 ||
+        take_next(&b, args[3], "seed", FLOATS, 0, 1, seed) < 0 || take_next(&b, args[4], "spread", FLOATS, 0, 1, spread) < 0 ||
+        take_next(&b, args[7], "center", FLOATS, 1, 1, center) < 0 || take_floats(args[5], &same, "same") < 0 ||
+        take_floats(args[6], &distinct, "distinct") < 0)
+        goto done;
+    if (seed[0] != 0 && seed[0] != q0[0]) {
+        PyErr_SetString(PyExc_ValueError, "seed must be shaped as q0, or empty (no seed)");
+        goto done;
+    }
+    if (vertices[0] < 1) {
+        PyErr_SetString(PyExc_ValueError, "vertices must hold a vertex");
+        goto done;
+    }
+    Py_ssize_t n = q0[0], V = vertices[0];
+    double *work = PyMem_Malloc(sizeof(double) * (size_t)(V * n + 1));
+    if (work == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    double reach;
+    const double *chosen_seed = seed[0] ? b.views[3].buf : NULL;
+    Py_BEGIN_ALLOW_THREADS
+    reach = polygon_ball_loops(n, V, b.views[0].buf, b.views[1].buf, b.views[2].buf, chosen_seed, b.views[4].buf, same, distinct,
+                               b.views[5].buf, work);
+    Py_END_ALLOW_THREADS
+    PyMem_Free(work);
+    result = PyFloat_FromDouble(reach);
+done:
+    release(&b);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"audit_laws", (PyCFunction)(void (*)(void))audit_laws, METH_FASTCALL,
      "audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed, sums, u, slips, normal):\n"
@@ -1083,6 +1378,18 @@ static PyMethodDef methods[] = {
     {"polygon_vertices", (PyCFunction)(void (*)(void))polygon_vertices, METH_FASTCALL,
      "polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices) -> count: a polygon's vertices, the numba\n"
      "kernel's loops; fills vertices (pairs, 2), returns their count or -1. See quasistatic.solvers.numerics.polygon."},
+    {"closed_rows", (PyCFunction)(void (*)(void))closed_rows, METH_FASTCALL,
+     "closed_rows(E, e, by_rank, rank, orthogonal, zero, sigma, basis, inverse, q0, spread) -> (r, residual_square): closed\n"
+     "rows factored by Jacobi rotations, the numba kernel's loops; fills sigma (n,), basis (n, n), inverse (n, k), q0 and\n"
+     "spread (n,). See quasistatic.solvers.numerics.closed_set."},
+    {"row_bounds", (PyCFunction)(void (*)(void))row_bounds, METH_FASTCALL,
+     "row_bounds(bank, rhs, inverse, q0, directions, rows, slack, reserve, rates): the listed bank rows' best slack at q0\n"
+     "and rates along the directions, the numba kernel's loops; fills reserve (R,) and rates (R, 2) at those rows.\n"
+     "See quasistatic.solvers.numerics.closed_set."},
+    {"polygon_ball", (PyCFunction)(void (*)(void))polygon_ball, METH_FASTCALL,
+     "polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center) -> reach: the ball around a polygon of\n"
+     "twists, the numba kernel's loops; fills center (n,), returns its radius, or -1 when every twist is the seed's.\n"
+     "See quasistatic.solvers.numerics.polygon."},
     {NULL, NULL, 0, NULL},
 };
 

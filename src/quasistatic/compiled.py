@@ -9,9 +9,10 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``check/audit.py::_laws_2d`` / ``_laws_3d``; :func:`analyse_frictionless`,
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
 ``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`nonnegative_fit`,
-``solvers/numerics/nnls.py::nonnegative_fit``; :func:`polygon_vertices`, ``solvers/numerics/polygon.py::polygon_vertices``;
-:func:`assemble_scene`, ``laws/assemble.py::assemble_numpy``; :func:`stack_rows`, numpy's ``array`` of small
-vectors).
+``solvers/numerics/nnls.py::nonnegative_fit``; :func:`polygon_vertices` and :func:`polygon_ball`,
+``solvers/numerics/polygon.py``; :func:`closed_rows` and :func:`row_bounds`, ``solvers/numerics/closed_set.py``;
+:func:`assemble_scene`, ``laws/assemble.py::assemble_numpy``; :func:`stack_rows`,
+numpy's ``array`` of small vectors).
 Each wrapper takes its kernel's arguments, makes
 them C-contiguous, and returns what the kernel returns; the C code makes the
 kernels' choices in the kernels' order of arithmetic. ``_lemke`` also runs the fast path's whole kernel
@@ -62,6 +63,9 @@ __all__ = [
     "drop_roundoff",
     "nonnegative_fit",
     "polygon_vertices",
+    "polygon_ball",
+    "closed_rows",
+    "row_bounds",
     "assemble_scene",
     "stack_rows",
 ]
@@ -349,6 +353,83 @@ def polygon_vertices(
         When the shapes or dtypes disagree, or ``vertices`` has fewer rows than the kept rows have pairs.
     """
     return int(kernels.polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices))
+
+
+def polygon_ball(
+    q0: np.ndarray,
+    directions: np.ndarray,
+    vertices: np.ndarray,
+    seed: np.ndarray,
+    spread: np.ndarray,
+    same: float,
+    distinct: float,
+    center: np.ndarray,
+) -> float:
+    """The ball around a polygon of twists in C, as ``solvers/numerics/polygon.py::polygon_ball``: ``center`` filled,
+    the radius returned (-1: every twist in the seed's box).
+
+    ``q0`` (n,), ``directions`` (2, n), ``vertices`` (V, 2) with ``V >= 1``, ``seed`` (n,) or (0,), ``spread`` (n,)
+    C-contiguous float64; ``center`` (n,) writable.
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, there is no vertex, or ``center`` cannot be filled.
+    """
+    return float(kernels.polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center))
+
+
+def closed_rows(
+    E: np.ndarray,
+    e: np.ndarray,
+    by_rank: bool,
+    rank: float,
+    orthogonal: float,
+    zero: float,
+    sigma: np.ndarray,
+    basis: np.ndarray,
+    inverse: np.ndarray,
+    q0: np.ndarray,
+    spread: np.ndarray,
+) -> tuple[int, float]:
+    """Closed rows factored by Jacobi rotations in C, as ``solvers/numerics/closed_set.py::closed_rows``: the arrays
+    filled, the ranks kept and the squared residual returned.
+
+    ``E`` (k, n), ``e`` (k,) C-contiguous float64; ``sigma`` (n,), ``basis`` (n, n), ``inverse`` (n, k), ``q0`` and
+    ``spread`` (n,) writable C-contiguous float64.
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, or an output cannot be filled.
+    """
+    r, square = kernels.closed_rows(E, e, by_rank, rank, orthogonal, zero, sigma, basis, inverse, q0, spread)
+    return int(r), float(square)
+
+
+def row_bounds(
+    bank: np.ndarray,
+    rhs: np.ndarray,
+    inverse: np.ndarray,
+    q0: np.ndarray,
+    directions: np.ndarray,
+    rows: np.ndarray,
+    slack: float,
+    reserve: np.ndarray,
+    rates: np.ndarray,
+) -> None:
+    """Bank rows' best slacks and rates over a closed set in C, as ``solvers/numerics/closed_set.py::row_bounds``:
+    ``reserve`` and ``rates`` filled at ``rows``.
+
+    ``bank`` (R, n), ``rhs`` (R,), ``inverse`` (n, k), ``q0`` (n,), ``directions`` (f, n) with ``f <= 2`` float64,
+    ``rows`` (I,) int64 in ``[0, R)``; ``reserve`` (R,) and ``rates`` (R, 2) writable C-contiguous float64.
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, a row is out of range, or ``reserve`` or ``rates`` cannot be filled.
+    """
+    kernels.row_bounds(bank, rhs, inverse, q0, directions, rows, slack, reserve, rates)
 
 
 def assemble_scene(

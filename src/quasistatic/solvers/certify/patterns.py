@@ -142,6 +142,7 @@ from ...laws.polyhedral import LCPForm
 from ...tolerances import (
     DISTINCT_TWIST,
     FORCE_CEILING,
+    JACOBI_ORTHOGONAL,
     LP_FEASIBILITY,
     MOTION_RANK,
     PATTERN_NODES,
@@ -149,10 +150,11 @@ from ...tolerances import (
     SAME_TWIST,
     ZERO,
 )
+from ..numerics.closed_set import closed_rows, row_bounds
 from ..numerics.highs import WarmLP, solve_lp
 from ..numerics.line_extent import AxisExtents, line_axis_extents
 from ..numerics.nnls import nonnegative_fit
-from ..numerics.polygon import UNBOUNDED, polygon_vertices
+from ..numerics.polygon import NEAR_SEED, UNBOUNDED, polygon_ball, polygon_vertices
 from .cheap import satisfies_form
 from .search import relative_interior_point
 
@@ -1266,19 +1268,18 @@ def _twist(rows: _Rows, node: _Node) -> _Twists:
         return _UNKNOWN
     closed = rows.closed_sets.get(node.equal)
     if closed is None:
-        closed = rows.closed_sets[node.equal] = _closed_set(rows, rows.row_mask(node.equal), k)
+        closed = rows.closed_sets[node.equal] = _closed_set(rows, _indices(node.equal), k)
     if isinstance(closed, _Twists):
         return closed
     if closed.free > widest:
         return _UNKNOWN  # rows of deficient rank leave more than a plane
     plane = closed.free == 2
     if closed.free == 1:
-        interval = _interval(closed, (-math.inf, math.inf), node.at_least)
+        interval = _interval(rows, closed, (-math.inf, math.inf), node.at_least)
         return _PRUNED if interval is None else _line(rows, closed, *interval)
-    at_least = rows.row_mask(node.at_least)
     if plane:
-        return _on_plane(rows, closed, at_least, node.at_least.bit_count())
-    if (closed.reserve[at_least] < 0.0).any():
+        return _on_plane(rows, closed, node.at_least)
+    if (closed.reserve[closed.read(rows, node.at_least)] < 0.0).any():
         return _PRUNED  # an open gap or slip sign fails on the whole set
     if _near_seed(rows, closed.q0, closed.q0, closed.spread):
         return _PRUNED
@@ -1291,27 +1292,27 @@ def _narrowed(rows: _Rows, parent: _Twists, shape: _Shape, new_rows: int) -> _Tw
     cuts it."""
     closed = shape.closed
     if shape.interval is not None:
-        interval = _interval(closed, shape.interval, new_rows)
+        interval = _interval(rows, closed, shape.interval, new_rows)
         if interval is None:
             return _PRUNED
         return parent if interval == shape.interval else _line(rows, closed, *interval)
-    reserve, (first, second) = closed.row_reserve, closed.row_rates
+    reserve, rates = closed.reserve, closed.rates
     vertices = shape.vertices
     assert vertices is not None
-    for j in _indices(new_rows):
-        vertices = _cut(vertices, (first[j], second[j]), reserve[j])
+    for j in closed.read(rows, new_rows):
+        vertices = _cut(vertices, (rates.item(j, 0), rates.item(j, 1)), reserve.item(j))
         if not vertices:
             return _PRUNED
     return parent if vertices is shape.vertices else _polygon(rows, closed, vertices)
 
 
-def _interval(closed: _ClosedSet, interval: tuple[float, float], at_least: int) -> tuple[float, float] | None:
+def _interval(rows: _Rows, closed: _ClosedSet, interval: tuple[float, float], at_least: int) -> tuple[float, float] | None:
     """The part of ``interval`` of the closed set's line ``q0 + t d`` where the rows ``at_least`` (bits) hold,
     ``rate t + reserve >= 0`` each; None when it is empty."""
     low, high = interval
-    reserve, (rates,) = closed.row_reserve, closed.row_rates
-    for j in _indices(at_least):
-        rate, slack = rates[j], reserve[j]
+    reserve, rates = closed.reserve, closed.rates
+    for j in closed.read(rows, at_least):
+        rate, slack = rates.item(j, 0), reserve.item(j)
         if rate > 0.0:
             low = max(low, -slack / rate)
         elif rate < 0.0:
@@ -1331,27 +1332,41 @@ def _indices(bits: int) -> list[int]:
     return index
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # its rows' slacks and rates are filled as nodes read them (:meth:`read`)
 class _ClosedSet:
-    """The twists the closed rows leave: ``q0`` (a point, or a point of the line ``q0 + t direction``), within
-    ``radius`` (2-norm) and ``spread`` (per entry) of the loosened and the ``ZERO``-exact sets; for every bank row,
-    its best slack at ``q0`` (``reserve``) and its rates along the line or plane (``row_rates``, ``plane_rates``)."""
+    """The twists the closed rows leave: ``q0`` (a point, or a point of the line or plane ``q0 + x directions``), within
+    ``radius`` (2-norm) and ``spread`` (per entry) of the loosened and the ``ZERO``-exact sets; for the bank rows read so
+    far, each row's best slack at ``q0`` (``reserve``) and its rates along the line or the plane (``rates``)."""
 
     q0: np.ndarray
     radius: float
     spread: np.ndarray
-    reserve: np.ndarray
-    direction: np.ndarray
-    plane: np.ndarray  # (2, n): orthonormal directions of what ``n - 2`` rows leave (the last two of E's full ``vt``)
-    free: int  # the dimension of what the closed rows leave: 0 a point, 1 a line, 2 a plane
-    # The same per bank row as plain floats, read a few at a time by :func:`_narrowed`: ``reserve``, and the
-    # row's rate along the line or along each of the plane's directions (on ``n - 2`` rows); else empty.
-    row_reserve: list[float]
-    row_rates: tuple[list[float], ...]
-    plane_rates: np.ndarray  # (rows, 2): each bank row's rate along the plane's two directions (on n - 2 rows)
+    inverse: np.ndarray  # (n, r): the closed rows' pseudo-inverse (truncated to the ranks kept)
+    directions: np.ndarray  # (free, n), C-contiguous: orthonormal directions of a line or a plane (the last rows of E's full vt)
+    free: int  # the dimension of what the closed rows leave: 0 a point, 1 a line, 2 a plane (more: not bounded here)
+    reserve: np.ndarray  # (bank rows,): filled at the rows read (``known``), never read elsewhere
+    rates: np.ndarray  # (bank rows, 2): the same, along ``directions``
+    known: int = 0  # the bank rows filled so far (bits)
+
+    @property
+    def direction(self) -> np.ndarray:
+        """A line's direction."""
+        return self.directions[-1]
+
+    def read(self, rows: _Rows, bits: int) -> list[int]:
+        """The bank rows ``bits`` (ascending), with ``reserve`` and ``rates`` filled at those not read before: a node
+        reads a few of the bank's hundreds of rows (measured: ~10 per closed set on the bench grasps' relaxations, of
+        126-1048), so each is worked out when first read, not for the whole bank."""
+        index = _indices(bits)
+        missing = bits & ~self.known
+        if missing:
+            chosen = np.array(index if missing == bits else _indices(missing), dtype=np.int64)
+            row_bounds(rows.bank, rows.rhs, self.inverse, self.q0, self.directions, chosen, LP_FEASIBILITY, self.reserve, self.rates)
+            self.known |= missing
+        return index
 
 
-def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
+def _closed_set(rows: _Rows, equal: list[int], k: int) -> _ClosedSet | _Twists:
     """What the ``k`` closed rows ``E q = e`` leave, every row loosened by ``LP_FEASIBILITY``.
 
     With ``E+`` the pseudo-inverse of the ``k`` rows and ``q0 = E+ e``, the part of ``q - q0`` in E's row space
@@ -1371,37 +1386,19 @@ def _closed_set(rows: _Rows, equal: np.ndarray, k: int) -> _ClosedSet | _Twists:
     small singular values join may disagree in round-off), so no set is pruned for it.
     """
     n = rows.g.size
-    E, e = rows.bank[equal], rows.rhs[equal]  # ``equal``: a boolean mask of the bank's rows
-    u, sigma, vt = np.linalg.svd(E, full_matrices=k < n)  # a line's direction is the last row of the full vt
-    full = min(k, n)
-    r = int(np.count_nonzero(sigma > MOTION_RANK)) if rows.by_rank else full
-    if r == 0 or sigma[r - 1] <= MOTION_RANK:
-        return _UNKNOWN
-    pseudo_inverse = (vt[:r].T / sigma[:r]) @ u[:, :r].T
-    q0 = pseudo_inverse @ e
-    residual = E @ q0 - e
-    if r == full and residual @ residual > k * LP_FEASIBILITY**2:
+    E, e = rows.bank[equal], rows.rhs[equal]  # ``equal``: the closed bank rows, ascending
+    sigma, basis, pseudo_inverse, q0, spread = np.empty(n), np.empty((n, n)), np.empty((n, k)), np.empty(n), np.empty(n)
+    # spread: as far as a twist meeting the rows as the seed does may lie, per entry
+    r, square = closed_rows(E, e, rows.by_rank, MOTION_RANK, JACOBI_ORTHOGONAL, ZERO, sigma, basis, pseudo_inverse, q0, spread)
+    if r == 0:
+        return _UNKNOWN  # no singular value above MOTION_RANK (with by_rank), or the closed rows' rank is deficient
+    if r == min(k, n) and square > k * LP_FEASIBILITY**2:
         return _PRUNED
-    spread = ZERO * np.abs(pseudo_inverse).sum(axis=1)  # as far as a twist meeting the rows as the seed does may lie
     radius = math.sqrt(k) * LP_FEASIBILITY / float(sigma[r - 1])
-    # Each bank row's best slack at q0 (t = 0 on a line), every row loosened by LP_FEASIBILITY; the rows of
-    # |bank E+| summed by a product (numpy's sum along a short axis costs 4x more).
-    bank = rows.bank
-    reach = np.abs(bank @ pseudo_inverse) @ np.ones(k)
-    reserve = bank @ q0 + LP_FEASIBILITY * reach - rows.rhs + LP_FEASIBILITY
     free = n - r
-    rates: tuple[list[float], ...] = ()  # for a line or a plane only (a point's children keep it)
-    plane_rates = _NO_RATES
-    if free == 1:
-        rates = ((bank @ vt[-1]).tolist(),)
-    elif free == 2:
-        plane_rates = bank @ vt[-2:].T
-        rates = (plane_rates[:, 0].tolist(), plane_rates[:, 1].tolist())
-    row_reserve = reserve.tolist() if rates else []
-    return _ClosedSet(q0, radius, spread, reserve, vt[-1], vt[-2:], free, row_reserve, rates, plane_rates)
-
-
-_NO_RATES = np.zeros((0, 2))  # a closed set's plane rates where it leaves no plane
+    directions = basis[r:n] if free <= 2 else basis[:0]  # a line's or a plane's (the last right singular vectors)
+    R = rows.bank.shape[0]
+    return _ClosedSet(q0, radius, spread, pseudo_inverse, directions, free, np.empty(R), np.empty((R, 2)))
 
 
 def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
@@ -1411,23 +1408,26 @@ def _line(rows: _Rows, closed: _ClosedSet, low: float, high: float) -> _Twists:
     shape = _Shape(closed, interval=(low, high))
     if not (math.isfinite(low) and math.isfinite(high)):
         return _Twists(False, shape=shape)
-    ends = closed.q0 + low * closed.direction, closed.q0 + high * closed.direction
+    direction = closed.directions[0]
+    ends = closed.q0 + low * direction, closed.q0 + high * direction
     if _near_seed(rows, *ends, closed.spread):
         return _PRUNED
     return _Twists(False, _Ball(0.5 * (ends[0] + ends[1]), 0.5 * (high - low) + closed.radius), shape=shape)
 
 
-def _on_plane(rows: _Rows, closed: _ClosedSet, at_least: np.ndarray, count: int) -> _Twists:
+def _on_plane(rows: _Rows, closed: _ClosedSet, at_least: int) -> _Twists:
     """Twists ``q0 + P^T x`` (``P``: the closed set's plane, ``x`` in R^2) with ``rate x + reserve >= 0`` for each of
-    the ``count`` inequality rows ``at_least`` (a mask of the bank's): a polygon, decided exactly in the plane.
+    the inequality rows ``at_least`` (bits): a polygon, decided exactly in the plane.
 
     It is bounded when its rows' normals leave no angle of ``pi`` or more between neighbours (they positively
     span the plane); then it is the hull of its vertices, the intersections of two of its lines that meet every
     row (with round-off's leniency): none means it is empty. Lines closer to parallel than :data:`_PARALLEL`
     meet far away or not at all; between that and :data:`_SKEW` a vertex is too close to call (no bound given).
     """
+    count = at_least.bit_count()
     vertices = np.empty((count * (count - 1) // 2, 2))
-    found = polygon_vertices(closed.plane_rates, closed.reserve, at_least, _PARALLEL, _SKEW, ROUNDOFF_SLACK, vertices)
+    closed.read(rows, at_least)
+    found = polygon_vertices(closed.rates, closed.reserve, rows.row_mask(at_least), _PARALLEL, _SKEW, ROUNDOFF_SLACK, vertices)
     if found == UNBOUNDED:
         return _UNKNOWN  # unbounded (or too close to call)
     if found == 0:
@@ -1458,20 +1458,15 @@ def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Ver
 
 def _polygon(rows: _Rows, closed: _ClosedSet, vertices: _Vertices) -> _Twists:
     """The twists over the hull of ``vertices`` (in the closed set's plane): the seed's (pruned), or a ball."""
-    twists = closed.q0 + np.array(vertices) @ closed.plane
-    if _all_near_seed(rows, twists, closed.spread):
+    center = np.empty(closed.q0.size)
+    seed = _NO_SEED if rows.seed is None else rows.seed
+    reach = polygon_ball(closed.q0, closed.directions, np.array(vertices), seed, closed.spread, SAME_TWIST, DISTINCT_TWIST, center)
+    if reach == NEAR_SEED:
         return _PRUNED
-    center = 0.5 * (twists.min(axis=0) + twists.max(axis=0))
-    reach = math.sqrt(float(((twists - center) ** 2).sum(axis=1).max()))
     return _Twists(False, _Ball(center, reach * (1.0 + ROUNDOFF_SLACK) + closed.radius), shape=_Shape(closed, vertices=vertices))
 
 
-def _all_near_seed(rows: _Rows, twists: np.ndarray, spread: np.ndarray) -> bool:
-    """Whether every twist of ``twists`` (rows; their hull) lies within the seed's box, as :func:`_near_seed`."""
-    if rows.seed is None:
-        return False
-    offset = np.abs(twists - rows.seed).max(axis=0)
-    return bool(offset.max() <= 0.5 * SAME_TWIST and (offset + spread).max() <= 0.5 * DISTINCT_TWIST)
+_NO_SEED = np.zeros(0)  # polygon_ball's seed where the search has none
 
 
 def _near_seed(rows: _Rows, first: np.ndarray, second: np.ndarray, spread: np.ndarray) -> bool:

@@ -1,10 +1,12 @@
-"""The vertices of a polygon given by half-planes, compiled: the mode branch and bound's plane of twists.
+"""The vertices of a polygon given by half-planes, and the ball around it, compiled: the mode branch and bound's plane
+of twists.
 
 Where a node's closed rows leave a plane of twists, its inequality rows cut a polygon from it
 (:func:`..certify.patterns._on_plane`): ``rates[k] . x + reserve[k] >= 0`` for the rows kept. A few to twenty rows,
-thousands of nodes: numpy's calls cost ~60 us a polygon there, these loops ~2 us. With numba the loops below are
-compiled; without it, the same loops in C (``quasistatic._kernels``, where the default install built it), else
-the same arithmetic in whole-array numpy calls.
+thousands of nodes: numpy's calls cost ~60 us a polygon there, these loops ~2 us. The polygon's twists are then
+bounded by a ball, or found in the seed's box (:func:`polygon_ball`: ~20 numpy calls, ~25 us, where the loops take
+~2 us). With numba the loops below are compiled; without it, the same loops in C (``quasistatic._kernels``, where the
+default install built it), else the same arithmetic in whole-array numpy calls.
 """
 
 from __future__ import annotations
@@ -14,12 +16,14 @@ import math
 import numpy as np
 
 from ...compiled import HAVE_KERNELS
+from ...compiled import polygon_ball as compiled_polygon_ball
 from ...compiled import polygon_vertices as compiled_polygon_vertices
 from ...jit import njit
 
-__all__ = ["polygon_vertices", "UNBOUNDED"]
+__all__ = ["polygon_vertices", "polygon_ball", "UNBOUNDED", "NEAR_SEED"]
 
 UNBOUNDED = -1  # polygon_vertices' answer for a polygon not known to be bounded (or too close to call)
+NEAR_SEED = -1.0  # polygon_ball's answer for a polygon whose twists all lie in the seed's box
 
 
 def _polygon_vertices_numpy(
@@ -124,3 +128,85 @@ def polygon_vertices(
                 vertices[count, 0], vertices[count, 1] = x, y
                 count += 1
     return count
+
+
+def _polygon_ball_numpy(
+    q0: np.ndarray,
+    directions: np.ndarray,
+    vertices: np.ndarray,
+    seed: np.ndarray,
+    spread: np.ndarray,
+    same: float,
+    distinct: float,
+    center: np.ndarray,
+) -> float:
+    """:func:`polygon_ball` in whole-array numpy calls (without numba or the C extension)."""
+    twists = q0 + vertices @ directions
+    if seed.size:
+        offset = np.abs(twists - seed).max(axis=0)
+        if offset.max() <= 0.5 * same and (offset + spread).max() <= 0.5 * distinct:
+            return NEAR_SEED
+    center[:] = 0.5 * (twists.min(axis=0) + twists.max(axis=0))
+    return math.sqrt(float(((twists - center) ** 2).sum(axis=1).max()))
+
+
+def _polygon_ball_compiled(
+    q0: np.ndarray,
+    directions: np.ndarray,
+    vertices: np.ndarray,
+    seed: np.ndarray,
+    spread: np.ndarray,
+    same: float,
+    distinct: float,
+    center: np.ndarray,
+) -> float:
+    """:func:`polygon_ball`'s loops in C (without numba, where the extension was built)."""
+    return compiled_polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center)
+
+
+@njit(python=_polygon_ball_compiled if HAVE_KERNELS else _polygon_ball_numpy)
+def polygon_ball(
+    q0: np.ndarray,
+    directions: np.ndarray,
+    vertices: np.ndarray,
+    seed: np.ndarray,
+    spread: np.ndarray,
+    same: float,
+    distinct: float,
+    center: np.ndarray,
+) -> float:
+    """The twists ``q0 + vertices[v] directions`` of a polygon's vertices (their hull: the polygon's twists): when a
+    ``seed`` is given (else it is empty) and every twist lies within ``same / 2`` of it per entry, and within
+    ``distinct / 2`` with ``spread`` added, :data:`NEAR_SEED`; else the ball around them, its ``center`` (the middle
+    of their bounding box, filled) and radius (returned, without round-off's margin).
+
+    ``q0`` (n,), ``directions`` (2, n), ``vertices`` (V, 2) with ``V >= 1``, ``seed`` (n,) or (0,), ``spread`` and
+    ``center`` (n,), all float64 and C-contiguous.
+    """
+    n, count = q0.size, vertices.shape[0]
+    twists = np.empty((count, n))
+    for v in range(count):
+        for j in range(n):
+            twists[v, j] = q0[j] + (vertices[v, 0] * directions[0, j] + vertices[v, 1] * directions[1, j])
+    if seed.size:
+        farthest, widest = 0.0, 0.0
+        for j in range(n):
+            offset = 0.0
+            for v in range(count):
+                offset = max(offset, abs(twists[v, j] - seed[j]))
+            farthest = max(farthest, offset)
+            widest = max(widest, offset + spread[j])
+        if farthest <= 0.5 * same and widest <= 0.5 * distinct:
+            return NEAR_SEED
+    for j in range(n):
+        low, high = twists[0, j], twists[0, j]
+        for v in range(1, count):
+            low, high = min(low, twists[v, j]), max(high, twists[v, j])
+        center[j] = 0.5 * (low + high)
+    reach = 0.0
+    for v in range(count):
+        square = 0.0
+        for j in range(n):
+            square += (twists[v, j] - center[j]) * (twists[v, j] - center[j])
+        reach = max(reach, square)
+    return math.sqrt(reach)
