@@ -116,7 +116,8 @@ def prove_unique_exact(problem: Problem, motion: RawMotion, options: Options, is
         return Uniqueness(False, reason="the fixed-mode equations are not proven to have one zero near the motion")
     residual = laws.enclosure(point(x))
     near = None if residual is None else _NearMotion(problem, laws, x, residual[0])
-    return _far(problem, motion.q, masks, angles, arc, options, is_motion, near)
+    least_loaded = [int(i) for i in np.argsort(np.asarray(motion.c)[:, -1], kind="stable")]
+    return _far(problem, motion.q, masks, angles, arc, options, is_motion, near, least_loaded)
 
 
 def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.ndarray, angles: np.ndarray) -> float | None:
@@ -294,8 +295,13 @@ def _far(
     options: Options,
     is_motion: Callable[[np.ndarray], bool],
     near: _NearMotion | None,
+    order: list[int],
 ) -> Uniqueness:
     """Every leaf of the sector relaxation outside the arcs (or with other modes) excluded, refining the sectors.
+
+    ``order``: the contacts, least loaded first, as the tree splits them (the pyramid's proof orders them so;
+    measured on the bench grasps: 21 % fewer nodes than as numbered). Each round resumes where the last
+    stopped (:class:`~.patterns.PassedRegions`: the regions it excluded before its surviving leaf).
 
     A node whose twists are all the motion's (its rows pin them: a rolling contact whose force may reach the
     circle, say) holds no other motion; the branch and bound passes it over (``twist=q``). A surviving leaf with
@@ -331,10 +337,11 @@ def _far(
 
     rounds = refinements = 0
     farkas: tuple[np.ndarray, ...] = ()  # the last round's, tried first on the next
+    passed = None  # what the rounds before excluded: the next resumes where the last stopped
     while options.remaining() > 0.0 and refinements < FAR_ROUNDS:
         rounds += 1
-        proof = relaxation_excluded(problem, sectors, options.remaining, covered, twist=q, farkas=farkas)
-        farkas = proof.farkas
+        proof = relaxation_excluded(problem, sectors, options.remaining, covered, q, farkas, passed, order)
+        farkas, passed = proof.farkas, proof.passed
         options.report(1, proof.nodes)  # a long proof shows on the CLI's status line
         if proof.excluded:
             return Uniqueness(True, rounds=rounds)
