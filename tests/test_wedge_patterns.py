@@ -94,7 +94,7 @@ def rolling_box() -> tuple[qs.Problem, np.ndarray]:
 
 def test_closed_rows_of_deficient_rank_leave_a_line_that_holds_the_motion(rolling_box: tuple[qs.Problem, np.ndarray]) -> None:
     problem, q = rolling_box
-    layout, _, _ = patterns._sector_layout(problem, _uniform(problem, 4), range(problem.n_contacts))
+    layout, _, _ = patterns._sector_layout(problem, _uniform(problem, 4), patterns.TreeShape(range(problem.n_contacts)))
     m = problem.n_contacts
     equal = np.zeros(layout.bank.shape[0], dtype=bool)
     equal[[*range(m), m, 2 * m]] = True  # every gap shut, contact 0 still: six rows of rank 5
@@ -153,9 +153,9 @@ def test_regions_passed_over_only_where_the_sectors_refine_those_they_were_found
     sectors = _uniform(problem, 4)
     proof = relaxation_excluded(problem, sectors)
     assert proof.passed is not None and proof.passed.regions  # a leaf survived after others were excluded
-    layout, _, sets = patterns._sector_layout(problem, sectors, range(problem.n_contacts))
+    layout, _, sets = patterns._sector_layout(problem, sectors, patterns.TreeShape(range(problem.n_contacts)))
     assert patterns._PassedOver.of(sets, sectors, None, proof.passed).regions  # the same sectors: kept
     merged = [np.delete(s, 1) for s in sectors]  # a boundary gone: a wider polygon than those excluded
-    _, _, merged_sets = patterns._sector_layout(problem, merged, range(problem.n_contacts))
+    _, _, merged_sets = patterns._sector_layout(problem, merged, patterns.TreeShape(range(problem.n_contacts)))
     assert not patterns._PassedOver.of(merged_sets, merged, None, proof.passed).regions
     assert not patterns._PassedOver.of(sets, sectors, np.zeros(problem.n_dof), proof.passed).regions  # another twist

@@ -166,6 +166,7 @@ __all__ = [
     "RelaxationProof",
     "PassedRegions",
     "SlipSet",
+    "TreeShape",
     "relaxation_excluded",
     "ROLLING_POLYGON",
     "CLOSED_LEAF",
@@ -456,6 +457,18 @@ def _tree_depth(mode: _Mode) -> int:
     return 1 + max((_tree_depth(child) for child in mode.children), default=-1)
 
 
+RELAXATION_ARC = 0.5 * np.pi  # widest arc of sectors (radians) a closed contact's first split gives in the sector
+# relaxation; measured: 22 % fewer nodes than half-turns on 62 relaxations of 8 and 16 sectors, the same verdicts
+
+
+class TreeShape(NamedTuple):
+    """The shape of the sector relaxation's tree: the order its levels split the contacts in, at each depth, and
+    the widest arc of sectors [rad] a closed contact's first split gives (below a half-turn)."""
+
+    order: Sequence[int]
+    widest_arc: float = RELAXATION_ARC
+
+
 class SlipSet(NamedTuple):
     """A set of one contact's modes in the sector relaxation: separating, rolling (closed and still; a frictionless
     contact's one closed mode), and sliding with its slip angle [rad] in ``low..high`` (none where ``low > high``)."""
@@ -513,7 +526,7 @@ def relaxation_excluded(
     twist: np.ndarray | None = None,
     farkas: Sequence[np.ndarray] = (),
     passed: PassedRegions | None = None,
-    order: Sequence[int] | None = None,
+    shape: TreeShape | None = None,
 ) -> RelaxationProof:
     """Whether the sector relaxation of the exact 3-D laws (:mod:`.wedge`) has no point, by the mode branch and bound.
 
@@ -536,10 +549,11 @@ def relaxation_excluded(
     so they exclude nodes before any fit (refined sectors' polygons lie inside the coarse ones': most still do).
     ``passed``: regions an earlier search excluded (:attr:`RelaxationProof.passed`; each leaf survived after the
     regions its search excluded in depth-first order), passed over where valid here (:class:`PassedRegions`):
-    the search resumes about where the last stopped instead of proving its tree's start again. ``order``: the
-    contacts in the order the tree splits them at each depth (the default: as numbered); it changes no verdict.
+    the search resumes about where the last stopped instead of proving its tree's start again. ``shape``: the
+    tree's (:class:`TreeShape`; the default: contacts as numbered, arcs of :data:`RELAXATION_ARC`); it changes
+    no verdict, only the search's cost.
     """
-    layout, sector_of, sets = _sector_layout(problem, sectors, range(problem.n_contacts) if order is None else order)
+    layout, sector_of, sets = _sector_layout(problem, sectors, TreeShape(range(problem.n_contacts)) if shape is None else shape)
     width = layout.loads.shape[1] // problem.n_contacts
 
     def leaf(node: _Node) -> tuple[int, ...]:
@@ -706,11 +720,11 @@ def _no_direction(rows: _Rows, equal: int, active: int) -> bool:
 
 
 def _sector_layout(
-    problem: Problem, sectors: list[np.ndarray], order: Sequence[int]
+    problem: Problem, sectors: list[np.ndarray], shape: TreeShape
 ) -> tuple[_Layout, dict[int, int], list[dict[int, SlipSet]]]:
     """The sector relaxation's rows and columns (see :func:`relaxation_excluded`), and the sector each leaf mode
-    slides in (by the mode's ``id``), per contact the set of modes each of its modes holds; the tree splits the
-    contacts in ``order`` at each depth. ``bank``: the normal rows (``i``), the two tangent rows (``m + i``,
+    slides in (by the mode's ``id``), per contact the set of modes each of its modes holds; the tree's
+    ``shape``. ``bank``: the normal rows (``i``), the two tangent rows (``m + i``,
     ``2 m + i``), then per contact and boundary angle ``theta`` the rows ``a(theta) x u >= 0`` and its negation,
     with ``u = Jt q - bt``. ``loads``: per contact a block of columns (the widest contact's count; the others
     padded with columns no mode keeps): a unit normal force with ``-c_t`` at each vertex of the rolling 16-gon,
@@ -730,12 +744,12 @@ def _sector_layout(
         rhs += [values, -values]
         tangents = _friction_points(float(mu[i]), angles)
         loads[:, i * width : i * width + len(tangents)] = Jn[i][:, None] - Jt[i].T @ tangents.T
-        root, contact_sets = _sector_tree(i, m, width, len(angles) - 1, angles, first_row, bool(mu[i] > 0.0), sector_of)
+        root, contact_sets = _sector_tree(i, m, width, angles, first_row, bool(mu[i] > 0.0), sector_of, shape.widest_arc)
         roots.append(root)
         sets.append(contact_sets)
         first_row += 2 * len(angles)
     rounds = max(_tree_depth(root) for root in roots)
-    levels = tuple(_Level(int(i)) for _ in range(rounds) for i in order)
+    levels = tuple(_Level(int(i)) for _ in range(rounds) for i in shape.order)
     return _Layout(np.vstack(bank), np.concatenate(rhs), loads, tuple(roots), levels), sector_of, sets
 
 
@@ -754,12 +768,13 @@ def _friction_points(mu: float, angles: np.ndarray) -> np.ndarray:
 
 
 def _sector_tree(
-    i: int, m: int, width: int, count: int, angles: np.ndarray, first_row: int, frictional: bool, sector_of: dict[int, int]
+    i: int, m: int, width: int, angles: np.ndarray, first_row: int, frictional: bool, sector_of: dict[int, int], widest_arc: float
 ) -> tuple[_Mode, dict[int, SlipSet]]:
     """Contact ``i``'s modes in the sector relaxation (rows and columns as in :func:`_sector_layout`): separating,
-    or closed; closed and frictional: rolling, or sliding in an arc of sectors of at most :data:`RELAXATION_ARC`
+    or closed; closed and frictional: rolling, or sliding in an arc of sectors of at most ``widest_arc`` [rad]
     (its two boundary rows; the columns of its sectors' polygons), halved down to one sector; and the set of
     modes each holds (by the mode's ``id``)."""
+    count = len(angles) - 1
     none = np.zeros(width, dtype=bool)
     real = none.copy()
     real[: ROLLING_POLYGON + 3 * count] = True
@@ -794,8 +809,8 @@ def _sector_tree(
         return noted(_mode(i, [i], rows, piece(first, last), (arc(first, middle), arc(middle + 1, last))), slips)
 
     groups, start = [], 0
-    for k in range(1, count + 1):  # arcs of at most RELAXATION_ARC (one sector may be wider, never a half-turn)
-        if k == count or angles[k + 1] - angles[start] > RELAXATION_ARC:
+    for k in range(1, count + 1):  # arcs of at most widest_arc (one sector may be wider, never a half-turn)
+        if k == count or angles[k + 1] - angles[start] > widest_arc:
             groups.append(arc(start, k - 1))
             start = k
     rolling = noted(_mode(i, [i, m + i, 2 * m + i], [], rolling_columns), SlipSet(False, True, *_NO_SLIP))
@@ -1069,8 +1084,6 @@ def _form_point(rows: _Rows, q: np.ndarray, fit: np.ndarray) -> np.ndarray | Non
 _PARALLEL = 1e-13  # sine of the angle below which two twist rows' lines in a plane are parallel (round-off)
 _SKEW = 1e-9  # sine above which two such lines meet at a vertex computed well; between the two, too close to call
 ROUNDOFF_SLACK = 1e-12  # relative leniency of a computed polygon vertex on its rows, and of its bounding radius
-RELAXATION_ARC = 0.5 * np.pi  # widest arc of sectors (radians) a closed contact's first split gives in the sector
-# relaxation; measured: 22 % fewer nodes than half-turns on 62 relaxations of 8 and 16 sectors, the same verdicts
 SLIP_ARCS = 4  # arcs of slip sectors a closed 3-D contact's first split gives (with rolling); measured: fewer
 # nodes than halves (2) or thirds (3) on the bench grasps at 8 and 32 edges, 6 and 8 more
 CLOCK_NODES = 256  # nodes between two looks at the caller's clock (~10 ms)
