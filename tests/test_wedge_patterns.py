@@ -6,7 +6,9 @@ relaxation only where SCIP proves it infeasible, and never where the exact laws 
 solve found one). It decides: on the random scenes SCIP calls infeasible it excludes most, and the jammed
 benchmark grasps get their wedge proof from it with SCIP's relaxation never built. On a box rolling on a table
 (gap rows of rank 3): the closed rows still bound the twists, the leaves that pin the motion's twist are passed
-over, and Farkas vectors handed to a search exclude nothing they do not prove.
+over, and Farkas vectors handed to a search exclude nothing they do not prove. A round resumed from the last
+(its excluded regions passed over) excludes only what SCIP proves infeasible, and only where its sectors refine
+those the regions were found with.
 """
 
 from __future__ import annotations
@@ -159,3 +161,19 @@ def test_regions_passed_over_only_where_the_sectors_refine_those_they_were_found
     _, _, merged_sets = patterns._sector_layout(problem, merged, patterns.TreeShape(range(problem.n_contacts)))
     assert not patterns._PassedOver.of(merged_sets, merged, None, proof.passed).regions
     assert not patterns._PassedOver.of(sets, sectors, np.zeros(problem.n_dof), proof.passed).regions  # another twist
+
+
+def test_rounds_resumed_reach_the_same_verdict_in_fewer_nodes() -> None:
+    problem = qs.assemble(grasp_3d(4, 1))  # jammed: its relaxation survives four refinements, then is excluded
+    totals = []
+    for resume in (False, True):
+        sectors, passed, nodes = _uniform(problem, 4), None, 0
+        for _ in range(8):
+            proof = relaxation_excluded(problem, sectors, passed=passed if resume else None)
+            nodes += proof.nodes
+            if proof.excluded or proof.sectors is None or not wedge.split_sectors(sectors, proof.sectors):
+                break
+            passed = proof.passed
+        assert proof.excluded
+        totals.append(nodes)
+    assert totals[1] < totals[0]
