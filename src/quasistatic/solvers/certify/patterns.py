@@ -116,7 +116,10 @@ same tree with other modes: per contact separating, rolling (force in a 16-gon a
 with its slip in one sector (force in that sector's polygon of chord and tangents), arcs of sectors halved
 down to one. Its nodes are pruned as above; a leaf is pruned only by an LP on its twist rows (infeasible),
 and the first that survives ends the search with its sectors (no seed, nothing listed): a closed tree proves
-that no point of the relaxation exists, within :data:`PYRAMID_PATTERN_NODES` nodes.
+that no point of the relaxation exists, within :data:`PYRAMID_PATTERN_NODES` nodes. The siblings before each node
+on the way to that leaf were excluded: as regions (a product over contacts of sets of modes) they let the next
+search, on the survivor's sectors halved, pass over what they hold (each halved sector's polygon lies inside the
+one it was cut from, so their exclusions still hold) and resume about where this one stopped.
 
 A leaf whose point or extremes fail the form's check (too close to call), an
 LP that does not answer, more motions than asked for, or more than
