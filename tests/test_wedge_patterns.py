@@ -6,7 +6,9 @@ relaxation only where SCIP proves it infeasible, and never where the exact laws 
 solve found one). It decides: on the random scenes SCIP calls infeasible it excludes most, and the jammed
 benchmark grasps get their wedge proof from it with SCIP's relaxation never built. On a box rolling on a table
 (gap rows of rank 3): the closed rows still bound the twists, the leaves that pin the motion's twist are passed
-over, and Farkas vectors handed to a search exclude nothing they do not prove.
+over, and Farkas vectors handed to a search exclude nothing they do not prove. A round resumed from the last
+(its excluded regions passed over) excludes only what SCIP proves infeasible, and only where its sectors refine
+those the regions were found with.
 """
 
 from __future__ import annotations
@@ -94,7 +96,7 @@ def rolling_box() -> tuple[qs.Problem, np.ndarray]:
 
 def test_closed_rows_of_deficient_rank_leave_a_line_that_holds_the_motion(rolling_box: tuple[qs.Problem, np.ndarray]) -> None:
     problem, q = rolling_box
-    layout, _ = patterns._sector_layout(problem, _uniform(problem, 4))
+    layout, _, _ = patterns._sector_layout(problem, _uniform(problem, 4), patterns.TreeShape(range(problem.n_contacts)))
     m = problem.n_contacts
     equal = [*range(m), m, 2 * m]  # every gap shut, contact 0 still: six rows of rank 5
     width = layout.loads.shape[1] // m
@@ -126,3 +128,51 @@ def test_farkas_vectors_passed_to_a_search_are_checked_on_its_own_columns(rollin
     assert not proof.excluded  # the box has a motion: no vector may exclude it
     refined = relaxation_excluded(problem, [np.sort(np.append(s, s[0] + 0.1)) for s in sectors], farkas=proof.farkas)
     assert not refined.excluded and all(v.shape == (problem.n_dof,) for v in proof.farkas)
+
+
+def test_a_search_resumed_from_the_last_excludes_only_what_scip_proves_infeasible() -> None:
+    """Each round refines the surviving leaf's sectors and passes over what the last excluded (its regions are
+    products of sets of modes whose polygons hold the refined ones'): a resumed exclusion is SCIP's too."""
+    resumed = 0
+    for scene in [grasp_3d(4, 1), grasp_3d(4, 2), *(_scene(seed) for seed in range(30))]:  # the grasps jam
+        problem = qs.assemble(scene)
+        sectors, passed = _uniform(problem, 4), None
+        for _ in range(6):
+            proof = relaxation_excluded(problem, sectors, passed=passed)
+            if proof.excluded and passed is not None and passed.regions:
+                resumed += 1
+                status = wedge._relaxation(problem, Options(time_limit=30.0).start_clock(), sectors, None)[0]
+                assert status == "infeasible", "excluded when resumed, feasible for SCIP"
+            if proof.sectors is None or not wedge.split_sectors(sectors, proof.sectors):
+                break
+            passed = proof.passed
+    assert resumed >= 3
+
+
+def test_regions_passed_over_only_where_the_sectors_refine_those_they_were_found_with() -> None:
+    problem = qs.assemble(grasp_3d(4, 1))  # jammed
+    sectors = _uniform(problem, 4)
+    proof = relaxation_excluded(problem, sectors)
+    assert proof.passed is not None and proof.passed.regions  # a leaf survived after others were excluded
+    layout, _, sets = patterns._sector_layout(problem, sectors, patterns.TreeShape(range(problem.n_contacts)))
+    assert patterns._PassedOver.of(sets, sectors, None, proof.passed).regions  # the same sectors: kept
+    merged = [np.delete(s, 1) for s in sectors]  # a boundary gone: a wider polygon than those excluded
+    _, _, merged_sets = patterns._sector_layout(problem, merged, patterns.TreeShape(range(problem.n_contacts)))
+    assert not patterns._PassedOver.of(merged_sets, merged, None, proof.passed).regions
+    assert not patterns._PassedOver.of(sets, sectors, np.zeros(problem.n_dof), proof.passed).regions  # another twist
+
+
+def test_rounds_resumed_reach_the_same_verdict_in_fewer_nodes() -> None:
+    problem = qs.assemble(grasp_3d(4, 1))  # jammed: its relaxation survives four refinements, then is excluded
+    totals = []
+    for resume in (False, True):
+        sectors, passed, nodes = _uniform(problem, 4), None, 0
+        for _ in range(8):
+            proof = relaxation_excluded(problem, sectors, passed=passed if resume else None)
+            nodes += proof.nodes
+            if proof.excluded or proof.sectors is None or not wedge.split_sectors(sectors, proof.sectors):
+                break
+            passed = proof.passed
+        assert proof.excluded
+        totals.append(nodes)
+    assert totals[1] < totals[0]

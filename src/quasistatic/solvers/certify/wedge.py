@@ -96,10 +96,12 @@ def _by_branch_and_bound(
 ) -> bool | None:
     """The relaxation decided by the mode branch and bound, refining ``sectors`` in place: True, infeasible
     (proven); False, a surviving pattern's twist is an exact motion; None, no answer (SCIP's loop goes on)."""
+    passed = None  # what the rounds before excluded: the next resumes where the last stopped
     for _ in range(BRANCH_AND_BOUND_ROUNDS):
         if options.remaining() <= 0.0:
             return None
-        proof = relaxation_excluded(problem, sectors, options.remaining)
+        proof = relaxation_excluded(problem, sectors, options.remaining, passed=passed)
+        passed = proof.passed
         if proof.excluded:
             return True
         if proof.sectors is None or proof.q is None:
