@@ -305,7 +305,7 @@ def test_without_numba_the_default_install_runs_the_kernels() -> None:
             assert lp._analyse is lp._analyse_compiled and audit._array_kernel(2, 3) is compiled.audit_laws
             assert motion._drop_roundoff is compiled.drop_roundoff
             assert nnls.nonnegative_fit is nnls._nonnegative_fit_compiled
-            assert polygon.polygon_vertices is polygon._polygon_vertices_compiled
+            assert polygon.polygon_vertices is compiled.polygon_vertices
         else:
             assert lp._analyse is lp._analyse_numpy and audit._array_kernel(2, 3) is None
             assert motion._drop_roundoff is motion._drop_roundoff_numpy

@@ -475,9 +475,9 @@ def stack_rows(rows: Sequence[np.ndarray], width: int) -> np.ndarray:
     """``np.array(rows, dtype=float)`` of 1-D float vectors of length ``width``, (len(rows), width), copied in C
     (numpy's conversion of a list of small arrays costs ~10x more); numpy's where the extension was not built or a
     row is not a C-contiguous float64 vector of that length."""
-    out = np.empty((len(rows), width))
     if kernels is None:  # not built: numpy's, the same numbers
         return np.array(rows, dtype=float).reshape(len(rows), width)
+    out = np.empty((len(rows), width))
     try:
         kernels.stack_rows(rows, out)
     except ValueError:

@@ -54,24 +54,7 @@ def _closed_rows_numpy(
     return r, float(residual @ residual)
 
 
-def _closed_rows_compiled(
-    E: np.ndarray,
-    e: np.ndarray,
-    by_rank: bool,
-    rank: float,
-    orthogonal: float,
-    zero: float,
-    sigma: np.ndarray,
-    basis: np.ndarray,
-    inverse: np.ndarray,
-    q0: np.ndarray,
-    spread: np.ndarray,
-) -> tuple[int, float]:
-    """:func:`closed_rows`' loops in C (without numba, where the extension was built)."""
-    return compiled_closed_rows(E, e, by_rank, rank, orthogonal, zero, sigma, basis, inverse, q0, spread)
-
-
-@njit(python=_closed_rows_compiled if HAVE_KERNELS else _closed_rows_numpy)
+@njit(python=compiled_closed_rows if HAVE_KERNELS else _closed_rows_numpy)
 def closed_rows(
     E: np.ndarray,
     e: np.ndarray,
@@ -191,22 +174,7 @@ def _row_bounds_numpy(
     rates[rows, : directions.shape[0]] = chosen @ directions.T
 
 
-def _row_bounds_compiled(
-    bank: np.ndarray,
-    rhs: np.ndarray,
-    inverse: np.ndarray,
-    q0: np.ndarray,
-    directions: np.ndarray,
-    rows: np.ndarray,
-    slack: float,
-    reserve: np.ndarray,
-    rates: np.ndarray,
-) -> None:
-    """:func:`row_bounds`' loops in C (without numba, where the extension was built)."""
-    compiled_row_bounds(bank, rhs, inverse, q0, directions, rows, slack, reserve, rates)
-
-
-@njit(python=_row_bounds_compiled if HAVE_KERNELS else _row_bounds_numpy)
+@njit(python=compiled_row_bounds if HAVE_KERNELS else _row_bounds_numpy)
 def row_bounds(
     bank: np.ndarray,
     rhs: np.ndarray,

@@ -57,14 +57,7 @@ def _polygon_vertices_numpy(
     return count
 
 
-def _polygon_vertices_compiled(
-    rates: np.ndarray, reserve: np.ndarray, rows: np.ndarray, parallel: float, skew: float, slack: float, vertices: np.ndarray
-) -> int:
-    """:func:`polygon_vertices`' loops in C (without numba, where the extension was built)."""
-    return compiled_polygon_vertices(rates, reserve, rows, parallel, skew, slack, vertices)
-
-
-@njit(python=_polygon_vertices_compiled if HAVE_KERNELS else _polygon_vertices_numpy)
+@njit(python=compiled_polygon_vertices if HAVE_KERNELS else _polygon_vertices_numpy)
 def polygon_vertices(
     rates: np.ndarray, reserve: np.ndarray, rows: np.ndarray, parallel: float, skew: float, slack: float, vertices: np.ndarray
 ) -> int:
@@ -150,21 +143,7 @@ def _polygon_ball_numpy(
     return math.sqrt(float(((twists - center) ** 2).sum(axis=1).max()))
 
 
-def _polygon_ball_compiled(
-    q0: np.ndarray,
-    directions: np.ndarray,
-    vertices: np.ndarray,
-    seed: np.ndarray,
-    spread: np.ndarray,
-    same: float,
-    distinct: float,
-    center: np.ndarray,
-) -> float:
-    """:func:`polygon_ball`'s loops in C (without numba, where the extension was built)."""
-    return compiled_polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center)
-
-
-@njit(python=_polygon_ball_compiled if HAVE_KERNELS else _polygon_ball_numpy)
+@njit(python=compiled_polygon_ball if HAVE_KERNELS else _polygon_ball_numpy)
 def polygon_ball(
     q0: np.ndarray,
     directions: np.ndarray,
