@@ -1337,11 +1337,13 @@ def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
     rows.proof.fits += 1
     lam = np.empty(rows.loads.shape[1])
     residual = nonnegative_fit(rows.loads, rows.columns(columns), rows.target, lam)
-    found = _Fit(lam, _bits(lam > 0.0))
     if residual <= rows.farkas.margin:
+        found = _Fit(lam, _bits(lam > 0.0))
         rows.fits.add(found)
         return found
-    return None if rows.farkas.add(-(rows.loads @ lam + rows.g), columns) else found
+    if rows.farkas.add(-(rows.loads @ lam + rows.g), columns):
+        return None  # excluded: the fit's support is never read
+    return _Fit(lam, _bits(lam > 0.0))
 
 
 @dataclass
@@ -1634,9 +1636,14 @@ def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Ver
     if min(values) >= 0.0:
         return vertices
     size = math.hypot(a, b)
-    kept = [v for v, value in zip(vertices, values, strict=True) if value >= -ROUNDOFF_SLACK * (size * math.hypot(*v) + abs(reserve))]
-    above = [(v, value) for v, value in zip(vertices, values, strict=True) if value > 0.0]
-    below = [(v, value) for v, value in zip(vertices, values, strict=True) if value < 0.0]
+    kept, above, below = [], [], []  # in the vertices' order, one pass
+    for v, value in zip(vertices, values, strict=True):
+        if value > 0.0:
+            above.append((v, value))
+        elif value < 0.0:
+            below.append((v, value))
+        if value >= -ROUNDOFF_SLACK * (size * math.hypot(*v) + abs(reserve)):
+            kept.append(v)
     if not above:
         return kept
     crossings = [(x + t * (u - x), y + t * (w - y)) for (x, y), va in above for (u, w), vb in below for t in (va / (va - vb),)]
