@@ -1082,6 +1082,10 @@ static Py_ssize_t closed_rows_loops(Py_ssize_t k, Py_ssize_t n, const double *E,
     memcpy(W, E, sizeof(double) * (size_t)(k * n));
     for (Py_ssize_t i = 0; i < n; i++)
         for (Py_ssize_t j = 0; j < n; j++) V[i * n + j] = i == j ? 1.0 : 0.0;
+    double negligible = 0.0; /* a null direction's column, in round-off: no pair with it turns */
+    for (Py_ssize_t i = 0; i < k; i++)
+        for (Py_ssize_t j = 0; j < n; j++) negligible += E[i * n + j] * E[i * n + j];
+    negligible *= orthogonal * orthogonal;
     for (int sweep = 0; sweep < 60; sweep++) {
         int rotated = 0;
         for (Py_ssize_t p = 0; p + 1 < n; p++)
@@ -1092,7 +1096,7 @@ static Py_ssize_t closed_rows_loops(Py_ssize_t k, Py_ssize_t n, const double *E,
                     beta += W[i * n + q] * W[i * n + q];
                     gamma += W[i * n + p] * W[i * n + q];
                 }
-                if (gamma == 0.0 || fabs(gamma) <= orthogonal * sqrt(alpha * beta)) continue;
+                if (gamma == 0.0 || fabs(gamma) <= orthogonal * sqrt(alpha * beta) || fmin(alpha, beta) <= negligible) continue;
                 rotated = 1;
                 double cos, sin;
                 jacobi_rotation(alpha, beta, gamma, &cos, &sin);

@@ -227,22 +227,16 @@ class _Mode:
 
 
 @dataclass(frozen=True, slots=True)
-class _Level:
-    """One level of the tree: the contact whose current set of modes (the node's) is split into its children."""
-
-    contact: int
-
-
-@dataclass(frozen=True, slots=True)
 class _Layout:
     """A problem's twist rows (``bank q >= or = rhs``), its load columns (a unit normal force on each edge of
-    each contact, ``K`` per contact), each contact's set of every mode (``roots``) and the levels of the tree."""
+    each contact, ``K`` per contact), each contact's set of every mode (``roots``) and the levels of the tree (each
+    the contact whose current set of modes, the node's, it splits into its children)."""
 
     bank: np.ndarray
     rhs: np.ndarray
     loads: np.ndarray
     roots: tuple[_Mode, ...]
-    levels: tuple[_Level, ...]
+    levels: tuple[int, ...]
 
 
 @dataclass
@@ -256,7 +250,7 @@ class _Rows:
     g: np.ndarray
     seed: np.ndarray | None  # the seed's twist
     form: LCPForm | None  # None: the sector relaxation of exact cones (:func:`relaxation_excluded`)
-    levels: tuple[_Level, ...]
+    levels: tuple[int, ...]  # the contact each level of the tree splits
     budget: int  # most nodes
     farkas: _FarkasVectors
     fits: _Fits = field(default_factory=lambda: _Fits())
@@ -326,16 +320,22 @@ class _Node:
     depth: int
     closed_rows: int = 0  # how many rows ``equal`` holds
 
-    def child(self, contact: int, mode: _Mode) -> _Node:
+    def child(self, contact: int, mode: _Mode, levels: tuple[int, ...]) -> _Node:
+        """The node with ``contact``'s set narrowed to ``mode``, past the next levels whose contact's set is one mode
+        already (nothing to split; ``levels``: the contact each splits)."""
         columns = self.columns & ~mode.removes
         modes = (*self.modes[:contact], mode, *self.modes[contact + 1 :])
         new_equal = mode.equal_bits & ~self.equal
         at_least = (self.at_least & ~new_equal) | (mode.at_least_bits & ~self.at_least)
-        return _Node(self.equal | new_equal, at_least, columns, modes, self.depth + 1, self.closed_rows + new_equal.bit_count())
+        depth = _settled_depth(levels, modes, self.depth + 1)
+        return _Node(self.equal | new_equal, at_least, columns, modes, depth, self.closed_rows + new_equal.bit_count())
 
-    def deeper(self) -> _Node:
-        """The same node one level down (a level that does not apply to it)."""
-        return _Node(self.equal, self.at_least, self.columns, self.modes, self.depth + 1, self.closed_rows)
+
+def _settled_depth(levels: tuple[int, ...], modes: tuple[_Mode, ...], depth: int) -> int:
+    """The first level from ``depth`` whose contact's set of ``modes`` splits (or the leaves' depth)."""
+    while depth < len(levels) and not modes[levels[depth]].children:
+        depth += 1
+    return depth
 
 
 def _bits(mask: np.ndarray) -> int:
@@ -377,7 +377,7 @@ def _planar_layout(problem: Problem, order: list[int]) -> _Layout:
     loads = np.stack([Jn + mu * Jt, Jn - mu * Jt], axis=1).reshape(-1, problem.n_dof).T
     roots = tuple(_planar_tree(i, m, bool(problem.mu[i] > 0.0)) for i in range(m))
     bank, rhs = np.vstack([Jn, Jt, -Jt, Jt]), np.concatenate([bn, bt, -bt, bt])
-    return _Layout(bank, rhs, loads, roots, tuple(_Level(i) for i in order))
+    return _Layout(bank, rhs, loads, roots, tuple(order))
 
 
 @functools.lru_cache(maxsize=4096)
@@ -420,7 +420,7 @@ def _pyramid_layout(form: LCPForm, groups: list[list[int]]) -> _Layout:
     loads = (Jn[:, None, :] + mu[:, None, None] * JD).reshape(m * K, n).T
     roots = tuple(_contact_tree(i, m, K, bool(mu[i] > 0.0)) for i in range(m))
     rounds = max(_tree_depth(root) for root in roots)
-    levels = [_Level(i) for group in groups for _ in range(rounds) for i in group]
+    levels = [i for group in groups for _ in range(rounds) for i in group]
     return _Layout(bank, rhs, loads, roots, tuple(levels))
 
 
@@ -754,7 +754,7 @@ def _sector_layout(
         sets.append(contact_sets)
         first_row += 2 * len(angles)
     rounds = max(_tree_depth(root) for root in roots)
-    levels = tuple(_Level(int(i)) for _ in range(rounds) for i in shape.order)
+    levels = tuple(int(i) for _ in range(rounds) for i in shape.order)
     return _Layout(np.vstack(bank), np.concatenate(rhs), loads, tuple(roots), levels), sector_of, sets
 
 
@@ -881,13 +881,13 @@ def _pinning_first(problem: Problem, q: np.ndarray, order: list[int]) -> list[in
     return sorted(order, key=lambda i: int(rank[i]))
 
 
-def _most_loaded_first(levels: tuple[_Level, ...], fit: _Fit, m: int) -> tuple[_Level, ...]:
+def _most_loaded_first(levels: tuple[int, ...], fit: _Fit, m: int) -> tuple[int, ...]:
     """Without a seed or a hint, the levels at each depth take the contacts the root's fit loads most first, as
     :func:`_order` takes a seed's: the first motion, which prunes the nodes after it, is met sooner (measured on
     the bench grasps' seedless searches: 12-20 % fewer nodes than as numbered)."""
     load = fit.forces.reshape(m, -1).sum(axis=1)
     order = [int(i) for i in np.argsort(-load, kind="stable")]
-    return tuple(_Level(i) for _ in range(len(levels) // m) for i in order)
+    return tuple(i for _ in range(len(levels) // m) for i in order)
 
 
 def _seed_modes_first(layout: _Layout, form: LCPForm, seed_x: np.ndarray) -> tuple[_Mode, ...]:
@@ -966,7 +966,7 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists, passed: list[i
     leaf = len(rows.levels)
     if node.depth == leaf:
         return False  # a leaf that survived: another motion may exist
-    contact = rows.levels[node.depth].contact
+    contact = rows.levels[node.depth]
     modes = _possible_modes(rows, node.modes[contact].children, twists.ball)
     excluded = rows.farkas.excludes(node.columns, rows.outside[contact], modes)
     blocked = False  # a closed sibling's Farkas vector also holds for separating, which keeps fewer columns
@@ -985,7 +985,7 @@ def _search(rows: _Rows, node: _Node, fit: _Fit, twists: _Twists, passed: list[i
             if any(not bits & ~region for region in passed):
                 continue  # an earlier search excluded it
             child_passed = over.meeting(passed, bits)
-        child = _past_settled(rows, node.child(contact, mode))
+        child = node.child(contact, mode, rows.levels)
         child_twists = _child_twists(rows, node, child, mode, twists)
         if child_twists.pruned:
             continue  # before any fit, known or new: the twists cost less
@@ -1044,10 +1044,8 @@ def _out_of_time(rows: _Rows) -> bool:
 
 def _past_settled(rows: _Rows, node: _Node) -> _Node:
     """``node`` moved past the levels whose contact's set is one mode already (nothing to split)."""
-    levels = rows.levels
-    while node.depth < len(levels) and not node.modes[levels[node.depth].contact].children:
-        node = node.deeper()
-    return node
+    depth = _settled_depth(rows.levels, node.modes, node.depth)
+    return node if depth == node.depth else _Node(node.equal, node.at_least, node.columns, node.modes, depth, node.closed_rows)
 
 
 def _child_twists(rows: _Rows, node: _Node, child: _Node, mode: _Mode, parent: _Twists) -> _Twists:
@@ -1268,34 +1266,41 @@ def _possible_modes(rows: _Rows, modes: tuple[_Mode, ...], ball: _Ball | None) -
     filter_ = rows.filters.get(id(modes))
     if filter_ is None:
         filter_ = rows.filters[id(modes)] = _ModeFilter.of(rows, modes)
-    slack = filter_.bank @ ball.center - filter_.rhs
-    reach = filter_.norms * ball.radius + LP_FEASIBILITY
-    meets, above = (np.abs(slack) <= reach).tolist(), (slack >= -reach).tolist()
+    slack = (filter_.bank @ ball.center - filter_.rhs).tolist()
+    radius = ball.radius
+    missed = below = 0  # the rows no point of the ball meets as equalities, and as inequalities (bits of the union)
+    for j, (value, norm) in enumerate(zip(slack, filter_.norms, strict=True)):  # a few rows: floats, not arrays
+        reach = norm * radius + LP_FEASIBILITY
+        if not abs(value) <= reach:
+            missed |= 1 << j
+            if not value >= -reach:
+                below |= 1 << j
     return tuple(
         mode
         for mode, equal, at_least in zip(modes, filter_.equal, filter_.at_least, strict=True)
-        if mode.separating or (all(meets[j] for j in equal) and all(above[j] for j in at_least))
+        if mode.separating or not (equal & missed or at_least & below)
     )
 
 
 @dataclass(frozen=True, slots=True)
 class _ModeFilter:
-    """The bank rows of a node's modes (``bank``, ``rhs``, ``norms``: their union), and each mode's among them."""
+    """The bank rows of a node's modes (``bank``, ``rhs``, ``norms``: their union), and each mode's among them
+    (bits of the union's positions)."""
 
     bank: np.ndarray
     rhs: np.ndarray
-    norms: np.ndarray
-    equal: tuple[list[int], ...]
-    at_least: tuple[list[int], ...]
+    norms: list[float]
+    equal: tuple[int, ...]
+    at_least: tuple[int, ...]
 
     @classmethod
     def of(cls, rows: _Rows, modes: tuple[_Mode, ...]) -> _ModeFilter:
         # From the modes' bit sets: iterating their index arrays reads numpy scalars one by one (~20x slower).
         union = _indices(functools.reduce(lambda bits, mode: bits | mode.equal_bits | mode.at_least_bits, modes, 0))
         where = {r: j for j, r in enumerate(union)}
-        equal = tuple([where[r] for r in _indices(mode.equal_bits)] for mode in modes)
-        at_least = tuple([where[r] for r in _indices(mode.at_least_bits)] for mode in modes)
-        return cls(rows.bank[union], rows.rhs[union], rows.norms[union], equal, at_least)
+        equal = tuple(sum(1 << where[r] for r in _indices(mode.equal_bits)) for mode in modes)
+        at_least = tuple(sum(1 << where[r] for r in _indices(mode.at_least_bits)) for mode in modes)
+        return cls(rows.bank[union], rows.rhs[union], rows.norms[union].tolist(), equal, at_least)
 
 
 def _margin(rows: _Rows) -> float:
@@ -1332,11 +1337,13 @@ def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
     rows.proof.fits += 1
     lam = np.empty(rows.loads.shape[1])
     residual = nonnegative_fit(rows.loads, rows.columns(columns), rows.target, lam)
-    found = _Fit(lam, _bits(lam > 0.0))
-    if residual <= _margin(rows):
+    if residual <= rows.farkas.margin:
+        found = _Fit(lam, _bits(lam > 0.0))
         rows.fits.add(found)
         return found
-    return None if rows.farkas.add(-(rows.loads @ lam + rows.g), columns) else found
+    if rows.farkas.add(-(rows.loads @ lam + rows.g), columns):
+        return None  # excluded: the fit's support is never read
+    return _Fit(lam, _bits(lam > 0.0))
 
 
 @dataclass
@@ -1396,11 +1403,16 @@ class _FarkasVectors:
     def excludes(self, columns: int, outside: int, modes: tuple[_Mode, ...]) -> list[bool]:
         """For each of ``modes`` (of one contact; ``outside``: every column not in its block, bits): whether a kept
         vector excludes ``columns`` (bits) narrowed to the mode's."""
-        left = [blockers & columns for blockers in self.blockers]  # the blockers a node's columns hold
-        if 0 in left:
-            return [True] * len(modes)  # a vector excludes the node itself
-        inside = [blockers for blockers in left if not blockers & outside]  # a mode's narrowing may remove these
-        return [any(not blockers & ~mode.removes for blockers in inside) for mode in modes]
+        inside = []  # the blockers the node's columns hold that a mode's narrowing may remove
+        for blockers in self.blockers:
+            left = blockers & columns
+            if not left:
+                return [True] * len(modes)  # a vector excludes the node itself
+            if not left & outside:
+                inside.append(left)
+        if not inside:
+            return [False] * len(modes)
+        return [any(not left & ~mode.removes for left in inside) for mode in modes]
 
 
 @dataclass(slots=True)  # made per node: not frozen, whose __init__ costs 3x; no one writes one
@@ -1624,9 +1636,14 @@ def _cut(vertices: _Vertices, rate: tuple[float, float], reserve: float) -> _Ver
     if min(values) >= 0.0:
         return vertices
     size = math.hypot(a, b)
-    kept = [v for v, value in zip(vertices, values, strict=True) if value >= -ROUNDOFF_SLACK * (size * math.hypot(*v) + abs(reserve))]
-    above = [(v, value) for v, value in zip(vertices, values, strict=True) if value > 0.0]
-    below = [(v, value) for v, value in zip(vertices, values, strict=True) if value < 0.0]
+    kept, above, below = [], [], []  # in the vertices' order, one pass
+    for v, value in zip(vertices, values, strict=True):
+        if value > 0.0:
+            above.append((v, value))
+        elif value < 0.0:
+            below.append((v, value))
+        if value >= -ROUNDOFF_SLACK * (size * math.hypot(*v) + abs(reserve)):
+            kept.append(v)
     if not above:
         return kept
     crossings = [(x + t * (u - x), y + t * (w - y)) for (x, y), va in above for (u, w), vb in below for t in (va / (va - vb),)]

@@ -70,7 +70,9 @@ def closed_rows(
 ) -> tuple[int, float]:
     """The closed rows ``E q = e`` factored: ``E = U diag(sigma) basis`` with ``sigma`` (n,) largest first (zeros past
     ``k``) and ``basis`` (n, n) orthonormal rows, the right singular vectors, by one-sided Jacobi rotations of E's
-    columns (Hestenes; pairs left once their cosine is below ``orthogonal``, as ``solvers/lp.py``'s); the ranks kept,
+    columns (Hestenes; pairs left once their cosine is below ``orthogonal``, as ``solvers/lp.py``'s, or once one of
+    them is below ``orthogonal`` times E's Frobenius norm: a null direction's column, in round-off, which would keep
+    turning where E has fewer rows than columns, measured: all 60 sweeps instead of 5-7); the ranks kept,
     ``r``: with ``by_rank`` the singular values above ``rank``, else ``min(k, n)``; the pseudo-inverse truncated to
     them, ``inverse`` (n, k); ``q0 = inverse e``; ``spread = zero |inverse|`` summed along each row. Returns ``r`` and
     the squared residual ``|E q0 - e|^2``; ``(0, 0.0)`` when no rank is kept or the last kept is ``rank`` or less (then
@@ -79,6 +81,11 @@ def closed_rows(
     k, n = E.shape
     W = E.copy()  # its columns rotated until orthogonal: W = E V
     V = np.eye(n)
+    negligible = 0.0  # a column's square norm below this is a null direction's, in round-off: no pair with it turns
+    for i in range(k):
+        for j in range(n):
+            negligible += E[i, j] * E[i, j]
+    negligible *= orthogonal * orthogonal
     for _ in range(60):
         rotated = False
         for p in range(n - 1):
@@ -88,7 +95,7 @@ def closed_rows(
                     alpha += W[i, p] * W[i, p]
                     beta += W[i, q] * W[i, q]
                     gamma += W[i, p] * W[i, q]
-                if gamma == 0.0 or abs(gamma) <= orthogonal * math.sqrt(alpha * beta):
+                if gamma == 0.0 or abs(gamma) <= orthogonal * math.sqrt(alpha * beta) or min(alpha, beta) <= negligible:
                     continue
                 rotated = True
                 diff = beta - alpha  # tan of the rotation in solvers/lp.py's overflow-free form
