@@ -43,7 +43,7 @@ LEMKE_VARIANTS = [
 
 
 def _solve_lcp(solver: Any, M: np.ndarray, q: np.ndarray, max_pivots: int = 1000) -> tuple[int, np.ndarray, int]:
-    status, z, pivots, _ = solver(np.asarray(M, float), np.asarray(q, float), np.ones(len(q)), max_pivots, TOL)
+    status, z, pivots, _ = solver(np.asarray(M, float), np.asarray(q, float), np.ones(len(q)), max_pivots, TOL, 0)
     return int(status), z, int(pivots)
 
 
@@ -390,7 +390,7 @@ def test_lemke_reaches_only_solutions_of_index_plus_one(instance: int, index: in
     assert _solution_indices(M, q) == {index}
     rng = np.random.default_rng(instance)
     for d in (np.ones(len(q)), *np.exp(rng.uniform(-2.0, 2.0, (4, len(q))))):
-        assert lemke(M, q, d, 1000, TOL)[0] == status
+        assert lemke(M, q, d, 1000, TOL, 0)[0] == status
 
 
 @pytest.mark.parametrize(
@@ -653,8 +653,8 @@ def test_plain_python_twins_equal_the_compiled_kernels() -> None:
                 )
         M, q_lcp = lcp._assemble(Jn, Jt, bn, bt, mu_f, data.g, edges, fr)
         for got, want in zip(
-            lemke_module._lemke_numpy(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL),
-            lemke(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL),
+            lemke_module._lemke_numpy(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL, 0),
+            lemke(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL, 0),
             strict=True,
         ):
             np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)  # the same pivots: status, point, count, basis
