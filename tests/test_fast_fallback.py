@@ -303,29 +303,27 @@ def _without_one_switch(patch: pytest.MonkeyPatch) -> None:
 
 
 def _textbook_lemke(patch: pytest.MonkeyPatch) -> None:
-    """The fast path on Lemke's textbook path (the twist halves leave the basis as any variable does), as before the
-    free twist: its ray point on grasp-3d 8 #0 is the one from which the depth start converges."""
-    patch.setattr(fast, "lemke_motion", lambda problem, free_twist=False: lemke_motion(problem))
+    """The fast path on Lemke's textbook path (the twist halves leave the basis as any variable does, covering vector
+    of ones), as before session 19: its ray point on grasp-3d 8 #0 is the one from which the quick rounds switching
+    every contact fail and the depth start converges."""
+    patch.setattr(fast, "lemke_motion", lambda problem, short_path=False: lemke_motion(problem))
 
 
-@pytest.mark.parametrize(("size", "instance"), [(6, 0), (6, 1), (6, 2), (6, 3), (8, 0), (8, 1)])
-def test_the_fast_path_runs_lemke_with_the_twist_free_and_keeps_its_answers(
-    size: int, instance: int, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """The fast path's Lemke keeps the twist halves basic once they enter (free variables): its answer on these grasps
-    (Lemke's solution, or Newton's from the ray's end) is the textbook path's, status and twist to 1e-9 relative,
-    in fewer pivots on the 8-contact grasps (8 #0: 113, not 143; 8 #1: 89, not 99)."""
+@pytest.mark.parametrize(("size", "instance"), [(4, 0), (6, 0), (6, 1), (6, 2), (6, 3), (8, 0), (8, 1)])
+def test_the_fast_path_runs_lemkes_short_path_and_keeps_its_answers(size: int, instance: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The fast path's Lemke keeps the twist halves basic once they enter (free variables) and starts from a covering
+    vector of ``GAP_COVERING`` on the gap rates' rows: on these grasps it ends as the textbook path does (a solution,
+    or a ray from whose last point Newton's method answers), in fewer pivots (8 #0: 59, not 143; 8 #1: 81, not 99),
+    and the answer keeps its status and twist to 1e-9 relative."""
     problem = qs.assemble(FAMILIES["grasp-3d"].make(size, instance))
-    free, textbook = lemke_motion(problem, free_twist=True), lemke_motion(problem)
-    assert free[0] == textbook[0]
-    if size == 8:
-        assert free[4] < textbook[4]
+    short, textbook = lemke_motion(problem, short_path=True), lemke_motion(problem)
+    assert short[0] == textbook[0] and short[4] < textbook[4]
     answer = qs.solve(problem, method="fast")
     notes = dict(answer.notes)
-    if free[0] == RAY:
-        assert f"({free[4]} pivots)" in notes["lemke"]
+    if short[0] == RAY:
+        assert f"({short[4]} pivots)" in notes["lemke"]
     else:
-        assert notes["pivots"] == free[4]
+        assert notes["pivots"] == short[4]
     with monkeypatch.context() as patch:
         _textbook_lemke(patch)
         before = qs.solve(problem, method="fast")
@@ -335,12 +333,14 @@ def test_the_fast_path_runs_lemke_with_the_twist_free_and_keeps_its_answers(
 
 
 def test_newton_switching_one_contact_a_round_answers_grasp_3d_8_0(monkeypatch: pytest.MonkeyPatch) -> None:
-    """grasp-3d 8 #0: from Lemke's ray point, Newton's quick rounds that switch every contact that must switch fail
-    (the first round ends with three closed contacts pulling, all opened at once); a round that switches only the
-    first of them reaches, in one switch, the motion that the full rounds from the ray's depth reach in ~1,000
-    evaluations of the laws (one of the scene's two motions, the one the mode branch and bound gave before)."""
+    """grasp-3d 8 #0: from the textbook Lemke path's ray point, Newton's quick rounds that switch every contact that
+    must switch fail (the first round ends with three closed contacts pulling, all opened at once); a round that
+    switches only the first of them reaches, in one switch, the motion that the full rounds from the ray's depth
+    reach in ~1,000 evaluations of the laws (one of the scene's two motions, the one the mode branch and bound gave
+    before). (From the fast path's short path's ray point the quick rounds switching every contact answer.)"""
     problem = qs.assemble(FAMILIES["grasp-3d"].make(8, 0))
     assert lemke_motion(problem)[0] == RAY
+    _textbook_lemke(monkeypatch)
     answer = qs.solve(problem, method="fast")
     notes = dict(answer.notes)
     assert answer.status == "solved" and notes["method"] == FROM_LEMKE_END, answer.message
@@ -348,7 +348,6 @@ def test_newton_switching_one_contact_a_round_answers_grasp_3d_8_0(monkeypatch: 
     assert answer.motion is not None and answer.motion.audit.passed and not answer.certified
     with monkeypatch.context() as patch:
         _without_one_switch(patch)
-        _textbook_lemke(patch)
         full_rounds = qs.solve(problem, method="fast")
     assert dict(full_rounds.notes)["newton_patience"] == NEWTON_ITERATIONS and dict(full_rounds.notes)["newton_switches"] == "all"
     twist = _twist(problem, answer.twists)
@@ -360,7 +359,7 @@ def test_newton_from_the_rays_last_point_with_its_depth_answers_grasp_3d_8_0(mon
     every gap rate raised by the artificial variable, so the contacts the path holds closed penetrate by it.
     Newton's method started with those contacts closed reaches the motion the mode branch and bound gave before
     (one of its two; ~100x slower); read with no depth (those contacts open), it fails and the branch and bound answers.
-    (The textbook path's ray point: from the free twist's, the depth start fails too.)"""
+    (The textbook path's ray point, where this start was found.)"""
     scene = FAMILIES["grasp-3d"].make(8, 0)
     problem = qs.assemble(scene)
     status, _, q, _, _, _ = lemke_motion(problem)

@@ -340,9 +340,11 @@ def _split_lcp_cases() -> Iterator[tuple[str, lcp.LemkeInputs]]:
         yield f"random 3-D #{seed} {friction}", qs.assemble(random_scene(3, seed, friction)).derived("fast", lcp.LemkeInputs)
 
 
-def _kernel_arguments(data: lcp.LemkeInputs, free_twist: bool = True) -> tuple[Any, ...]:
+def _kernel_arguments(data: lcp.LemkeInputs, short_path: bool = True) -> tuple[Any, ...]:
+    """The kernel's arguments: the fast path's (the twist free, :data:`lcp.GAP_COVERING`), or the textbook path's."""
     tolerances = (lcp.FRICTION_ALIGNMENT, lcp.MODE_SPEED, lcp.PIVOT, lcp.BASIS_FEASIBILITY, lcp.PIVOTS_PER_ROW)
-    return (data.J, data.b, data.mu, data.g, data.frictional, data.base, data.exact, free_twist, lcp.REALIGNMENTS, *tolerances)
+    path = (True, lcp.GAP_COVERING) if short_path else (False, 1.0)
+    return (data.J, data.b, data.mu, data.g, data.frictional, data.base, data.exact, *path, lcp.REALIGNMENTS, *tolerances)
 
 
 @needs_extension
@@ -351,15 +353,15 @@ def test_the_extensions_split_lcp_kernel_is_the_numba_kernels() -> None:
     """The same status, stage, pivots and re-alignments, and the same motion to 1e-9 relative, on every case; every stage met."""
     stages: dict[bool, set[tuple[int, int]]] = {False: set(), True: set()}
     for name, data in _split_lcp_cases():
-        for free_twist in (False, True):  # the textbook path (the LP's, the certified candidate's) and the fast path's
-            arguments = _kernel_arguments(data, free_twist)
+        for short_path in (False, True):  # the textbook path (the LP's, the certified candidate's) and the fast path's
+            arguments = _kernel_arguments(data, short_path)
             got, want = lcp._solve_split_lcp_compiled(*arguments), lcp.solve_split_lcp(*arguments)
             assert [int(v) for v in (got[0], got[1], got[4], got[5])] == [int(v) for v in (want[0], want[1], want[4], want[5])], name
             for g, w in ((got[2], want[2]), (got[3], want[3])):
                 np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(w).max(initial=0.0))), err_msg=name)
-            stages[free_twist].add((int(want[0]), int(want[1])))
-    for free_twist, met in stages.items():
-        assert {(SOLUTION, 0), (SOLUTION, 2), (RAY, 0), (RAY, 1), (lcp.NOT_CONVERGED, 2)} <= met, (free_twist, met)
+            stages[short_path].add((int(want[0]), int(want[1])))
+    for short_path, met in stages.items():
+        assert {(SOLUTION, 0), (SOLUTION, 2), (RAY, 0), (RAY, 1), (lcp.NOT_CONVERGED, 2)} <= met, (short_path, met)
 
 
 @needs_extension

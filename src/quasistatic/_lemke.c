@@ -6,7 +6,7 @@
  *       int64 are filled; z_0 .. z_{free-1} are free (they never leave the basis once they enter). NaN
  *       never qualifies in a comparison, so NaN data end on a ray or at max_pivots, never in a loop or
  *       out of bounds.
- *   solve_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, ..., q, c) -> (status, stage, pivots, realignments)
+ *   solve_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, gap_covering, ..., q, c) -> (status, stage, pivots, realignments)
  *       The fast path's whole kernel, solvers/numerics/lcp.py::solve_split_lcp step for step.
  *   lemke_address
  *       The address of quasistatic_lemke, the same method on raw pointers (no Python objects):
@@ -521,9 +521,10 @@ typedef struct {
     const int64_t *frictional;
     double mode_tol, dissipation_tol, pivot_tol, feasibility_tol, cone_roundoff, newton_damping, newton_stop;
     int64_t pivots_per_row;
-    int free_twist; /* the twist halves q+, q- free in Lemke's method (kept basic once they enter) */
+    int free_twist;      /* the twist halves q+, q- free in Lemke's method (kept basic once they enter) */
+    double gap_covering; /* the covering vector's entries on the gap rates' rows (1 elsewhere) */
     /* the LCP */
-    double *Jn, *bn, *Jt, *bt, *mu_f, *offsets, *edges, *M, *qv, *ones, *z, *work, *A, *rhs, *U, *solution;
+    double *Jn, *bn, *Jt, *bt, *mu_f, *offsets, *edges, *M, *qv, *covering, *z, *work, *A, *rhs, *U, *solution;
     int64_t *basis, *rows, *basic;
     /* Newton's method (sizes up to n + 3 m unknowns) */
     double *x, *trial, *residual, *jacobian, *r_trial, *j_trial, *forces, *f_trial, *normal, *gradient, *step, *newton_q;
@@ -610,7 +611,7 @@ static void assemble(Split *s) {
 static int64_t split_lemke(Split *s, int64_t *pivots) {
     int64_t more = 0;
     const int64_t n_free = s->free_twist ? 2 * s->n : 0;
-    const int64_t status = quasistatic_lemke(s->N, s->M, s->qv, s->ones, s->pivots_per_row * s->N, s->pivot_tol, n_free, s->z, s->basis,
+    const int64_t status = quasistatic_lemke(s->N, s->M, s->qv, s->covering, s->pivots_per_row * s->N, s->pivot_tol, n_free, s->z, s->basis,
                                              &more, s->work, s->rows);
     *pivots += more;
     return status;
@@ -890,20 +891,20 @@ static SplitResult split_lcp(Split *s, int exact, int64_t max_realignments, doub
 enum { LARGEST_SPLIT = 1 << 20 }; /* LCP rows and Newton unknowns at most: keeps every size below in size_t */
 
 /* Lay the scratch arrays of s out in `memory` (doubles) and `integers` (int64, 3 N + 2 m of them) and set the covering
- * vector to ones; with memory NULL, only count. Returns the doubles used. */
+ * vector (gap_covering on the gap rates' rows, 1 elsewhere); with memory NULL, only count. Returns the doubles used. */
 static size_t lay_out(Split *s, double *memory, int64_t *integers) {
     const Py_ssize_t m = s->m, n = s->n, f = s->f, K = s->K, t = s->d - 1, N = s->N, S = n + 3 * m;
     size_t used = 0;
 #define TAKE(field, count) (s->field = memory ? memory + used : NULL, used += (size_t)(count))
     TAKE(Jn, m * n), TAKE(bn, m), TAKE(Jt, f * t * n), TAKE(bt, f * t), TAKE(mu_f, f), TAKE(offsets, f), TAKE(edges, f * K * t);
-    TAKE(M, N * N), TAKE(qv, N), TAKE(ones, N), TAKE(z, N), TAKE(work, N * (N + 3)), TAKE(A, N * N), TAKE(rhs, N);
+    TAKE(M, N * N), TAKE(qv, N), TAKE(covering, N), TAKE(z, N), TAKE(work, N * (N + 3)), TAKE(A, N * N), TAKE(rhs, N);
     TAKE(U, N > S ? N * N : S * S), TAKE(solution, N);
     TAKE(x, S), TAKE(trial, S), TAKE(residual, S), TAKE(jacobian, S * S), TAKE(r_trial, S), TAKE(j_trial, S * S);
     TAKE(forces, 3 * m), TAKE(f_trial, 3 * m), TAKE(normal, S * S), TAKE(gradient, S), TAKE(step, S), TAKE(newton_q, n);
 #undef TAKE
     if (memory == NULL) return used + 1; /* + 1: never a request for no bytes */
     s->basis = integers, s->rows = integers + N, s->basic = integers + 2 * N, s->kind = integers + 3 * N, s->column = integers + 3 * N + m;
-    for (Py_ssize_t i = 0; i < N; i++) s->ones[i] = 1.0;
+    for (Py_ssize_t i = 0; i < N; i++) s->covering[i] = i >= 2 * n && i < 2 * n + m ? s->gap_covering : 1.0;
     return used;
 }
 
@@ -935,13 +936,13 @@ static int take_double(PyObject *const *args, int index, double *value) {
 static int take_options(PyObject *const *args, Split *s, int *exact, long long *max_realignments) {
     *exact = PyObject_IsTrue(args[6]);
     s->free_twist = PyObject_IsTrue(args[7]);
-    *max_realignments = PyLong_AsLongLong(args[8]);
-    const long long pivots_per_row = PyLong_AsLongLong(args[13]);
+    *max_realignments = PyLong_AsLongLong(args[9]);
+    const long long pivots_per_row = PyLong_AsLongLong(args[14]);
     if (*exact < 0 || s->free_twist < 0 || ((*max_realignments == -1 || pivots_per_row == -1) && PyErr_Occurred())) return -1;
     s->pivots_per_row = pivots_per_row;
-    if (take_double(args, 9, &s->dissipation_tol) || take_double(args, 10, &s->mode_tol) || take_double(args, 11, &s->pivot_tol) ||
-        take_double(args, 12, &s->feasibility_tol) || take_double(args, 14, &s->cone_roundoff) ||
-        take_double(args, 15, &s->newton_damping) || take_double(args, 16, &s->newton_stop))
+    if (take_double(args, 8, &s->gap_covering) || take_double(args, 10, &s->dissipation_tol) || take_double(args, 11, &s->mode_tol) ||
+        take_double(args, 12, &s->pivot_tol) || take_double(args, 13, &s->feasibility_tol) || take_double(args, 15, &s->cone_roundoff) ||
+        take_double(args, 16, &s->newton_damping) || take_double(args, 17, &s->newton_stop))
         return -1;
     return 0;
 }
@@ -976,10 +977,11 @@ static int take_sizes(PyObject *const *args, Split *s, int exact) {
 
 static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
     (void)module;
-    if (nargs != 19) {
+    if (nargs != 20) {
         PyErr_SetString(PyExc_TypeError,
-                        "solve_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, max_realignments, dissipation_tol, mode_tol,"
-                        " pivot_tol, feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) takes 19 arguments");
+                        "solve_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, gap_covering, max_realignments, dissipation_tol,"
+                        " mode_tol, pivot_tol, feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) takes 20"
+                        " arguments");
         return NULL;
     }
     Split s;
@@ -989,7 +991,7 @@ static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssi
     if (take_options(args, &s, &exact, &max_realignments) < 0 || take_sizes(args, &s, exact) < 0) return NULL;
     const Py_ssize_t m = s.m, d = s.d, n = s.n, f = s.f, K = s.K;
     static const char *names[8] = {"J", "b", "mu", "g", "frictional", "base", "q", "c"};
-    const int indices[8] = {0, 1, 2, 3, 4, 5, 17, 18};
+    const int indices[8] = {0, 1, 2, 3, 4, 5, 18, 19};
     const int ndims[8] = {3, 2, 1, 1, 1, 1, 1, 2};
     const Py_ssize_t shapes[8][3] = {{m, d, n}, {m, d}, {m}, {n}, {f}, {K}, {n}, {m, d}};
     Py_buffer views[8];
@@ -1085,8 +1087,8 @@ static PyMethodDef methods[] = {
      "fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces): the fixed-mode laws at x,\n"
      "the numba kernel's loops; fills residual (N,), jacobian (N, N) and forces (m, d). See quasistatic.laws.fixed_modes."},
     {"solve_split_lcp", (PyCFunction)(void (*)(void))solve_split_lcp, METH_FASTCALL,
-     "solve_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, max_realignments, dissipation_tol, mode_tol, pivot_tol,\n"
-     "feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) -> (status, stage, pivots, realignments):\n"
+     "solve_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, gap_covering, max_realignments, dissipation_tol, mode_tol,\n"
+     "pivot_tol, feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) -> (status, stage, pivots, realignments):\n"
      "the fast path's kernel, the numba kernel's steps; fills q (n,) and c (m, d). See quasistatic.solvers.numerics.lcp."},
     {"exact_newton", (PyCFunction)(void (*)(void))exact_newton, METH_FASTCALL,
      "exact_newton(J, b, mu, g, q, c, depth, patience, one_switch, mode_tol, tol, cone_roundoff, newton_damping, newton_stop,"
