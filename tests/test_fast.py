@@ -43,7 +43,7 @@ LEMKE_VARIANTS = [
 
 
 def _solve_lcp(solver: Any, M: np.ndarray, q: np.ndarray, max_pivots: int = 1000) -> tuple[int, np.ndarray, int]:
-    status, z, pivots, _ = solver(np.asarray(M, float), np.asarray(q, float), np.ones(len(q)), max_pivots, TOL)
+    status, z, pivots, _ = solver(np.asarray(M, float), np.asarray(q, float), np.ones(len(q)), max_pivots, TOL, 0)
     return int(status), z, int(pivots)
 
 
@@ -137,6 +137,26 @@ def test_lemke_stops_at_its_pivot_limit() -> None:
     A = rng.normal(size=(8, 8))
     status, _, pivots = _solve_lcp(lemke, A @ A.T + np.eye(8), -np.abs(rng.normal(size=8)) - 1.0, max_pivots=2)
     assert (status, pivots) == (PIVOT_LIMIT, 2)
+
+
+@pytest.mark.parametrize("solver", LEMKE_VARIANTS)
+@pytest.mark.parametrize(("family", "size"), [("grasp-3d", 4), ("grasp-2d", 4)])
+def test_lemkes_free_variables_never_leave_and_may_turn_negative(solver: Any, family: str, size: int) -> None:
+    """With the split twist's halves free (``free = 2n``), Lemke ends at a point of the mixed LCP: the halves are
+    unbounded (some negative here), every other variable solves its complementarity, and equilibrium (the halves'
+    rows) holds exactly; every variant takes the same pivots."""
+    from quasistatic.solvers.numerics import lcp
+    from quasistatic.tools.bench.families import FAMILIES
+
+    scene = FAMILIES[family].make(size, 0)
+    M, q = _split_lcp(scene)
+    halves = 2 * qs.assemble(scene).derived("fast", lcp.LemkeInputs).J.shape[2]
+    status, z, pivots, _ = solver(M, q, np.ones(q.shape[0]), 1000, TOL, halves)
+    assert status == SOLUTION and int(pivots) == int(lemke(M, q, np.ones(q.shape[0]), 1000, TOL, halves)[2])
+    assert z[:halves].min() < -1e-6  # a free half went negative: it stayed in the basis
+    w = M @ z + q
+    assert np.abs(w[:halves]).max() <= 1e-9
+    assert z[halves:].min() >= -1e-9 and w[halves:].min() >= -1e-9 and abs(z[halves:] @ w[halves:]) <= 1e-9
 
 
 # --------------------------------------------------------------------------- the backend on scene files
@@ -390,7 +410,7 @@ def test_lemke_reaches_only_solutions_of_index_plus_one(instance: int, index: in
     assert _solution_indices(M, q) == {index}
     rng = np.random.default_rng(instance)
     for d in (np.ones(len(q)), *np.exp(rng.uniform(-2.0, 2.0, (4, len(q))))):
-        assert lemke(M, q, d, 1000, TOL)[0] == status
+        assert lemke(M, q, d, 1000, TOL, 0)[0] == status
 
 
 @pytest.mark.parametrize(
@@ -652,12 +672,13 @@ def test_plain_python_twins_equal_the_compiled_kernels() -> None:
                     lcp._contact_speeds_numpy(data.J, data.b, q, i), lcp._contact_speeds(data.J, data.b, q, i), rtol=1e-13, atol=1e-15
                 )
         M, q_lcp = lcp._assemble(Jn, Jt, bn, bt, mu_f, data.g, edges, fr)
-        for got, want in zip(
-            lemke_module._lemke_numpy(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL),
-            lemke(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL),
-            strict=True,
-        ):
-            np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)  # the same pivots: status, point, count, basis
+        for free in (0, 2 * n):  # the textbook path, and the split twist's halves free (the fast path's)
+            for got, want in zip(
+                lemke_module._lemke_numpy(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL, free),
+                lemke(M, q_lcp, np.ones(q_lcp.shape[0]), 4000, TOL, free),
+                strict=True,
+            ):
+                np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)  # the same pivots: status, point, count, basis
         kind = rng.integers(0, 3, m).astype(np.int64)  # separating, rolling and sliding contacts mixed
         column, size = fixed_modes.columns(kind, n, scene.dimension - 1)
         x = rng.normal(size=size)

@@ -302,13 +302,45 @@ def _without_one_switch(patch: pytest.MonkeyPatch) -> None:
     patch.setattr(fast, "_exact_from", every_switch)
 
 
+def _textbook_lemke(patch: pytest.MonkeyPatch) -> None:
+    """The fast path on Lemke's textbook path (the twist halves leave the basis as any variable does, covering vector
+    of ones), as before session 19: its ray point on grasp-3d 8 #0 is the one from which the quick rounds switching
+    every contact fail and the depth start converges."""
+    patch.setattr(fast, "lemke_motion", lambda problem, short_path=False: lemke_motion(problem))
+
+
+@pytest.mark.parametrize(("size", "instance"), [(4, 0), (6, 0), (6, 1), (6, 2), (6, 3), (8, 0), (8, 1)])
+def test_the_fast_path_runs_lemkes_short_path_and_keeps_its_answers(size: int, instance: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The fast path's Lemke keeps the twist halves basic once they enter (free variables) and starts from a covering
+    vector of ``GAP_COVERING`` on the gap rates' rows: on these grasps it ends as the textbook path does (a solution,
+    or a ray from whose last point Newton's method answers), in fewer pivots (8 #0: 59, not 143; 8 #1: 81, not 99),
+    and the answer keeps its status and twist to 1e-9 relative."""
+    problem = qs.assemble(FAMILIES["grasp-3d"].make(size, instance))
+    short, textbook = lemke_motion(problem, short_path=True), lemke_motion(problem)
+    assert short[0] == textbook[0] and short[4] < textbook[4]
+    answer = qs.solve(problem, method="fast")
+    notes = dict(answer.notes)
+    if short[0] == RAY:
+        assert f"({short[4]} pivots)" in notes["lemke"]
+    else:
+        assert notes["pivots"] == short[4]
+    with monkeypatch.context() as patch:
+        _textbook_lemke(patch)
+        before = qs.solve(problem, method="fast")
+    assert answer.status == before.status == "solved" and answer.motion is not None and answer.motion.audit.passed
+    twist = _twist(problem, answer.twists)
+    assert np.allclose(twist, _twist(problem, before.twists), rtol=0.0, atol=1e-9 * np.abs(twist).max())
+
+
 def test_newton_switching_one_contact_a_round_answers_grasp_3d_8_0(monkeypatch: pytest.MonkeyPatch) -> None:
-    """grasp-3d 8 #0: from Lemke's ray point, Newton's quick rounds that switch every contact that must switch fail
-    (the first round ends with three closed contacts pulling, all opened at once); a round that switches only the
-    first of them reaches, in one switch, the motion that the full rounds from the ray's depth reach in ~1,000
-    evaluations of the laws (one of the scene's two motions, the one the mode branch and bound gave before)."""
+    """grasp-3d 8 #0: from the textbook Lemke path's ray point, Newton's quick rounds that switch every contact that
+    must switch fail (the first round ends with three closed contacts pulling, all opened at once); a round that
+    switches only the first of them reaches, in one switch, the motion that the full rounds from the ray's depth
+    reach in ~1,000 evaluations of the laws (one of the scene's two motions, the one the mode branch and bound gave
+    before). (From the fast path's short path's ray point the quick rounds switching every contact answer.)"""
     problem = qs.assemble(FAMILIES["grasp-3d"].make(8, 0))
     assert lemke_motion(problem)[0] == RAY
+    _textbook_lemke(monkeypatch)
     answer = qs.solve(problem, method="fast")
     notes = dict(answer.notes)
     assert answer.status == "solved" and notes["method"] == FROM_LEMKE_END, answer.message
@@ -326,12 +358,14 @@ def test_newton_from_the_rays_last_point_with_its_depth_answers_grasp_3d_8_0(mon
     """grasp-3d 8 #0 without the start that switches one contact a round: Lemke's ray point solves the laws with
     every gap rate raised by the artificial variable, so the contacts the path holds closed penetrate by it.
     Newton's method started with those contacts closed reaches the motion the mode branch and bound gave before
-    (one of its two; ~100x slower); read with no depth (those contacts open), it fails and the branch and bound answers."""
+    (one of its two; ~100x slower); read with no depth (those contacts open), it fails and the branch and bound answers.
+    (The textbook path's ray point, where this start was found.)"""
     scene = FAMILIES["grasp-3d"].make(8, 0)
     problem = qs.assemble(scene)
     status, _, q, _, _, _ = lemke_motion(problem)
     assert status == RAY and lemke_depth(problem, q) > 0.0
     _without_one_switch(monkeypatch)
+    _textbook_lemke(monkeypatch)
     answer = qs.solve(problem, method="fast")
     assert answer.status == "solved" and dict(answer.notes)["method"] == FROM_LEMKE_END, answer.message
     assert dict(answer.notes)["newton_patience"] == NEWTON_ITERATIONS  # quick mode switches miss this one

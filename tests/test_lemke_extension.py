@@ -101,9 +101,9 @@ def test_the_extension_pivots_as_the_kernel_on_random_lcps(door: Callable[..., A
     seen: set[int] = set()
     for _, M, q in _random_lcps(rng, 400):
         d = np.ones(q.shape[0])
-        for max_pivots in (1000, 3):
-            want = REFERENCE(M, q, d, max_pivots, TOL)
-            _same_run(door(M, q, d, max_pivots, TOL), want)
+        for max_pivots, free in ((1000, 0), (3, 0), (1000, q.shape[0] // 2)):  # free: z[:free] never leave once basic
+            want = REFERENCE(M, q, d, max_pivots, TOL, free)
+            _same_run(door(M, q, d, max_pivots, TOL, free), want)
             seen.add(int(want[0]))
     assert seen == {SOLUTION, RAY, PIVOT_LIMIT}  # every ending was met
 
@@ -114,7 +114,7 @@ def test_the_extension_pivots_as_the_kernel_on_random_lcps(door: Callable[..., A
 def test_the_extension_on_the_smallest_lcps(n: int, door: Callable[..., Any]) -> None:
     for q in ([], [2.0]) if n == 0 else ([-2.0], [2.0], [0.0]):
         for M in (np.full((n, n), 3.0), np.full((n, n), -1.0)):
-            args = (M, np.array(q[:n], float), np.full(n, 0.5), 10, TOL)
+            args = (M, np.array(q[:n], float), np.full(n, 0.5), 10, TOL, n)
             _same_run(door(*args), REFERENCE(*args))
 
 
@@ -132,13 +132,13 @@ def test_the_numpy_twins_tie_break_is_the_kernels() -> None:
             continue
         ties += 1
         xB = np.where(np.isin(np.arange(n), rows), 0.0, 1.0)  # the rows tie at ratio 0, the others are above it
-        want = lemke_module._ratio_test(Binv, xB, col, np.zeros(n, np.int64), 2 * n, TOL)
+        want = lemke_module._ratio_test(Binv, xB, col, np.zeros(n, np.int64), 2 * n, TOL, 0)
         assert lemke_module._tie_break_numpy(Binv, col, rows, TOL) == want
     assert ties > 100
 
 
-def _bench_lcps() -> Iterator[tuple[str, np.ndarray, np.ndarray]]:
-    """The split-twist LCPs of the benchmark rows where Lemke's method dominates the time."""
+def _bench_lcps() -> Iterator[tuple[str, np.ndarray, np.ndarray, int]]:
+    """The split-twist LCPs of the benchmark rows where Lemke's method dominates the time, and their twist halves' count."""
     rows = [("grasp-2d", 2), ("grasp-2d", 4), ("grasp-2d", 8), ("grasp-3d", 4), ("grasp-2d-nf", 8)]
     rows += [("box-push-nf", 4), ("box-push-nf", 16), ("box-push-nf", 64), ("pile-nf", 10)]
     for family, size in rows:
@@ -147,18 +147,19 @@ def _bench_lcps() -> Iterator[tuple[str, np.ndarray, np.ndarray]]:
             Jn, bn, Jt, bt, mu_f = lcp._split_rows(data.J, data.b, data.mu, data.frictional)
             edges = lcp._edges(data.base, np.zeros(data.frictional.shape[0]), data.J.shape[1] - 1)
             M, q = lcp._assemble(Jn, Jt, bn, bt, mu_f, data.g, edges, data.frictional)
-            yield f"{family} {size} #{instance}", M, q
+            yield f"{family} {size} #{instance}", M, q, 2 * data.J.shape[2]
 
 
 @needs_extension
 @pytest.mark.parametrize("door", DOORS)
 def test_the_extension_pivots_as_the_kernel_on_the_bench_lcps(door: Callable[..., Any]) -> None:
-    for name, M, q in _bench_lcps():
+    for name, M, q, twist_halves in _bench_lcps():
         d = np.ones(q.shape[0])
         cap = lcp.PIVOTS_PER_ROW * q.shape[0]
-        got, want = door(M, q, d, cap, TOL), REFERENCE(M, q, d, cap, TOL)
-        assert int(want[2]) > 0, name  # Lemke pivots on every one
-        _same_run(got, want)
+        for free in (0, twist_halves):  # the textbook path, and the fast path's (the twist free)
+            got, want = door(M, q, d, cap, TOL, free), REFERENCE(M, q, d, cap, TOL, free)
+            assert int(want[2]) > 0, name  # Lemke pivots on every one
+            _same_run(got, want)
 
 
 @needs_extension
@@ -173,7 +174,7 @@ def test_the_extension_pivots_as_the_kernel_on_the_bench_lcps(door: Callable[...
 )
 def test_bad_shapes_raise(M: np.ndarray, q: np.ndarray, d: np.ndarray, message: str) -> None:
     with pytest.raises(ValueError, match=message):
-        compiled.lemke(M, q, d, 10, TOL)
+        compiled.lemke(M, q, d, 10, TOL, 0)
 
 
 @pytest.mark.skipif(not HAVE_NUMBA, reason="the compiled door needs numba")
@@ -181,7 +182,7 @@ def test_bad_shapes_raise(M: np.ndarray, q: np.ndarray, d: np.ndarray, message: 
 def test_bad_shapes_raise_through_the_compiled_door(M: np.ndarray, d: np.ndarray) -> None:
     """The C entry point trusts its sizes: the compiled ``lemke`` checks them first (never an out-of-bounds read)."""
     with pytest.raises(ValueError, match=r"M must be \(n, n\) and d \(n,\)"):
-        lemke(M, -np.ones(3), d, 10, TOL)
+        lemke(M, -np.ones(3), d, 10, TOL, 0)
 
 
 @needs_extension
@@ -191,19 +192,19 @@ def test_bad_output_buffers_raise() -> None:
 
     M, q, d = np.eye(3), -np.ones(3), np.ones(3)
     with pytest.raises(ValueError, match=r"z must have shape \(3,\)"):
-        _lemke.lemke(M, q, d, 10, TOL, np.empty(2), np.empty(3, np.int64))
+        _lemke.lemke(M, q, d, 10, TOL, 0, np.empty(2), np.empty(3, np.int64))
     with pytest.raises(ValueError, match="basis must be a C-contiguous int64"):
-        _lemke.lemke(M, q, d, 10, TOL, np.empty(3), np.empty(3, np.int32))
+        _lemke.lemke(M, q, d, 10, TOL, 0, np.empty(3), np.empty(3, np.int32))
     with pytest.raises(ValueError):
-        _lemke.lemke(M, q, d, 10, TOL, np.empty(3), np.empty(6, np.int64)[::2])
+        _lemke.lemke(M, q, d, 10, TOL, 0, np.empty(3), np.empty(6, np.int64)[::2])
     with pytest.raises(ValueError):
-        _lemke.lemke(M, q, d, 10, TOL, np.empty(3)[::-1], np.empty(3, np.int64))
+        _lemke.lemke(M, q, d, 10, TOL, 0, np.empty(3)[::-1], np.empty(3, np.int64))
     frozen = np.empty(3)
     frozen.flags.writeable = False
     with pytest.raises(ValueError):
-        _lemke.lemke(M, q, d, 10, TOL, frozen, np.empty(3, np.int64))
+        _lemke.lemke(M, q, d, 10, TOL, 0, frozen, np.empty(3, np.int64))
     with pytest.raises(TypeError):
-        _lemke.lemke(M, q, d, 10, TOL, np.empty(3))
+        _lemke.lemke(M, q, d, 10, TOL, 0, np.empty(3))
 
 
 @needs_extension
@@ -221,7 +222,7 @@ def test_nan_and_inf_end_within_the_pivot_limit(where: str, value: float, door: 
         q[1] = value
     if where in ("d", "all"):
         d[2] = value
-    status, z, pivots, basis = door(M, q, d, 40, TOL)
+    status, z, pivots, basis = door(M, q, d, 40, TOL, 0)
     assert status in (SOLUTION, RAY, PIVOT_LIMIT) and 0 <= pivots <= 40
     assert z.shape == (6,) and set(basis.tolist()) <= set(range(13))  # w, z or z0 in every row
 
@@ -237,7 +238,7 @@ def test_without_numba_the_default_install_runs_the_extension() -> None:
         from quasistatic.solvers.numerics import lemke as module
         expected = compiled.lemke if compiled.HAVE_EXTENSION else module._lemke_numpy
         assert module.lemke is expected, module.lemke
-        status, z, pivots, _ = module.lemke(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), np.ones(2), 10, 1e-11)
+        status, z, pivots, _ = module.lemke(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), np.ones(2), 10, 1e-11, 0)
         assert status == module.SOLUTION and np.allclose(z, [4 / 3, 7 / 3])
         """
     )
@@ -264,7 +265,7 @@ def test_with_numba_but_no_extension_the_kernels_call_numbas_lemke() -> None:
         rng = np.random.default_rng(1)
         for n in (0, 3, 12):
             A = rng.normal(size=(n, n))
-            args = (A @ A.T + np.eye(n), rng.normal(size=n), np.ones(n), 100, 1e-11)
+            args = (A @ A.T + np.eye(n), rng.normal(size=n), np.ones(n), 100, 1e-11, 0)
             got, want = module.lemke(*args), module.numba_lemke(*args)
             assert (got[0], got[2]) == (want[0], want[2]) and (got[3] == want[3]).all() and (got[1] == want[1]).all()
         assert qs.solve(qs.assemble(grasp_2d(4, 0)), method="fast").status == "solved"
@@ -339,24 +340,28 @@ def _split_lcp_cases() -> Iterator[tuple[str, lcp.LemkeInputs]]:
         yield f"random 3-D #{seed} {friction}", qs.assemble(random_scene(3, seed, friction)).derived("fast", lcp.LemkeInputs)
 
 
-def _kernel_arguments(data: lcp.LemkeInputs) -> tuple[Any, ...]:
+def _kernel_arguments(data: lcp.LemkeInputs, short_path: bool = True) -> tuple[Any, ...]:
+    """The kernel's arguments: the fast path's (the twist free, :data:`lcp.GAP_COVERING`), or the textbook path's."""
     tolerances = (lcp.FRICTION_ALIGNMENT, lcp.MODE_SPEED, lcp.PIVOT, lcp.BASIS_FEASIBILITY, lcp.PIVOTS_PER_ROW)
-    return (data.J, data.b, data.mu, data.g, data.frictional, data.base, data.exact, lcp.REALIGNMENTS, *tolerances)
+    path = (True, lcp.GAP_COVERING) if short_path else (False, 1.0)
+    return (data.J, data.b, data.mu, data.g, data.frictional, data.base, data.exact, *path, lcp.REALIGNMENTS, *tolerances)
 
 
 @needs_extension
 @pytest.mark.skipif(not HAVE_NUMBA, reason="the reference is the numba kernel")
 def test_the_extensions_split_lcp_kernel_is_the_numba_kernels() -> None:
     """The same status, stage, pivots and re-alignments, and the same motion to 1e-9 relative, on every case; every stage met."""
-    stages: set[tuple[int, int]] = set()
+    stages: dict[bool, set[tuple[int, int]]] = {False: set(), True: set()}
     for name, data in _split_lcp_cases():
-        arguments = _kernel_arguments(data)
-        got, want = lcp._solve_split_lcp_compiled(*arguments), lcp.solve_split_lcp(*arguments)
-        assert [int(v) for v in (got[0], got[1], got[4], got[5])] == [int(v) for v in (want[0], want[1], want[4], want[5])], name
-        for g, w in ((got[2], want[2]), (got[3], want[3])):
-            np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(w).max(initial=0.0))), err_msg=name)
-        stages.add((int(want[0]), int(want[1])))
-    assert {(SOLUTION, 0), (SOLUTION, 2), (RAY, 0), (RAY, 1), (lcp.NOT_CONVERGED, 2)} <= stages, stages
+        for short_path in (False, True):  # the textbook path (the LP's, the certified candidate's) and the fast path's
+            arguments = _kernel_arguments(data, short_path)
+            got, want = lcp._solve_split_lcp_compiled(*arguments), lcp.solve_split_lcp(*arguments)
+            assert [int(v) for v in (got[0], got[1], got[4], got[5])] == [int(v) for v in (want[0], want[1], want[4], want[5])], name
+            for g, w in ((got[2], want[2]), (got[3], want[3])):
+                np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(w).max(initial=0.0))), err_msg=name)
+            stages[short_path].add((int(want[0]), int(want[1])))
+    for short_path, met in stages.items():
+        assert {(SOLUTION, 0), (SOLUTION, 2), (RAY, 0), (RAY, 1), (lcp.NOT_CONVERGED, 2)} <= met, (short_path, met)
 
 
 @needs_extension
@@ -375,7 +380,7 @@ def test_the_extensions_split_lcp_kernel_checks_its_arrays() -> None:
             lcp._solve_split_lcp_compiled(*arguments[:index], value, *arguments[index + 1 :])
     planar = qs.assemble(FAMILIES["grasp-2d"].make(4, 0)).derived("fast", lcp.LemkeInputs)
     with pytest.raises(ValueError, match="exact cones need 3-D contacts"):
-        lcp._solve_split_lcp_compiled(*_kernel_arguments(planar)[:6], True, *_kernel_arguments(planar)[7:])
+        lcp._solve_split_lcp_compiled(*_kernel_arguments(planar)[:6], True, *_kernel_arguments(planar)[7:])  # exact in 2-D
 
 
 # --------------------------------------------------------------------------- Newton's method on the exact cones alone, in C

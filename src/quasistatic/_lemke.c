@@ -1,11 +1,12 @@
 /* Compiled kernels, each making the numba kernel's choices:
  *
- *   lemke(M, q, d, max_pivots, tol, z, basis) -> (status, pivots)
+ *   lemke(M, q, d, max_pivots, tol, free, z, basis) -> (status, pivots)
  *       Lemke's method with lexicographic anti-cycling, solvers/numerics/lemke.py's numba kernel
  *       pivot for pivot. M: (n, n) float64, q and d: (n,) float64; z: (n,) float64 and basis: (n,)
- *       int64 are filled. NaN never qualifies in a comparison, so NaN data end on a ray or at
- *       max_pivots, never in a loop or out of bounds.
- *   solve_split_lcp(J, b, mu, g, frictional, base, exact, ..., q, c) -> (status, stage, pivots, realignments)
+ *       int64 are filled; z_0 .. z_{free-1} are free (they never leave the basis once they enter). NaN
+ *       never qualifies in a comparison, so NaN data end on a ray or at max_pivots, never in a loop or
+ *       out of bounds.
+ *   solve_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, gap_covering, ..., q, c) -> (status, stage, pivots, realignments)
  *       The fast path's whole kernel, solvers/numerics/lcp.py::solve_split_lcp step for step.
  *   lemke_address
  *       The address of quasistatic_lemke, the same method on raw pointers (no Python objects):
@@ -15,7 +16,7 @@
  *       Newton's method on the exact 3-D fixed-mode laws from (q, c), solvers/numerics/lcp.py::_newton step
  *       for step (the kernel's own Newton, called alone); q_out (n,) and c_out (m, 3) are filled.
  *   api_version
- *       6; quasistatic/compiled.py runs without a .so built from an older source.
+ *       7; quasistatic/compiled.py runs without a .so built from an older source.
  *   fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces) -> None
  *       The fixed-mode laws at x, laws/fixed_modes.py::system loop for loop (the 3-D fast
  *       path's Newton iterations call it); the last three arrays are filled.
@@ -52,6 +53,7 @@ enum { SOLUTION = 0, RAY = 1, PIVOT_LIMIT = 2 };
  * the candidate rows of the ratio test with their values. */
 typedef struct {
     Py_ssize_t n;
+    int64_t n_free; /* z_0 .. z_{free-1} never leave the basis (a mixed LCP's free variables) */
     const double *M, *q, *d;
     double *Binv, *xB, *col, *values;
     int64_t *basis, *rows;
@@ -115,7 +117,8 @@ static Py_ssize_t keep_smallest(Lemke *s, Py_ssize_t count, Py_ssize_t column, d
 }
 
 /* The leaving row by the lexicographic minimum ratio; -1 when no entry of the entering
- * column is above the pivot tolerance (relative to its largest magnitude). */
+ * column is above the pivot tolerance (relative to its largest magnitude) in a row whose
+ * basic variable may leave (every row but a free variable's: a free variable has no bound). */
 static int64_t ratio_test(Lemke *s, int64_t artificial, double tol) {
     const Py_ssize_t n = s->n;
     double largest = 1.0;
@@ -124,7 +127,7 @@ static int64_t ratio_test(Lemke *s, int64_t artificial, double tol) {
     const double pivot_tol = tol * largest;
     Py_ssize_t count = 0;
     for (Py_ssize_t i = 0; i < n; i++)
-        if (s->col[i] > pivot_tol) s->rows[count++] = i;
+        if (s->col[i] > pivot_tol && !(s->basis[i] >= n && s->basis[i] < n + s->n_free)) s->rows[count++] = i;
     if (count > 0) count = keep_smallest(s, count, -1, tol);
     if (count == 0) return -1;
     for (Py_ssize_t k = 0; k < count; k++)
@@ -176,11 +179,12 @@ static int run(Lemke *s, int64_t max_pivots, double tol, int64_t *pivots) {
 }
 
 /* Lemke's method on raw arrays, no Python objects: the entry point numba kernels call (its address is the
- * module's lemke_address). M (n, n) row-major, q and d (n,); fills z (n,), basis (n,) and *pivots; work
- * (n (n + 3) doubles) and rows (n int64) are scratch space. The caller checks the sizes. Returns the status. */
-int64_t quasistatic_lemke(int64_t n, const double *M, const double *q, const double *d, int64_t max_pivots, double tol,
+ * module's lemke_address). M (n, n) row-major, q and d (n,); z_0 .. z_{free-1} are free (never leave the basis once
+ * they enter, so their values may turn negative); fills z (n,), basis (n,) and *pivots; work (n (n + 3) doubles) and
+ * rows (n int64) are scratch space. The caller checks the sizes. Returns the status. */
+int64_t quasistatic_lemke(int64_t n, const double *M, const double *q, const double *d, int64_t max_pivots, double tol, int64_t n_free,
                           double *z, int64_t *basis, int64_t *pivots, double *work, int64_t *rows) {
-    Lemke s = {(Py_ssize_t)n, M, q, d, work, work + n * n, work + n * n + n, work + n * n + 2 * n, basis, rows};
+    Lemke s = {(Py_ssize_t)n, n_free, M, q, d, work, work + n * n, work + n * n + n, work + n * n + 2 * n, basis, rows};
     int status = SOLUTION;
     int needs_pivots = 0;
     *pivots = 0;
@@ -234,14 +238,16 @@ static int take_buffer(PyObject *arg, Py_buffer *view, const char *name, const c
 
 static PyObject *lemke(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
     (void)module;
-    if (nargs != 7) {
-        PyErr_SetString(PyExc_TypeError, "lemke(M, q, d, max_pivots, tol, z, basis) takes 7 arguments");
+    if (nargs != 8) {
+        PyErr_SetString(PyExc_TypeError, "lemke(M, q, d, max_pivots, tol, free, z, basis) takes 8 arguments");
         return NULL;
     }
     const long long max_pivots = PyLong_AsLongLong(args[3]);
     if (max_pivots == -1 && PyErr_Occurred()) return NULL;
     const double tol = PyFloat_AsDouble(args[4]);
     if (tol == -1.0 && PyErr_Occurred()) return NULL;
+    const long long n_free = PyLong_AsLongLong(args[5]);
+    if (n_free == -1 && PyErr_Occurred()) return NULL;
 
     Py_buffer views[5];
     int taken = 0;
@@ -259,7 +265,7 @@ static PyObject *lemke(PyObject *module, PyObject *const *args, Py_ssize_t nargs
         }
     }
     static const char *names[5] = {"M", "q", "d", "z", "basis"};
-    const int inputs[5] = {0, 1, 2, 5, 6};
+    const int inputs[5] = {0, 1, 2, 6, 7};
     for (; taken < 5; taken++) {
         const int writable = taken >= 3;
         const char *codes = taken == 4 ? "ql" : "d";
@@ -280,7 +286,8 @@ static PyObject *lemke(PyObject *module, PyObject *const *args, Py_ssize_t nargs
     }
     int64_t status, pivots;
     Py_BEGIN_ALLOW_THREADS
-    status = quasistatic_lemke(n, views[0].buf, views[1].buf, views[2].buf, max_pivots, tol, views[3].buf, views[4].buf, &pivots, memory, rows);
+    status = quasistatic_lemke(n, views[0].buf, views[1].buf, views[2].buf, max_pivots, tol, n_free, views[3].buf, views[4].buf, &pivots, memory,
+                               rows);
     Py_END_ALLOW_THREADS
     PyMem_RawFree(rows);
     result = Py_BuildValue("(LL)", (long long)status, (long long)pivots);
@@ -514,8 +521,10 @@ typedef struct {
     const int64_t *frictional;
     double mode_tol, dissipation_tol, pivot_tol, feasibility_tol, cone_roundoff, newton_damping, newton_stop;
     int64_t pivots_per_row;
+    int free_twist;      /* the twist halves q+, q- free in Lemke's method (kept basic once they enter) */
+    double gap_covering; /* the covering vector's entries on the gap rates' rows (1 elsewhere) */
     /* the LCP */
-    double *Jn, *bn, *Jt, *bt, *mu_f, *offsets, *edges, *M, *qv, *ones, *z, *work, *A, *rhs, *U, *solution;
+    double *Jn, *bn, *Jt, *bt, *mu_f, *offsets, *edges, *M, *qv, *covering, *z, *work, *A, *rhs, *U, *solution;
     int64_t *basis, *rows, *basic;
     /* Newton's method (sizes up to n + 3 m unknowns) */
     double *x, *trial, *residual, *jacobian, *r_trial, *j_trial, *forces, *f_trial, *normal, *gradient, *step, *newton_q;
@@ -601,8 +610,9 @@ static void assemble(Split *s) {
 /* Lemke's method on the assembled LCP from the artificial start; fills z and basis, adds its pivots. */
 static int64_t split_lemke(Split *s, int64_t *pivots) {
     int64_t more = 0;
-    const int64_t status = quasistatic_lemke(s->N, s->M, s->qv, s->ones, s->pivots_per_row * s->N, s->pivot_tol, s->z, s->basis, &more,
-                                             s->work, s->rows);
+    const int64_t n_free = s->free_twist ? 2 * s->n : 0;
+    const int64_t status = quasistatic_lemke(s->N, s->M, s->qv, s->covering, s->pivots_per_row * s->N, s->pivot_tol, n_free, s->z, s->basis,
+                                             &more, s->work, s->rows);
     *pivots += more;
     return status;
 }
@@ -622,7 +632,7 @@ static void motion(const Split *s, double *q, double *c) {
 }
 
 /* The LCP solution with the last complementary basis (M_SS z_S = -q_S) into z, and whether it is feasible
- * (lcp.py::_basis_solution). */
+ * (lcp.py::_basis_solution; free twist halves may be negative). */
 static int basis_solution(Split *s) {
     const Py_ssize_t N = s->N;
     Py_ssize_t count = 0;
@@ -635,7 +645,12 @@ static int basis_solution(Split *s) {
             for (Py_ssize_t c = 0; c < count; c++) s->A[r * count + c] = s->M[s->basic[r] * N + s->basic[c]];
         }
         if (!linear_solve(count, s->A, s->rhs, s->U, s->solution)) return 0; /* the basis does not carry over */
+        const int64_t n_free = s->free_twist ? 2 * s->n : 0;
         for (Py_ssize_t r = 0; r < count; r++) {
+            if (s->basic[r] < n_free) {
+                s->z[s->basic[r]] = s->solution[r];
+                continue;
+            }
             if (s->solution[r] < -s->feasibility_tol) return 0;
             s->z[s->basic[r]] = py_max(s->solution[r], 0.0);
         }
@@ -876,20 +891,20 @@ static SplitResult split_lcp(Split *s, int exact, int64_t max_realignments, doub
 enum { LARGEST_SPLIT = 1 << 20 }; /* LCP rows and Newton unknowns at most: keeps every size below in size_t */
 
 /* Lay the scratch arrays of s out in `memory` (doubles) and `integers` (int64, 3 N + 2 m of them) and set the covering
- * vector to ones; with memory NULL, only count. Returns the doubles used. */
+ * vector (gap_covering on the gap rates' rows, 1 elsewhere); with memory NULL, only count. Returns the doubles used. */
 static size_t lay_out(Split *s, double *memory, int64_t *integers) {
     const Py_ssize_t m = s->m, n = s->n, f = s->f, K = s->K, t = s->d - 1, N = s->N, S = n + 3 * m;
     size_t used = 0;
 #define TAKE(field, count) (s->field = memory ? memory + used : NULL, used += (size_t)(count))
     TAKE(Jn, m * n), TAKE(bn, m), TAKE(Jt, f * t * n), TAKE(bt, f * t), TAKE(mu_f, f), TAKE(offsets, f), TAKE(edges, f * K * t);
-    TAKE(M, N * N), TAKE(qv, N), TAKE(ones, N), TAKE(z, N), TAKE(work, N * (N + 3)), TAKE(A, N * N), TAKE(rhs, N);
+    TAKE(M, N * N), TAKE(qv, N), TAKE(covering, N), TAKE(z, N), TAKE(work, N * (N + 3)), TAKE(A, N * N), TAKE(rhs, N);
     TAKE(U, N > S ? N * N : S * S), TAKE(solution, N);
     TAKE(x, S), TAKE(trial, S), TAKE(residual, S), TAKE(jacobian, S * S), TAKE(r_trial, S), TAKE(j_trial, S * S);
     TAKE(forces, 3 * m), TAKE(f_trial, 3 * m), TAKE(normal, S * S), TAKE(gradient, S), TAKE(step, S), TAKE(newton_q, n);
 #undef TAKE
     if (memory == NULL) return used + 1; /* + 1: never a request for no bytes */
     s->basis = integers, s->rows = integers + N, s->basic = integers + 2 * N, s->kind = integers + 3 * N, s->column = integers + 3 * N + m;
-    for (Py_ssize_t i = 0; i < N; i++) s->ones[i] = 1.0;
+    for (Py_ssize_t i = 0; i < N; i++) s->covering[i] = i >= 2 * n && i < 2 * n + m ? s->gap_covering : 1.0;
     return used;
 }
 
@@ -920,13 +935,14 @@ static int take_double(PyObject *const *args, int index, double *value) {
 /* The flags, counts and tolerances of solve_split_lcp's arguments into s (-1 with the exception set). */
 static int take_options(PyObject *const *args, Split *s, int *exact, long long *max_realignments) {
     *exact = PyObject_IsTrue(args[6]);
-    *max_realignments = PyLong_AsLongLong(args[7]);
-    const long long pivots_per_row = PyLong_AsLongLong(args[12]);
-    if (*exact < 0 || ((*max_realignments == -1 || pivots_per_row == -1) && PyErr_Occurred())) return -1;
+    s->free_twist = PyObject_IsTrue(args[7]);
+    *max_realignments = PyLong_AsLongLong(args[9]);
+    const long long pivots_per_row = PyLong_AsLongLong(args[14]);
+    if (*exact < 0 || s->free_twist < 0 || ((*max_realignments == -1 || pivots_per_row == -1) && PyErr_Occurred())) return -1;
     s->pivots_per_row = pivots_per_row;
-    if (take_double(args, 8, &s->dissipation_tol) || take_double(args, 9, &s->mode_tol) || take_double(args, 10, &s->pivot_tol) ||
-        take_double(args, 11, &s->feasibility_tol) || take_double(args, 13, &s->cone_roundoff) ||
-        take_double(args, 14, &s->newton_damping) || take_double(args, 15, &s->newton_stop))
+    if (take_double(args, 8, &s->gap_covering) || take_double(args, 10, &s->dissipation_tol) || take_double(args, 11, &s->mode_tol) ||
+        take_double(args, 12, &s->pivot_tol) || take_double(args, 13, &s->feasibility_tol) || take_double(args, 15, &s->cone_roundoff) ||
+        take_double(args, 16, &s->newton_damping) || take_double(args, 17, &s->newton_stop))
         return -1;
     return 0;
 }
@@ -961,10 +977,11 @@ static int take_sizes(PyObject *const *args, Split *s, int exact) {
 
 static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
     (void)module;
-    if (nargs != 18) {
+    if (nargs != 20) {
         PyErr_SetString(PyExc_TypeError,
-                        "solve_split_lcp(J, b, mu, g, frictional, base, exact, max_realignments, dissipation_tol, mode_tol, pivot_tol,"
-                        " feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) takes 18 arguments");
+                        "solve_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, gap_covering, max_realignments, dissipation_tol,"
+                        " mode_tol, pivot_tol, feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) takes 20"
+                        " arguments");
         return NULL;
     }
     Split s;
@@ -974,7 +991,7 @@ static PyObject *solve_split_lcp(PyObject *module, PyObject *const *args, Py_ssi
     if (take_options(args, &s, &exact, &max_realignments) < 0 || take_sizes(args, &s, exact) < 0) return NULL;
     const Py_ssize_t m = s.m, d = s.d, n = s.n, f = s.f, K = s.K;
     static const char *names[8] = {"J", "b", "mu", "g", "frictional", "base", "q", "c"};
-    const int indices[8] = {0, 1, 2, 3, 4, 5, 16, 17};
+    const int indices[8] = {0, 1, 2, 3, 4, 5, 18, 19};
     const int ndims[8] = {3, 2, 1, 1, 1, 1, 1, 2};
     const Py_ssize_t shapes[8][3] = {{m, d, n}, {m, d}, {m}, {n}, {f}, {K}, {n}, {m, d}};
     Py_buffer views[8];
@@ -1064,14 +1081,14 @@ done:
 
 static PyMethodDef methods[] = {
     {"lemke", (PyCFunction)(void (*)(void))lemke, METH_FASTCALL,
-     "lemke(M, q, d, max_pivots, tol, z, basis) -> (status, pivots): Lemke's method, the numba kernel's rules;\n"
+     "lemke(M, q, d, max_pivots, tol, free, z, basis) -> (status, pivots): Lemke's method, the numba kernel's rules;\n"
      "fills z (n,) float64 and basis (n,) int64. See quasistatic.solvers.numerics.lemke."},
     {"fixed_mode_system", (PyCFunction)(void (*)(void))fixed_mode_system, METH_FASTCALL,
      "fixed_mode_system(J, b, mu, g, x, kind, column, residual, jacobian, forces): the fixed-mode laws at x,\n"
      "the numba kernel's loops; fills residual (N,), jacobian (N, N) and forces (m, d). See quasistatic.laws.fixed_modes."},
     {"solve_split_lcp", (PyCFunction)(void (*)(void))solve_split_lcp, METH_FASTCALL,
-     "solve_split_lcp(J, b, mu, g, frictional, base, exact, max_realignments, dissipation_tol, mode_tol, pivot_tol,\n"
-     "feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) -> (status, stage, pivots, realignments):\n"
+     "solve_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, gap_covering, max_realignments, dissipation_tol, mode_tol,\n"
+     "pivot_tol, feasibility_tol, pivots_per_row, cone_roundoff, newton_damping, newton_stop, q, c) -> (status, stage, pivots, realignments):\n"
      "the fast path's kernel, the numba kernel's steps; fills q (n,) and c (m, d). See quasistatic.solvers.numerics.lcp."},
     {"exact_newton", (PyCFunction)(void (*)(void))exact_newton, METH_FASTCALL,
      "exact_newton(J, b, mu, g, q, c, depth, patience, one_switch, mode_tol, tol, cone_roundoff, newton_damping, newton_stop,"
@@ -1095,7 +1112,7 @@ PyMODINIT_FUNC PyInit__lemke(void) {
         return NULL;
     }
     /* what quasistatic/compiled.py checks: a .so built from an older source is not used */
-    if (PyModule_AddIntConstant(module, "api_version", 6) < 0) {
+    if (PyModule_AddIntConstant(module, "api_version", 7) < 0) {
         Py_DECREF(module);
         return NULL;
     }

@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-API_VERSION = 6  # the _lemke.c these wrappers call (its module attribute api_version)
+API_VERSION = 7  # the _lemke.c these wrappers call (its module attribute api_version)
 
 
 def _load(name: str) -> Any:
@@ -72,11 +72,11 @@ __all__ = [
 
 HAVE_EXTENSION = extension is not None
 HAVE_KERNELS = kernels is not None
-# quasistatic_lemke(n, M, q, d, max_pivots, tol, z, basis, pivots, work, rows) -> status; 0 when not built
+# quasistatic_lemke(n, M, q, d, max_pivots, tol, free, z, basis, pivots, work, rows) -> status; 0 when not built
 LEMKE_ADDRESS: int = extension.lemke_address if HAVE_EXTENSION else 0
 
 
-def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
+def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float, free: int) -> tuple[int, np.ndarray, int, np.ndarray]:
     """Lemke's method in C: ``(status, z, pivots, basis)`` as ``solvers/numerics/lemke.py::lemke`` returns them.
 
     Parameters
@@ -86,6 +86,8 @@ def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: flo
     max_pivots : int
     tol : float
         Pivot tolerance and tie width, as the kernel's [-].
+    free : int
+        ``z[:free]`` are free: once basic they never leave (as the kernel's).
 
     Raises
     ------
@@ -101,6 +103,7 @@ def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: flo
         np.ascontiguousarray(d, np.float64),
         max_pivots,
         tol,
+        free,
         z,
         basis,
     )
@@ -151,6 +154,8 @@ def solve_split_lcp(
     frictional: np.ndarray,
     base: np.ndarray,
     exact: bool,
+    free_twist: bool,
+    gap_covering: float,
     max_realignments: int,
     dissipation_tol: float,
     mode_tol: float,
@@ -178,6 +183,8 @@ def solve_split_lcp(
         np.ascontiguousarray(frictional, np.int64),
         np.ascontiguousarray(base, np.float64),
         exact,
+        free_twist,
+        gap_covering,
         max_realignments,
         dissipation_tol,
         mode_tol,

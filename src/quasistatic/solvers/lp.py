@@ -116,7 +116,9 @@ def _lemke_pair(
     Returns Lemke's status, the twist, the contact-frame forces (normal only;
     negative round-off clipped) and the analysis of the pair, in one compiled call.
     """
-    status, _, q, c, _, _ = solve_split_lcp(J, b, mu, g, frictional, base, False, 0, 0.0, mode_tol, pivot_tol, 0.0, pivots_per_row)
+    status, _, q, c, _, _ = solve_split_lcp(
+        J, b, mu, g, frictional, base, False, False, 1.0, 0, 0.0, mode_tol, pivot_tol, 0.0, pivots_per_row
+    )
     last = c.shape[1] - 1
     normal = c[:, last].copy()
     analysis = _analyse(Jn, bn, g, q, normal, zero, motion_rank, force_rank)

@@ -46,6 +46,7 @@ __all__ = [
     "NOT_CONVERGED",
     "PIVOTS_PER_ROW",
     "FAST_EDGES",
+    "GAP_COVERING",
     "PLANAR_EDGES",
 ]
 
@@ -54,6 +55,9 @@ NOT_CONVERGED = 3  # kernel status beyond Lemke's: neither re-alignment nor Newt
 FAST_EDGES = 6  # pyramid edges for exact 3-D cones (Newton then solves the circle; 6 was 2-3x faster than 8 on 3-D grasps, same successes)
 REALIGNMENTS = 20  # most edge re-alignments for exact 3-D cones
 NEWTON_ITERATIONS = 50  # most Newton iterations a set of contact modes gets (the kernel's patience: a stall never ends it early)
+# Lemke's covering vector on the gap rates' rows in the fast path (1 on the others): a path that relaxes the gap
+# rates less than equilibrium and friction ends sooner (grasp-3d 8 #0: 59 pivots, not 113, docs/performance.md).
+GAP_COVERING = 0.3
 QUICK_PATIENCE = 2  # Newton iterations without halving the residual after which a due mode switch ends the round (8 #1)
 PLANAR_EDGES = np.array([1.0, -1.0])  # a 2-D cone's edges along the tangent, as the kernels build them
 
@@ -85,9 +89,12 @@ def _edge_angles(count: int) -> np.ndarray:
     return 2.0 * np.pi * np.arange(count) / count
 
 
-def lemke_motion(problem: Problem) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
+def lemke_motion(problem: Problem, short_path: bool = False) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
     """The fast path's kernel on ``problem`` with the library's tolerances (inputs kept with the problem).
 
+    ``short_path``: Lemke's method keeps the twist halves basic once they enter, from a covering vector of
+    :data:`GAP_COVERING` on the gap rates' rows (:func:`solve_split_lcp`; the fast path's choice); else the
+    textbook path (the certified method's candidate, as before).
     Returns status, stage, twist ``q``, contact-frame forces ``c``, pivots and re-alignments, as
     :func:`solve_split_lcp`.
     """
@@ -100,6 +107,8 @@ def lemke_motion(problem: Problem) -> tuple[int, int, np.ndarray, np.ndarray, in
         data.frictional,
         data.base,
         data.exact,
+        short_path,
+        GAP_COVERING if short_path else 1.0,
         REALIGNMENTS,
         FRICTION_ALIGNMENT,
         MODE_SPEED,
@@ -153,6 +162,8 @@ def _solve_split_lcp_compiled(
     frictional: np.ndarray,
     base: np.ndarray,
     exact: bool,
+    free_twist: bool,
+    gap_covering: float,
     max_realignments: int,
     dissipation_tol: float,
     mode_tol: float,
@@ -162,7 +173,7 @@ def _solve_split_lcp_compiled(
 ) -> tuple[int, int, np.ndarray, np.ndarray, int, int]:
     """:func:`solve_split_lcp` in the extension's C, step for step (what runs without numba where it was built)."""
     args = (max_realignments, dissipation_tol, mode_tol, pivot_tol, feasibility_tol, pivots_per_row, _NEWTON)
-    return compiled_split_lcp(J, b, mu, g, frictional, base, exact, *args)
+    return compiled_split_lcp(J, b, mu, g, frictional, base, exact, free_twist, gap_covering, *args)
 
 
 # Without numba: the extension's C where it was built, else this kernel as plain Python (with its steps' numpy twins).
@@ -175,6 +186,8 @@ def solve_split_lcp(
     frictional: np.ndarray,
     base: np.ndarray,
     exact: bool,
+    free_twist: bool,
+    gap_covering: float,
     max_realignments: int,
     dissipation_tol: float,
     mode_tol: float,
@@ -186,7 +199,12 @@ def solve_split_lcp(
 
     ``J`` (m, d, n), ``b`` (m, d), ``mu`` (m,), ``g`` (n,) as in Problem;
     ``frictional`` (f,) the contacts with ``mu > 0``; ``base`` (K,) the edge
-    signs in 2-D or the unrotated edge angles in 3-D.
+    signs in 2-D or the unrotated edge angles in 3-D. ``free_twist``: the
+    halves ``q+``, ``q-`` are Lemke's free variables (kept basic once they
+    enter, :mod:`.lemke`): the twist crosses zero without leaving the basis,
+    a shorter path (grasp-3d 8 #0: 113 pivots, not 143). ``gap_covering``:
+    Lemke's covering vector on the gap rates' rows (1 on the others; 1 is
+    the textbook start).
 
     Returns status (lemke's, or 3: not converged), stage (0: first solve,
     1: after re-alignment, 2: Newton's method), twist ``q`` (n,), forces
@@ -199,7 +217,9 @@ def solve_split_lcp(
     edges = _edges(base, offsets, d - 1)
     M, qv = _assemble(Jn, Jt, bn, bt, mu_f, g, edges, frictional)
     cap = pivots_per_row * qv.shape[0]
-    status, z, pivots, basis = lemke(M, qv, np.ones(qv.shape[0]), cap, pivot_tol)
+    free = 2 * n if free_twist else 0
+    covering = _covering(qv.shape[0], n, m, gap_covering)
+    status, z, pivots, basis = lemke(M, qv, covering, cap, pivot_tol, free)
     q, c = _motion(z, edges, frictional, m, d, n)
     realignments = 0
     if status != SOLUTION or not exact:
@@ -234,14 +254,23 @@ def solve_split_lcp(
         realignments += 1
         edges = _edges(base, offsets, 2)
         M, qv = _assemble(Jn, Jt, bn, bt, mu_f, g, edges, frictional)
-        feasible, z = _basis_solution(M, qv, basis, feasibility_tol)
+        feasible, z = _basis_solution(M, qv, basis, feasibility_tol, free)
         if not feasible:
-            status, z, more, basis = lemke(M, qv, np.ones(qv.shape[0]), cap, pivot_tol)
+            status, z, more, basis = lemke(M, qv, covering, cap, pivot_tol, free)
             pivots += more
             if status != SOLUTION:
                 q, c = _motion(z, edges, frictional, m, d, n)
                 return status, 1, q, c, pivots, realignments
         q, c = _motion(z, edges, frictional, m, d, n)
+
+
+@njit
+def _covering(N: int, n: int, m: int, gap_covering: float) -> np.ndarray:
+    """Lemke's covering vector (N,) on ``z = [q+, q-, cn, beta, lam]``: ``gap_covering`` on the gap rates' rows (those
+    of ``cn``), 1 elsewhere."""
+    covering = np.ones(N)
+    covering[2 * n : 2 * n + m] = gap_covering
+    return covering
 
 
 def _split_rows_numpy(
@@ -293,7 +322,7 @@ def split_lcp_point(
     Jn, bn, Jt, bt, mu_f = _split_rows(J, b, mu, frictional)
     edges = _edges(base, np.zeros(f), d - 1)
     M, qv = _assemble(Jn, Jt, bn, bt, mu_f, g, edges, frictional)
-    status, z, _, _ = lemke(M, qv, np.ones(qv.shape[0]), pivots_per_row * qv.shape[0], pivot_tol)
+    status, z, _, _ = lemke(M, qv, np.ones(qv.shape[0]), pivots_per_row * qv.shape[0], pivot_tol, 0)
     return status, z
 
 
@@ -587,8 +616,9 @@ def _motion(z: np.ndarray, edges: np.ndarray, frictional: np.ndarray, m: int, d:
 
 
 @njit
-def _basis_solution(M: np.ndarray, q: np.ndarray, basis: np.ndarray, tol: float) -> tuple[bool, np.ndarray]:
-    """The LCP solution with the given complementary basis (``M_SS z_S = -q_S``), and whether it is feasible."""
+def _basis_solution(M: np.ndarray, q: np.ndarray, basis: np.ndarray, tol: float, free: int) -> tuple[bool, np.ndarray]:
+    """The LCP solution with the given complementary basis (``M_SS z_S = -q_S``), and whether it is feasible (the free
+    ``z[:free]`` may be negative)."""
     N = q.shape[0]
     basic = np.empty(N, dtype=np.int64)
     count = 0
@@ -608,6 +638,9 @@ def _basis_solution(M: np.ndarray, q: np.ndarray, basis: np.ndarray, tol: float)
         if not regular:  # the basis does not carry over
             return False, z
         for r in range(count):
+            if basic[r] < free:
+                z[basic[r]] = solution[r]
+                continue
             if solution[r] < -tol:
                 return False, z
             z[basic[r]] = max(solution[r], 0.0)

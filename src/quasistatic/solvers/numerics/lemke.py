@@ -28,6 +28,11 @@ whose solutions all have index -1 always ends on a ray (docs/performance.md).
 
 Variable numbering in ``basis``: ``0..n-1`` are ``w``, ``n..2n-1`` are ``z``,
 ``2n`` is the artificial ``z0``.
+
+Free variables (a mixed LCP's, written as the first ``free`` entries of ``z``): once one
+enters the basis it never leaves (its row drops out of the ratio test, so its value may turn
+negative), the usual treatment of a mixed LCP's free variables; its complement then stays
+nonbasic at zero. ``free = 0`` is the textbook method.
 """
 
 from __future__ import annotations
@@ -49,7 +54,9 @@ PIVOT_LIMIT = 2  # stopped after max_pivots pivots
 STATUS_NAMES = {SOLUTION: "solution", RAY: "secondary ray", PIVOT_LIMIT: "pivot limit"}
 
 
-def _lemke_numpy(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
+def _lemke_numpy(
+    M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float, free: int
+) -> tuple[int, np.ndarray, int, np.ndarray]:
     """Whole-array twin of :func:`lemke` for plain Python: the same pivots, in fewer numpy calls.
 
     Without numba each numpy call costs about a microsecond of interpreter time
@@ -90,34 +97,42 @@ def _lemke_numpy(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, t
             return PIVOT_LIMIT, _basic_z_numpy(basis, xB), pivots, basis
         entering = leaving + n if leaving < n else leaving - n
         col = Binv[:, entering].copy() if entering < n else Binv.dot(minus_columns[entering - n])
-        row = _quick_ratio_test(Binv, xB, col, basis, artificial, tol, ratios)
+        row = _quick_ratio_test(Binv, xB, col, basis, artificial, tol, ratios, free)
         if row < 0:
             return RAY, _basic_z_numpy(basis, xB), pivots, basis
 
 
 def _quick_ratio_test(
-    Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, basis: np.ndarray, artificial: int, tol: float, ratios: np.ndarray
+    Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, basis: np.ndarray, artificial: int, tol: float, ratios: np.ndarray, free: int
 ) -> int:
     """:func:`_ratio_test` in whole-array steps when one row attains the minimum ratio (``ratios``: scratch space)."""
     largest = col[col.argmax()]  # argmax and indexing: a third of max()'s interpreter time
     pivot_tol = tol * max(1.0, largest, -col[col.argmin()])
-    if largest <= pivot_tol:
+    candidates = col > pivot_tol
+    if free:
+        candidates &= ~_free_rows_numpy(basis, artificial // 2, free)
+    if not candidates.any():
         return -1
     ratios.fill(np.inf)
-    np.divide(xB, col, out=ratios, where=col > pivot_tol)
+    np.divide(xB, col, out=ratios, where=candidates)
     row = int(ratios.argmin())
     theta = ratios[row]
     ratios[row] = np.inf
     if ratios[ratios.argmin()] <= theta + tol * (1.0 + abs(theta)):  # a tie (degenerate step): the kernel's rule decides
-        return _tied_ratio_test_numpy(Binv, xB, col, basis, artificial, tol, pivot_tol)
+        return _tied_ratio_test_numpy(Binv, xB, col, basis, artificial, tol, candidates)
     return row
 
 
+def _free_rows_numpy(basis: np.ndarray, n: int, free: int) -> np.ndarray:
+    """The rows whose basic variable is one of the free ``z[:free]`` (never leaving)."""
+    return (basis >= n) & (basis < n + free)
+
+
 def _tied_ratio_test_numpy(
-    Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, basis: np.ndarray, artificial: int, tol: float, pivot_tol: float
+    Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, basis: np.ndarray, artificial: int, tol: float, candidates: np.ndarray
 ) -> int:
     """:func:`_ratio_test` where ratios tie: the rows within the tie width, ``z0``'s first, else the lexicographic rule."""
-    rows = np.flatnonzero(col > pivot_tol)
+    rows = np.flatnonzero(candidates)
     ratios = xB[rows] / col[rows]
     theta = ratios.min()
     rows = rows[ratios <= theta + tol * (1.0 + abs(theta))]
@@ -170,7 +185,9 @@ _PLAIN_LEMKE = compiled_lemke if HAVE_EXTENSION else _lemke_numpy
 
 
 @njit
-def numba_lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
+def numba_lemke(
+    M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float, free: int
+) -> tuple[int, np.ndarray, int, np.ndarray]:
     """Solve ``w = M z + q, z >= 0, w >= 0, z . w = 0`` by Lemke's method: the kernel whose choices the others make.
 
     numba compiles it; :func:`lemke` runs the extension's C instead where it was built.
@@ -187,6 +204,8 @@ def numba_lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, to
         Pivot tolerance relative to the largest entry of the entering column,
         and the width within which two ratios tie [-]; the data are
         scene-relative (entries of order one), so e.g. 1e-11.
+    free : int
+        ``z[:free]`` are free variables: once basic, never leaving (module docstring); 0 for none.
 
     Returns
     -------
@@ -231,7 +250,7 @@ def numba_lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, to
             return PIVOT_LIMIT, _basic_z(basis, xB), pivots, basis
         entering = leaving + n if leaving < n else leaving - n
         _column(Binv, M, d, entering, col)
-        row = _ratio_test(Binv, xB, col, basis, artificial, tol)
+        row = _ratio_test(Binv, xB, col, basis, artificial, tol, free)
         if row < 0:
             return RAY, _basic_z(basis, xB), pivots, basis
 
@@ -260,10 +279,12 @@ def _column(Binv: np.ndarray, M: np.ndarray, d: np.ndarray, entering: int, col: 
 
 
 @njit
-def _ratio_test(Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, basis: np.ndarray, artificial: int, tol: float) -> int:
-    """Leaving row by the lexicographic minimum ratio; -1 when the column has no positive entry."""
+def _ratio_test(Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, basis: np.ndarray, artificial: int, tol: float, free: int) -> int:
+    """Leaving row by the lexicographic minimum ratio; -1 when the column has no positive entry in a row whose basic
+    variable may leave (a free ``z[:free]`` never does)."""
     pivot_tol = tol * max(1.0, np.max(np.abs(col)))
-    rows = np.flatnonzero(col > pivot_tol)
+    n = col.shape[0]
+    rows = np.flatnonzero((col > pivot_tol) & ~((basis >= n) & (basis < n + free)))
     if rows.size == 0:
         return -1
     ratios = xB[rows] / col[rows]
@@ -294,16 +315,16 @@ def _pivot(Binv: np.ndarray, xB: np.ndarray, col: np.ndarray, row: int) -> None:
 
 
 # The C entry point quasistatic_lemke (src/quasistatic/_lemke.c), as kernels call it:
-# (n, M, q, d, max_pivots, tol, z, basis, pivots, work, rows) -> status; work: n (n + 3), rows: n scratch entries.
+# (n, M, q, d, max_pivots, tol, free, z, basis, pivots, work, rows) -> status; work: n (n + 3), rows: n scratch entries.
 _C_LEMKE = "quasistatic_lemke"
 _C_SIGNATURE = (
-    "int64(int64, CPointer(float64), CPointer(float64), CPointer(float64), int64, float64,"
+    "int64(int64, CPointer(float64), CPointer(float64), CPointer(float64), int64, float64, int64,"
     " CPointer(float64), CPointer(int64), CPointer(int64), CPointer(float64), CPointer(int64))"
 )
 
 
 def _numba_lemke_by_pointers(
-    n: int, M: Any, q: Any, d: Any, max_pivots: int, tol: float, z: Any, basis: Any, pivots: Any, work: Any, rows: Any
+    n: int, M: Any, q: Any, d: Any, max_pivots: int, tol: float, free: int, z: Any, basis: Any, pivots: Any, work: Any, rows: Any
 ) -> int:
     """:func:`numba_lemke` behind the C entry point's signature (pointers; ``work`` and ``rows`` unused): where numba is
     installed but the extension was not built, the kernels call this instead, by the same name."""
@@ -312,7 +333,7 @@ def _numba_lemke_by_pointers(
         q_[i], d_[i] = q[i], d[i]
         for j in range(n):
             M_[i, j] = M[i * n + j]
-    status, z_, pivots_, basis_ = numba_lemke(M_, q_, d_, max_pivots, tol)
+    status, z_, pivots_, basis_ = numba_lemke(M_, q_, d_, max_pivots, tol, free)
     for i in range(n):
         z[i], basis[i] = z_[i], basis_[i]
     pivots[0] = pivots_
@@ -327,7 +348,7 @@ if HAVE_NUMBA:
 
 
 @njit(python=_PLAIN_LEMKE)
-def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float) -> tuple[int, np.ndarray, int, np.ndarray]:
+def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: float, free: int) -> tuple[int, np.ndarray, int, np.ndarray]:
     """Solve ``w = M z + q, z >= 0, w >= 0, z . w = 0`` by Lemke's method: :func:`numba_lemke`'s pivots, in C where built.
 
     Arguments and results as :func:`numba_lemke`'s.
@@ -343,5 +364,7 @@ def lemke(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_pivots: int, tol: flo
     M, q, d = np.ascontiguousarray(M), np.ascontiguousarray(q), np.ascontiguousarray(d)
     z, basis, pivots = np.empty(n), np.empty(n, dtype=np.int64), np.zeros(1, dtype=np.int64)
     work, rows = np.empty(n * (n + 3)), np.empty(n, dtype=np.int64)
-    status = _c_lemke(n, M.ctypes, q.ctypes, d.ctypes, max_pivots, tol, z.ctypes, basis.ctypes, pivots.ctypes, work.ctypes, rows.ctypes)
+    status = _c_lemke(
+        n, M.ctypes, q.ctypes, d.ctypes, max_pivots, tol, free, z.ctypes, basis.ctypes, pivots.ctypes, work.ctypes, rows.ctypes
+    )
     return status, z, pivots[0], basis
