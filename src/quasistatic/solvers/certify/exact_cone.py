@@ -5,8 +5,7 @@ cone) and for a sliding contact whose slip is exactly opposite one of its
 edges (the force then lies on the cone, opposite the slip). So: find every
 motion with an 8-edge pyramid by the certified search, then refine each one by
 solving the exact laws with its contact modes fixed (smooth equations, by
-least squares from the pyramid motion: a bounded trust region, then
-Levenberg-Marquardt if that stalls). A sliding contact of the pyramid may
+Levenberg-Marquardt from the pyramid motion). A sliding contact of the pyramid may
 roll or separate under the circle, so those mode changes are tried too; where
 the least-squares forces of a statically indeterminate set leave the cones,
 the forces are recovered at the refined twist by an LP. Where 8 edges leave
@@ -44,14 +43,13 @@ from ...tolerances import (
     FREE_TWIST_DIRECTION,
     FRICTION_ALIGNMENT,
     JACOBIAN_RANK,
-    LEAST_SQUARES_STEP,
     LP_FEASIBILITY,
     MODE_SPEED,
     SAME_TWIST,
 )
 from ..numerics.forces import least_normal_forces
 from ..numerics.highs import solve_lp
-from ..numerics.optimize import least_squares
+from ..numerics.levenberg_marquardt import levenberg_marquardt
 from ..result import BackendResult, Options
 from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
@@ -404,7 +402,7 @@ def _mode_changes(modes: np.ndarray) -> Iterator[np.ndarray]:
 
 
 def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, evaluations: int) -> RawMotion | None:
-    """Bounded Gauss-Newton (trust region, normal forces >= 0) on the exact laws with the given contact modes.
+    """Levenberg-Marquardt on the exact laws with the given contact modes, from the pyramid motion.
 
     With the modes fixed, the exact laws are smooth equations
     (:mod:`quasistatic.laws.fixed_modes`). Returns None when they have no
@@ -420,19 +418,15 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     masks = ModeMasks.of(problem, modes)  # a frictionless contact gets no slip equation
     laws = FixedModeLaws(problem, masks)
     x0 = laws.start(motion.q, motion.c)
-    options = {"xtol": LEAST_SQUARES_STEP, "ftol": LEAST_SQUARES_STEP, "gtol": LEAST_SQUARES_STEP, "max_nfev": evaluations * x0.size}
-    fit = least_squares(laws.residual, x0, jac=laws.jacobian, bounds=(laws.lower_bounds(), np.inf), method="trf", **options)
-    if np.max(np.abs(fit.fun), initial=0.0) > FIXED_MODE_RESIDUAL:
-        # The bounded trust region can stall where unbounded Levenberg-Marquardt converges (a random
-        # 6-contact grasp); a negative normal force is then caught below, where forces are recovered by LP.
-        fit = least_squares(laws.residual, x0, jac=laws.jacobian, method="lm", **options)
+    # Unbounded: a zero with a negative normal force is caught below, where forces are recovered by LP.
+    fit = levenberg_marquardt(lambda x: (laws.residual(x), laws.jacobian(x)), x0, FIXED_MODE_RESIDUAL, evaluations * x0.size)
     q, c = laws.motion(fit.x)
     # A sliding contact may come to rest (its force then sits on the cone): still a solution.
     new_modes = np.array(contact_modes(problem, q))
     frictional = problem.mu > 0
     same = np.where(frictional, new_modes == modes, (new_modes == "separating") == (modes == "separating"))
     keeps_modes = bool(np.all(same | (masks.sliding & (new_modes == "rolling"))))
-    converged = float(np.max(np.abs(laws.residual(fit.x)), initial=0.0)) <= FIXED_MODE_RESIDUAL
+    converged = fit.worst <= FIXED_MODE_RESIDUAL
     if not (converged and keeps_modes):
         return None
     if not _inside_cones(problem, c, masks.rolling):
