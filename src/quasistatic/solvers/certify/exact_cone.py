@@ -373,7 +373,13 @@ class _Necessary:
     more than ``MODE_SPEED``, and has forces in the exact cones (to ``CONE_ROUNDOFF``, inside the polygons) on its
     closed contacts only that balance the load to ``FIXED_MODE_RESIDUAL`` (or an LP's, to ``LP_FEASIBILITY``). So
     where HiGHS finds either LP infeasible (every row loosened by ``LP_FEASIBILITY``), no refinement with that
-    pattern can succeed: the test only skips work that would fail."""
+    pattern can succeed: the test only skips work that would fail.
+
+    A verdict also decides the patterns it implies, without their LP (:class:`_Verdicts`): forces that balance
+    the load on some closed contacts balance it on more (the others' forces zero), so a closed set whose polygons
+    cannot balance it makes every set inside it fail, and one that can makes every set around it pass; a twist
+    meeting a pattern's rows meets those of a pattern with fewer closed or rolling contacts (each row the same, or
+    dropped), so a kinematic verdict carries to every pattern with more of them (infeasible) or fewer (feasible)."""
 
     def __init__(self, problem: Problem) -> None:
         self.problem = problem
@@ -381,7 +387,9 @@ class _Necessary:
         m, n = problem.n_contacts, problem.n_dof
         friction = problem.mu[:, None, None] * edge_jacobian(problem, edges).reshape(m, BALANCE_EDGES, n)
         self.generators = problem.Jn[:, None, :] + friction  # (m, K, n): the polygon's edges as wrenches
-        self.known: dict[bytes, bool] = {}
+        self.balance = _Verdicts()  # by closed set: fewer closed contacts, fewer columns
+        self.kinematics = _Verdicts()  # by closed and rolling sets (negated: more of them, more rows)
+        self.lps = 0  # LPs solved (the rest were known or implied)
 
     def possible(self, modes: np.ndarray) -> bool:
         """False when no solution of the exact laws has these contact modes (proven by an infeasible LP)."""
@@ -391,24 +399,55 @@ class _Necessary:
     def _balances(self, closed: np.ndarray) -> bool:
         if not closed.any():
             return True  # nothing to test (the attempt decides)
-        key = b"f" + np.packbits(closed).tobytes()
-        if key not in self.known:
+        key = _bits(closed)
+        verdict = self.balance.implied(key)
+        if verdict is None:
             G = self.generators[closed].reshape(-1, self.problem.n_dof).T
             g = self.problem.g
-            self.known[key] = solve_lp(np.zeros(G.shape[1]), G, -g, -g, np.zeros(G.shape[1])).status != "infeasible"
-        return self.known[key]
+            self.lps += 1
+            verdict = solve_lp(np.zeros(G.shape[1]), G, -g, -g, np.zeros(G.shape[1])).status != "infeasible"
+            self.balance.add(key, verdict)
+        return verdict
 
     def _kinematic(self, masks: ModeMasks) -> bool:
-        key = b"q" + np.packbits(np.concatenate([masks.closed, masks.rolling])).tobytes()
-        if key not in self.known:
+        m = self.problem.n_contacts
+        key = _bits(~masks.closed) | _bits(~masks.rolling) << m  # more rows: fewer bits
+        verdict = self.kinematics.implied(key)
+        if verdict is None:
             p = self.problem
             rolling = masks.rolling
             A = np.vstack([p.Jn, p.Jt[rolling].reshape(-1, p.n_dof)])
             rhs = np.concatenate([p.bn, p.bt[rolling].ravel()])
             upper = np.concatenate([np.where(masks.closed, p.bn, np.inf), p.bt[rolling].ravel()])
-            lp = solve_lp(np.zeros(p.n_dof), A, rhs - LP_FEASIBILITY, upper + LP_FEASIBILITY)
-            self.known[key] = lp.status != "infeasible"
-        return self.known[key]
+            self.lps += 1
+            verdict = solve_lp(np.zeros(p.n_dof), A, rhs - LP_FEASIBILITY, upper + LP_FEASIBILITY).status != "infeasible"
+            self.kinematics.add(key, verdict)
+        return verdict
+
+
+class _Verdicts:
+    """LP verdicts on sets (bits) where feasibility grows with the set: a feasible set's supersets are feasible,
+    an infeasible set's subsets infeasible."""
+
+    def __init__(self) -> None:
+        self.feasible: list[int] = []
+        self.infeasible: list[int] = []
+
+    def implied(self, key: int) -> bool | None:
+        """The verdict on ``key`` that a known one implies, or None."""
+        if any(key & known == known for known in self.feasible):
+            return True
+        if any(key & known == key for known in self.infeasible):
+            return False
+        return None
+
+    def add(self, key: int, feasible: bool) -> None:
+        (self.feasible if feasible else self.infeasible).append(key)
+
+
+def _bits(mask: np.ndarray) -> int:
+    """A boolean mask as an integer's bits (entry i: bit i)."""
+    return sum(1 << int(i) for i in np.flatnonzero(mask))
 
 
 def _mode_changes(modes: np.ndarray) -> Iterator[np.ndarray]:
