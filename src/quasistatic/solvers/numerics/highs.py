@@ -210,8 +210,8 @@ def _load(
     maximize: bool,
 ) -> highspy.Highs:
     n = cost.size
-    matrix = sp.csc_matrix(A)
-    m = matrix.shape[0]
+    m = A.shape[0]
+    start, index, value = _columnwise(A)
     lp = highspy.HighsLp()
     lp.num_col_ = n
     lp.num_row_ = m
@@ -221,14 +221,28 @@ def _load(
     lp.row_lower_ = row_lower
     lp.row_upper_ = row_upper
     lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-    lp.a_matrix_.start_ = matrix.indptr
-    lp.a_matrix_.index_ = matrix.indices
-    lp.a_matrix_.value_ = matrix.data
+    lp.a_matrix_.start_ = start
+    lp.a_matrix_.index_ = index
+    lp.a_matrix_.value_ = value
     try:
         solver.passModel(lp)
     except Exception as exc:  # a crash inside HiGHS, not a status
         raise SolverError("highs", f"HiGHS failed: {exc}") from exc
     return solver
+
+
+def _columnwise(A: np.ndarray | sp.spmatrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``A``'s nonzeros column by column (HiGHS's ``kColwise``: column starts, row indices, values), as
+    ``scipy.sparse.csc_matrix(A)`` holds them; a dense ``A`` without SciPy's conversion (~65 us of an LP's ~0.7 ms
+    on the sector relaxation's small leaves)."""
+    if sp.issparse(A):
+        matrix = sp.csc_matrix(A)
+        return matrix.indptr, matrix.indices, matrix.data
+    columns = np.asarray(A, dtype=float).T
+    nonzero = columns != 0.0
+    start = np.zeros(columns.shape[0] + 1, dtype=np.int32)
+    np.cumsum(nonzero.sum(axis=1), out=start[1:])
+    return start, np.nonzero(nonzero)[1].astype(np.int32), columns[nonzero]
 
 
 def _run(solver: highspy.Highs, cost: np.ndarray, maximize: bool) -> LPResult:
