@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes, slips
-from ...laws.fixed_modes import FixedModeLaws
+from ...laws.fixed_modes import FixedModeLaws, system
 from ...laws.polyhedral import LCPForm, aligned_edges, edge_jacobian, polyhedral_form
 from ...solution import Certificate, CertificateKind, Diagnosis
 from ...tolerances import (
@@ -354,7 +354,7 @@ def _repaired_modes(problem: Problem, motion: RawMotion, modes: np.ndarray) -> n
     the pattern found this way is only a candidate, whose refinement must pass every check, as any other's."""
     laws = FixedModeLaws(problem, ModeMasks.of(problem, modes))
     x0 = laws.start(motion.q, motion.c)
-    fit = levenberg_marquardt(lambda x: (laws.residual(x), laws.jacobian(x)), x0, FIXED_MODE_RESIDUAL, 200 * x0.size)
+    fit = levenberg_marquardt(_equations(laws), x0, FIXED_MODE_RESIDUAL, 200 * x0.size)
     if fit.worst > FIXED_MODE_RESIDUAL:
         return None
     q, c = laws.motion(fit.x)
@@ -405,7 +405,7 @@ class _Necessary:
             G = self.generators[closed].reshape(-1, self.problem.n_dof).T
             g = self.problem.g
             self.lps += 1
-            verdict = solve_lp(np.zeros(G.shape[1]), G, -g, -g, np.zeros(G.shape[1])).status != "infeasible"
+            verdict = solve_lp(np.zeros(G.shape[1]), G, -g, -g, np.zeros(G.shape[1]), simplex_first=True).status != "infeasible"
             self.balance.add(key, verdict)
         return verdict
 
@@ -420,7 +420,8 @@ class _Necessary:
             rhs = np.concatenate([p.bn, p.bt[rolling].ravel()])
             upper = np.concatenate([np.where(masks.closed, p.bn, np.inf), p.bt[rolling].ravel()])
             self.lps += 1
-            verdict = solve_lp(np.zeros(p.n_dof), A, rhs - LP_FEASIBILITY, upper + LP_FEASIBILITY).status != "infeasible"
+            lp = solve_lp(np.zeros(p.n_dof), A, rhs - LP_FEASIBILITY, upper + LP_FEASIBILITY, simplex_first=True)
+            verdict = lp.status != "infeasible"
             self.kinematics.add(key, verdict)
         return verdict
 
@@ -481,7 +482,7 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     laws = FixedModeLaws(problem, masks)
     x0 = laws.start(motion.q, motion.c)
     # Unbounded: a zero with a negative normal force is caught below, where forces are recovered by LP.
-    fit = levenberg_marquardt(lambda x: (laws.residual(x), laws.jacobian(x)), x0, FIXED_MODE_RESIDUAL, evaluations * x0.size)
+    fit = levenberg_marquardt(_equations(laws), x0, FIXED_MODE_RESIDUAL, evaluations * x0.size)
     q, c = laws.motion(fit.x)
     # A sliding contact may come to rest (its force then sits on the cone): still a solution.
     new_modes = np.array(contact_modes(problem, q))
@@ -507,6 +508,11 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
         extremes, forces = tuple(e for e, _ in exact), tuple(f for _, f in exact)
         return RawMotion(q, c, extremes, motion.unbounded, motion.free_axes, extreme_forces=forces)
     return RawMotion(q, c)
+
+
+def _equations(laws: FixedModeLaws) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """The fixed-mode laws' residual and Jacobian at ``x`` in one call of the compiled :func:`system`."""
+    return lambda x: system(laws.J, laws.b, laws.mu, laws.g, x, laws.kind, laws.column, laws.n)[:2]
 
 
 def _jacobian_at(problem: Problem, q: np.ndarray, c: np.ndarray, modes: np.ndarray) -> np.ndarray:

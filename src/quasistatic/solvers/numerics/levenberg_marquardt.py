@@ -51,10 +51,11 @@ def levenberg_marquardt(equations: Equations, x0: np.ndarray, tolerance: float, 
                 break
         normal = jacobian.T @ jacobian
         gradient = jacobian.T @ residual
-        curvature = np.diag(normal)
-        scale = np.maximum(curvature, 1e-12 * float(np.max(curvature, initial=1.0)))  # a zero column still damped
+        curvature = normal.diagonal().copy()
+        scale = np.maximum(curvature, 1e-12 * float(curvature.max(initial=1.0)))  # a zero column still damped
+        normal.flat[:: normal.shape[0] + 1] += damping * scale  # J^T J + damping diag(scale), in place
         try:
-            step = np.linalg.solve(normal + np.diag(damping * scale), -gradient)
+            step = np.linalg.solve(normal, -gradient)
         except np.linalg.LinAlgError:
             damping, growth = damping * growth, 2.0 * growth
             continue
