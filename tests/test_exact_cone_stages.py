@@ -1,7 +1,8 @@
 """The stages of the certified exact-cone solve (``certify/exact_cone.py``) that decide which searches run: where a
 pyramid motion's modes lead to a zero that breaks them, the modes at that zero are tried last (the 8-edge search
 decides where it once needed a second, 32-edge search); where the 8-edge pyramid jams but Newton's method from
-Lemke's end finds an exact motion, the sector relaxation's proof that none exists is not tried."""
+Lemke's end finds an exact motion, the sector relaxation's proof that none exists is not tried, and the
+uniqueness proof certifies that motion without the 32-edge search."""
 
 from __future__ import annotations
 
@@ -55,17 +56,22 @@ def _wedge_proofs(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     return tried
 
 
-def test_a_pyramid_that_jams_where_an_exact_motion_is_found_skips_the_wedge_proof(monkeypatch: pytest.MonkeyPatch) -> None:
-    """grasp-3d 6 #3: the 8-edge pyramid jams, an exact motion exists; solved by the 32-edge search, as before,
-    without the relaxation's proof (which fails there: checked with the skip off)."""
+def test_a_pyramid_that_jams_where_newton_finds_an_exact_motion_skips_the_wedge_proof_and_the_wider_search(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """grasp-3d 6 #3: the 8-edge pyramid jams, Newton's method from Lemke's end finds the exact motion, and the
+    uniqueness proof certifies it without the relaxation's proof that none exists (which fails there) or the
+    32-edge search; with Newton's motion withheld, both run and give the same answer."""
     tried = _wedge_proofs(monkeypatch)
     solution = qs.solve(grasp_3d(6, 3))
     assert solution.status == "solved" and solution.certified and not tried
-    monkeypatch.setattr(exact_cone, "_exact_motion_found", lambda problem: False)
+    assert "jams" in dict(solution.notes)["pyramid"]
+    monkeypatch.setattr(exact_cone, "_newton_from_lemke", lambda problem: None)
     again = qs.solve(grasp_3d(6, 3))
-    assert tried == [""] and again.status == "solved"
+    assert tried == [""] and again.status == "solved" and again.certified
+    assert "32-edge" in dict(again.notes)["pyramid"]
     assert solution.motion is not None and again.motion is not None
-    np.testing.assert_array_equal(solution.motion.twists["object"], again.motion.twists["object"])
+    np.testing.assert_allclose(solution.motion.twists["object"], again.motion.twists["object"], rtol=0, atol=1e-12)
 
 
 def test_a_jammed_grasp_still_gets_its_wedge_proof(monkeypatch: pytest.MonkeyPatch) -> None:

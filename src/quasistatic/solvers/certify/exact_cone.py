@@ -6,12 +6,17 @@ edges (the force then lies on the cone, opposite the slip). So: find every
 motion with an 8-edge pyramid by the certified search, then refine each one by
 solving the exact laws with its contact modes fixed (smooth equations, by
 Levenberg-Marquardt from the pyramid motion). A sliding contact of the pyramid may
-roll or separate under the circle, so those mode changes are tried too; where
-the least-squares forces of a statically indeterminate set leave the cones,
-the forces are recovered at the refined twist by an LP. Where 8 edges leave
-the answer undecided (a motion that does not refine, a wedge, no motion with
-prescribed modes, equilibrium too close to call), the search runs again with
-32 edges.
+roll or separate under the circle, so those mode changes are tried too, and
+last the modes at the zero the pyramid's own modes lead to (an open contact
+that it penetrates closes); where the least-squares forces of a statically
+indeterminate set leave the cones, the forces are recovered at the refined
+twist by an LP. Where 8 edges leave the answer undecided (a motion that does
+not refine, a wedge, no motion with prescribed modes, equilibrium too close to
+call), the search runs again with 32 edges; but where the 8-edge pyramid jams
+and Newton's method from where Lemke's path ends finds an exact motion, that
+motion is first proven the only one directly (the proof of :mod:`.exact_unique`
+covers every twist: it needs no pyramid's list), and the sector relaxation's
+proof that no motion exists (which cannot pass) is not tried.
 
 What is proven: ``unstable`` (no equilibrium even in a pyramid circumscribing
 the exact cone), kinematic ``jammed`` (a Farkas certificate), wedged
@@ -72,7 +77,8 @@ BALANCE_EDGES = 16  # polygon around each circle when a changed mode pattern's c
 
 
 def solve_exact_3d(problem: Problem, options: Options, by_patterns: bool = False) -> BackendResult:
-    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided.
+    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided (unless
+    the 8-edge pyramid jams and Newton's method finds an exact motion proven the only one: module docstring).
 
     ``by_patterns``: each pyramid's motions are first sought by the mode branch and bound
     (:mod:`.patterns`), and the SCIP search runs only where it leaves them undecided.
@@ -85,8 +91,11 @@ def solve_exact_3d(problem: Problem, options: Options, by_patterns: bool = False
             return result
         if undecided in ("wedged", "modes") and not relaxed:  # the pyramid has no motion: try to prove it for the circle
             relaxed = True
-            if undecided == "wedged" and _exact_motion_found(problem):
-                continue  # no proof that the circle has none can pass: the wider pyramid's search decides
+            found = _newton_from_lemke(problem) if undecided == "wedged" else None
+            if found is not None:  # no proof that the circle has none can pass
+                if (alone := _proven_alone(problem, found, options)) is not None:
+                    return alone
+                continue  # the wider pyramid's search decides
             if proof := _wedge_proof(problem, options):
                 return _no_motion(problem, options, proof)
     if undecided == "wedged":
@@ -114,18 +123,31 @@ def _wedge_proof(problem: Problem, options: Options) -> str:
     return f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; {method})"
 
 
-def _exact_motion_found(problem: Problem) -> bool:
-    """Whether the fast path's first start finds a motion of the exact laws (Newton's method, quick rounds, from
-    where Lemke's path ends, as ``solvers/fast.py`` starts it; its forces checked by LP, as the wedge proof checks a
-    point it meets). The sector relaxation holds every exact motion, so then it cannot be proven infeasible:
-    its proof is not tried, at no change of verdict (grasp-3d 6 #3: its 8-edge pyramid jams, the relaxation's
-    proof fails in ~60 ms, and the 32-edge search finds the motion)."""
+def _newton_from_lemke(problem: Problem) -> RawMotion | None:
+    """A motion of the exact laws by the fast path's first start (Newton's method, quick rounds, from where Lemke's
+    path ends, as ``solvers/fast.py`` starts it), its forces checked by LP as the wedge proof checks a point it
+    meets; None where it finds none. The sector relaxation holds every exact motion, so where one is found the
+    relaxation's proof that none exists cannot pass, and is not tried (grasp-3d 6 #3: its 8-edge pyramid jams,
+    and that proof fails in ~60 ms)."""
     status, _, q, c, _, _ = lemke_motion(problem)
     if status in (RAY, PIVOT_LIMIT):
         converged, q, c = exact_newton(problem, q, c, 0.0, QUICK_PATIENCE)
     else:
         converged = status == SOLUTION
-    return converged and _exact_forces(problem, q) is not None
+    return RawMotion(q, c) if converged and _exact_forces(problem, q) is not None else None
+
+
+def _proven_alone(problem: Problem, motion: RawMotion, options: Options) -> BackendResult | None:
+    """``solved``, certified, where :mod:`.exact_unique` proves ``motion`` (exact) the only one; else None.
+
+    Its proof covers every twist (near the motion and everywhere else), so it needs no pyramid's list: where the
+    8-edge pyramid jams and Newton's method finds an exact motion, the 32-edge search (which would find the same
+    motion, and prove it the same way) is not run (grasp-3d 6 #3: ~100 ms)."""
+    uniqueness = prove_unique_exact(problem, motion, options, lambda q: _exact_forces(problem, q) is not None)
+    if not uniqueness.proven:
+        return None
+    note = f"the {SEARCH_EDGES}-edge pyramid jams; the motion found by Newton's method from where Lemke's path ends"
+    return unique_exact_motion(problem, motion, options, EXACT_UNIQUENESS_PROOF).with_notes(pyramid=note)
 
 
 def _exact_forces(problem: Problem, q: np.ndarray) -> np.ndarray | None:
