@@ -11,7 +11,7 @@ from quasistatic.laws import ModeMasks, contact_modes
 from quasistatic.laws.assemble import assemble
 from quasistatic.laws.fixed_modes import FixedModeLaws
 from quasistatic.solvers.fast import solve_fast
-from quasistatic.solvers.numerics.levenberg_marquardt import levenberg_marquardt
+from quasistatic.solvers.numerics.levenberg_marquardt import _fixed_mode_fit_numpy, fixed_mode_fit, levenberg_marquardt
 from quasistatic.solvers.numerics.optimize import least_squares
 from quasistatic.solvers.result import Options
 from quasistatic.tolerances import FIXED_MODE_RESIDUAL, LEAST_SQUARES_STEP
@@ -55,3 +55,26 @@ def test_finds_the_zero_scipy_finds_on_the_exact_laws(contacts: int, index: int)
     scipy_fit = least_squares(laws.residual, x0, jac=laws.jacobian, method="lm", **tolerances)
     assert fit.worst <= FIXED_MODE_RESIDUAL
     np.testing.assert_allclose(fit.x[: laws.n], scipy_fit.x[: laws.n], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize(("contacts", "index"), [(6, 1), (8, 1)])
+def test_the_compiled_fit_is_its_numpy_twin(contacts: int, index: int) -> None:
+    """``fixed_mode_fit`` (numba) and its twin agree on every refinement attempt of two bench grasps: the same
+    verdict, and where they converge the same zero to round-off (where they stall, the stalls may differ)."""
+    pytest.importorskip("numba")
+    problem = assemble(grasp_3d(contacts, index))
+    raw = solve_fast(problem, Options()).motions[0]
+    masks = ModeMasks.of(problem, np.array(contact_modes(problem, raw.q), dtype=object))
+    converged = 0
+    for k, sliding in enumerate(np.flatnonzero(masks.sliding)):  # the motion's modes, and each slider opened
+        closed = masks.closed.copy()
+        closed[sliding] = k == 0
+        laws = FixedModeLaws(problem, ModeMasks(closed, masks.rolling & closed, masks.sliding & closed))
+        x0 = laws.start(raw.q, raw.c) * (1.0 + 1e-2 * np.cos(np.arange(laws.size)))
+        args = (laws.J, laws.b, laws.mu, laws.g, x0, laws.kind, laws.column, laws.n, FIXED_MODE_RESIDUAL, 20 * x0.size)
+        compiled, twin = fixed_mode_fit(*args), _fixed_mode_fit_numpy(*args)
+        assert (compiled[1] <= FIXED_MODE_RESIDUAL) == (twin[1] <= FIXED_MODE_RESIDUAL)
+        if twin[1] <= FIXED_MODE_RESIDUAL:
+            converged += 1
+            np.testing.assert_allclose(compiled[0], twin[0], rtol=0, atol=1e-12)
+    assert converged >= 1

@@ -34,12 +34,12 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 
 import numpy as np
 
 from ...laws import ModeMasks, Problem, RawMotion, contact_modes, slips
-from ...laws.fixed_modes import FixedModeLaws, system
+from ...laws.fixed_modes import FixedModeLaws
 from ...laws.polyhedral import LCPForm, aligned_edges, edge_jacobian, polyhedral_form
 from ...solution import Certificate, CertificateKind, Diagnosis
 from ...tolerances import (
@@ -56,7 +56,7 @@ from ..numerics.forces import least_normal_forces
 from ..numerics.highs import solve_lp
 from ..numerics.lcp import QUICK_PATIENCE, exact_newton, lemke_motion
 from ..numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION
-from ..numerics.levenberg_marquardt import levenberg_marquardt
+from ..numerics.levenberg_marquardt import EquationFit, fixed_mode_fit
 from ..result import BackendResult, Options
 from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
@@ -394,7 +394,7 @@ def _repaired_modes(problem: Problem, motion: RawMotion, modes: np.ndarray) -> n
     the pattern found this way is only a candidate, whose refinement must pass every check, as any other's."""
     laws = FixedModeLaws(problem, ModeMasks.of(problem, modes))
     x0 = laws.start(motion.q, motion.c)
-    fit = levenberg_marquardt(_equations(laws), x0, FIXED_MODE_RESIDUAL, 200 * x0.size)
+    fit = _fit(laws, x0, 200 * x0.size)
     if fit.worst > FIXED_MODE_RESIDUAL:
         return None
     q, c = laws.motion(fit.x)
@@ -522,7 +522,7 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     laws = FixedModeLaws(problem, masks)
     x0 = laws.start(motion.q, motion.c)
     # Unbounded: a zero with a negative normal force is caught below, where forces are recovered by LP.
-    fit = levenberg_marquardt(_equations(laws), x0, FIXED_MODE_RESIDUAL, evaluations * x0.size)
+    fit = _fit(laws, x0, evaluations * x0.size)
     q, c = laws.motion(fit.x)
     # A sliding contact may come to rest (its force then sits on the cone): still a solution.
     new_modes = np.array(contact_modes(problem, q))
@@ -550,9 +550,10 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     return RawMotion(q, c)
 
 
-def _equations(laws: FixedModeLaws) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
-    """The fixed-mode laws' residual and Jacobian at ``x`` in one call of the compiled :func:`system`."""
-    return lambda x: system(laws.J, laws.b, laws.mu, laws.g, x, laws.kind, laws.column, laws.n)[:2]
+def _fit(laws: FixedModeLaws, x0: np.ndarray, evaluations: int) -> EquationFit:
+    """Levenberg-Marquardt on the fixed-mode laws from ``x0``, to ``FIXED_MODE_RESIDUAL``, within ``evaluations``."""
+    x, worst, made = fixed_mode_fit(laws.J, laws.b, laws.mu, laws.g, x0, laws.kind, laws.column, laws.n, FIXED_MODE_RESIDUAL, evaluations)
+    return EquationFit(x, float(worst), int(made))
 
 
 def _jacobian_at(problem: Problem, q: np.ndarray, c: np.ndarray, modes: np.ndarray) -> np.ndarray:

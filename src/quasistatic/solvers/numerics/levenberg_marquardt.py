@@ -2,9 +2,9 @@
 
 The exact-cone refinement solves the fixed-mode laws (10-30 unknowns) from a pyramid motion. SciPy's
 ``least_squares`` costs ~0.2-0.3 ms of Python per evaluation there, where the laws themselves are compiled and
-cost microseconds; this loop costs one small linear solve per step, so a refinement takes a few milliseconds
-(docs/performance.md). It is a local method, as SciPy's is: it finds a zero near the start or stalls; the caller
-checks what it returns.
+cost microseconds; :func:`levenberg_marquardt` costs ~40 us of numpy calls per step, and
+:func:`fixed_mode_fit`, the same loop on the fixed-mode laws compiled by numba, a few (docs/performance.md). It
+is a local method, as SciPy's is: it finds a zero near the start or stalls; the caller checks what it returns.
 """
 
 from __future__ import annotations
@@ -14,7 +14,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["EquationFit", "levenberg_marquardt"]
+from ...jit import njit
+from ...laws.fixed_modes import system
+
+__all__ = ["EquationFit", "levenberg_marquardt", "fixed_mode_fit"]
 
 Equations = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]  # x -> residual (N,), Jacobian (N, N)
 
@@ -73,3 +76,73 @@ def levenberg_marquardt(equations: Equations, x0: np.ndarray, tolerance: float, 
         else:
             damping, growth = damping * growth, 2.0 * growth
     return EquationFit(x, float(np.max(np.abs(residual), initial=0.0)), evaluations)
+
+
+def _fixed_mode_fit_numpy(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    x0: np.ndarray,
+    kind: np.ndarray,
+    column: np.ndarray,
+    n: int,
+    tolerance: float,
+    max_evaluations: int,
+) -> tuple[np.ndarray, float, int]:
+    """:func:`fixed_mode_fit` without numba: :func:`levenberg_marquardt` on :func:`system` (the C extension's)."""
+    fit = levenberg_marquardt(lambda x: system(J, b, mu, g, x, kind, column, n)[:2], x0, tolerance, max_evaluations)
+    return fit.x, fit.worst, fit.evaluations
+
+
+@njit(python=_fixed_mode_fit_numpy)
+def fixed_mode_fit(
+    J: np.ndarray,
+    b: np.ndarray,
+    mu: np.ndarray,
+    g: np.ndarray,
+    x0: np.ndarray,
+    kind: np.ndarray,
+    column: np.ndarray,
+    n: int,
+    tolerance: float,
+    max_evaluations: int,
+) -> tuple[np.ndarray, float, int]:
+    """:func:`levenberg_marquardt` on the fixed-mode laws :func:`~quasistatic.laws.fixed_modes.system` (its
+    arguments, ``x0`` (N,) the start): the zero's unknowns, their largest residual entry, and the evaluations made.
+    The same steps, in the same order, as the numpy loop (its twin without numba)."""
+    x = x0.copy()
+    residual, jacobian, _ = system(J, b, mu, g, x, kind, column, n)
+    cost = np.dot(residual, residual)
+    size = x.shape[0]
+    evaluations, damping, growth, converged = 1, FIRST_DAMPING, 2.0, 0
+    while evaluations < max_evaluations and damping < MOST_DAMPING:
+        if np.max(np.abs(residual)) <= tolerance:
+            converged += 1
+            if converged > POLISH_STEPS:
+                break
+        normal = np.dot(jacobian.T, jacobian)
+        gradient = np.dot(jacobian.T, residual)
+        curvature = np.diag(normal).copy()
+        scale = np.maximum(curvature, 1e-12 * max(np.max(curvature), 1.0))
+        for i in range(size):
+            normal[i, i] += damping * scale[i]
+        try:
+            step = np.linalg.solve(normal, -gradient)
+        except Exception:  # numba raises numpy's LinAlgError as a plain exception
+            damping, growth = damping * growth, 2.0 * growth
+            continue
+        new_residual, new_jacobian, _ = system(J, b, mu, g, x + step, kind, column, n)
+        evaluations += 1
+        new_cost = np.dot(new_residual, new_residual)
+        predicted = np.dot(step, damping * scale * step - gradient)
+        gain = (cost - new_cost) / predicted if predicted > 0.0 and np.isfinite(new_cost) else -1.0
+        if gain > 0.0:
+            x, residual, jacobian, cost = x + step, new_residual, new_jacobian, new_cost
+            damping *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
+            growth = 2.0
+        elif converged:
+            break
+        else:
+            damping, growth = damping * growth, 2.0 * growth
+    return x, np.max(np.abs(residual)), evaluations
