@@ -56,7 +56,7 @@ from ..numerics.forces import least_normal_forces
 from ..numerics.highs import solve_lp
 from ..numerics.lcp import QUICK_PATIENCE, exact_newton, lemke_motion
 from ..numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION
-from ..numerics.levenberg_marquardt import EquationFit, fixed_mode_fit
+from ..numerics.levenberg_marquardt import fixed_mode_fit
 from ..result import BackendResult, Options
 from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
@@ -394,7 +394,7 @@ def _repaired_modes(problem: Problem, motion: RawMotion, modes: np.ndarray) -> n
     the pattern found this way is only a candidate, whose refinement must pass every check, as any other's."""
     laws = FixedModeLaws(problem, ModeMasks.of(problem, modes))
     x0 = laws.start(motion.q, motion.c)
-    fit = _fit(laws, x0, 200 * x0.size)
+    fit = fixed_mode_fit(laws, x0, FIXED_MODE_RESIDUAL, 200 * x0.size)
     if fit.worst > FIXED_MODE_RESIDUAL:
         return None
     q, c = laws.motion(fit.x)
@@ -522,7 +522,7 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     laws = FixedModeLaws(problem, masks)
     x0 = laws.start(motion.q, motion.c)
     # Unbounded: a zero with a negative normal force is caught below, where forces are recovered by LP.
-    fit = _fit(laws, x0, evaluations * x0.size)
+    fit = fixed_mode_fit(laws, x0, FIXED_MODE_RESIDUAL, evaluations * x0.size)
     q, c = laws.motion(fit.x)
     # A sliding contact may come to rest (its force then sits on the cone): still a solution.
     new_modes = np.array(contact_modes(problem, q))
@@ -548,12 +548,6 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
         extremes, forces = tuple(e for e, _ in exact), tuple(f for _, f in exact)
         return RawMotion(q, c, extremes, motion.unbounded, motion.free_axes, extreme_forces=forces)
     return RawMotion(q, c)
-
-
-def _fit(laws: FixedModeLaws, x0: np.ndarray, evaluations: int) -> EquationFit:
-    """Levenberg-Marquardt on the fixed-mode laws from ``x0``, to ``FIXED_MODE_RESIDUAL``, within ``evaluations``."""
-    x, worst, made = fixed_mode_fit(laws.J, laws.b, laws.mu, laws.g, x0, laws.kind, laws.column, laws.n, FIXED_MODE_RESIDUAL, evaluations)
-    return EquationFit(x, float(worst), int(made))
 
 
 def _jacobian_at(problem: Problem, q: np.ndarray, c: np.ndarray, modes: np.ndarray) -> np.ndarray:

@@ -1,10 +1,12 @@
-"""Levenberg-Marquardt on the fixed-mode laws, compiled by numba.
+"""Levenberg-Marquardt on the fixed-mode laws, the exact-cone refinement's solver.
 
 The exact-cone refinement solves the fixed-mode laws (10-30 unknowns) from a pyramid motion. SciPy's
 ``least_squares`` costs ~0.2-0.3 ms of Python per evaluation there, where the laws themselves are compiled and
-cost microseconds; :func:`fixed_mode_fit` costs a few microseconds per step with numba, ~40 without (numpy calls
-around the C extension's laws; docs/performance.md). It is a local method, as SciPy's is: it finds a zero near
-the start or stalls; the caller checks what it returns.
+cost microseconds. :func:`fixed_mode_fit` is a Python loop around two compiled calls per step, the laws and
+:func:`damped_step` (numba's loops; numpy's products and LAPACK without numba): ~17 us a step with numba, ~50
+without (docs/performance.md). The loop itself is not compiled: numba took ~5-8 s to compile it (it compiles the
+laws again inside it) on a cold cache, for ~13 us a step. It is a local method, as SciPy's is: it finds a zero
+near the start or stalls; the caller checks what it returns.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ...jit import njit
-from ...laws.fixed_modes import system
+from ...laws.fixed_modes import FixedModeLaws, system
 
 __all__ = ["EquationFit", "fixed_mode_fit", "damped_step"]
 
@@ -101,34 +103,22 @@ def damped_step(jacobian: np.ndarray, residual: np.ndarray, damping: float) -> t
     return step, predicted, True
 
 
-@njit
-def fixed_mode_fit(
-    J: np.ndarray,
-    b: np.ndarray,
-    mu: np.ndarray,
-    g: np.ndarray,
-    x0: np.ndarray,
-    kind: np.ndarray,
-    column: np.ndarray,
-    n: int,
-    tolerance: float,
-    max_evaluations: int,
-) -> tuple[np.ndarray, float, int]:
-    """A zero of the fixed-mode laws :func:`~quasistatic.laws.fixed_modes.system` (its arguments; ``x0`` (N,) the
-    start) near ``x0``: Levenberg-Marquardt steps until the largest residual entry is at most ``tolerance``, then
-    :data:`POLISH_STEPS` more (or until one fails to lower the residual), or until it stalls or has made
-    ``max_evaluations`` evaluations. Returns the unknowns, their largest residual entry (the caller judges it) and
-    the evaluations made. Without numba the same code runs as Python, on the C extension's laws.
+def fixed_mode_fit(laws: FixedModeLaws, x0: np.ndarray, tolerance: float, max_evaluations: int) -> EquationFit:
+    """A zero of the fixed-mode laws ``laws`` (their unknowns; ``x0`` (N,) the start) near ``x0``:
+    Levenberg-Marquardt steps until the largest residual entry is at most ``tolerance``, then :data:`POLISH_STEPS`
+    more (or until one fails to lower the residual), or until it stalls or has made ``max_evaluations``
+    evaluations. The caller judges the fit's largest residual entry.
 
     The damping scales each unknown by its own curvature (:func:`damped_step`; twists and forces differ in scale,
     and a plain identity stalled on grasp-3d 6 #0 where MINPACK's scaled method converges) and follows Nielsen's
     rule (shrunk by the step's gain ratio, doubled and redoubled on failure)."""
-    x = x0.copy()
+    J, b, mu, g, kind, column, n = laws.J, laws.b, laws.mu, laws.g, laws.kind, laws.column, laws.n
+    x = np.array(x0, dtype=float)
     residual, jacobian, _ = system(J, b, mu, g, x, kind, column, n)
-    cost = np.sum(residual * residual)
+    cost = float(residual @ residual)
     evaluations, damping, growth, converged = 1, FIRST_DAMPING, 2.0, 0
     while evaluations < max_evaluations and damping < MOST_DAMPING:
-        if np.max(np.abs(residual)) <= tolerance:
+        if float(np.max(np.abs(residual))) <= tolerance:
             converged += 1
             if converged > POLISH_STEPS:
                 break
@@ -138,7 +128,7 @@ def fixed_mode_fit(
             continue
         new_residual, new_jacobian, _ = system(J, b, mu, g, x + step, kind, column, n)
         evaluations += 1
-        new_cost = np.sum(new_residual * new_residual)
+        new_cost = float(new_residual @ new_residual)
         gain = (cost - new_cost) / predicted if predicted > 0.0 and np.isfinite(new_cost) else -1.0
         if gain > 0.0:
             x, residual, jacobian, cost = x + step, new_residual, new_jacobian, new_cost
@@ -148,4 +138,4 @@ def fixed_mode_fit(
             break  # within the tolerance, and no step lowers the residual further: machine precision
         else:
             damping, growth = damping * growth, 2.0 * growth
-    return x, np.max(np.abs(residual)), evaluations
+    return EquationFit(x, float(np.max(np.abs(residual))), evaluations)
