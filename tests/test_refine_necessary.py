@@ -17,6 +17,7 @@ import pytest
 
 import quasistatic as qs
 import quasistatic.solvers.certify.exact_cone as exact_cone
+from quasistatic.laws.assemble import assemble
 from quasistatic.tools.bench.families import grasp_3d
 from random_scenes import random_scene
 
@@ -69,3 +70,19 @@ def test_skipped_patterns_change_no_answer_slow(monkeypatch: pytest.MonkeyPatch,
     tested, untested, infeasible = _with_and_without(monkeypatch, made)
     assert infeasible > 0
     assert tested == untested
+
+
+@pytest.mark.parametrize(("contacts", "index"), [(6, 1), (8, 1)])
+def test_implied_verdicts_are_each_pattern_s_own(contacts: int, index: int) -> None:
+    """One ``_Necessary`` asked of many patterns (verdicts implied between them by the closed and rolling sets)
+    answers as a fresh one per pattern (its own LPs), with fewer LPs."""
+    problem = assemble(grasp_3d(contacts, index))
+    m = problem.n_contacts
+    bases = [np.array(["sliding"] * m, dtype=object), np.array(["sliding", "separating"] * (m // 2), dtype=object)]
+    patterns = [changed for base in bases for changed in exact_cone._mode_changes(base)]
+    shared = exact_cone._Necessary(problem)
+    together = [shared.possible(modes) for modes in patterns]
+    alone = [exact_cone._Necessary(problem).possible(modes) for modes in patterns]
+    assert together == alone
+    assert not all(alone) and any(alone)  # both verdicts met
+    assert shared.lps < len(patterns)

@@ -5,14 +5,18 @@ cone) and for a sliding contact whose slip is exactly opposite one of its
 edges (the force then lies on the cone, opposite the slip). So: find every
 motion with an 8-edge pyramid by the certified search, then refine each one by
 solving the exact laws with its contact modes fixed (smooth equations, by
-least squares from the pyramid motion: a bounded trust region, then
-Levenberg-Marquardt if that stalls). A sliding contact of the pyramid may
-roll or separate under the circle, so those mode changes are tried too; where
-the least-squares forces of a statically indeterminate set leave the cones,
-the forces are recovered at the refined twist by an LP. Where 8 edges leave
-the answer undecided (a motion that does not refine, a wedge, no motion with
-prescribed modes, equilibrium too close to call), the search runs again with
-32 edges.
+Levenberg-Marquardt from the pyramid motion). A sliding contact of the pyramid may
+roll or separate under the circle, so those mode changes are tried too, and
+last the modes at the zero the pyramid's own modes lead to (an open contact
+that it penetrates closes); where the least-squares forces of a statically
+indeterminate set leave the cones, the forces are recovered at the refined
+twist by an LP. Where 8 edges leave the answer undecided (a motion that does
+not refine, a wedge, no motion with prescribed modes, equilibrium too close to
+call), the search runs again with 32 edges; but where the 8-edge pyramid jams
+and Newton's method from where Lemke's path ends finds an exact motion, that
+motion is first proven the only one directly (the proof of :mod:`.exact_unique`
+covers every twist: it needs no pyramid's list), and the sector relaxation's
+proof that no motion exists (which cannot pass) is not tried.
 
 What is proven: ``unstable`` (no equilibrium even in a pyramid circumscribing
 the exact cone), kinematic ``jammed`` (a Farkas certificate), wedged
@@ -44,14 +48,15 @@ from ...tolerances import (
     FREE_TWIST_DIRECTION,
     FRICTION_ALIGNMENT,
     JACOBIAN_RANK,
-    LEAST_SQUARES_STEP,
     LP_FEASIBILITY,
     MODE_SPEED,
     SAME_TWIST,
 )
 from ..numerics.forces import least_normal_forces
 from ..numerics.highs import solve_lp
-from ..numerics.optimize import least_squares
+from ..numerics.lcp import QUICK_PATIENCE, exact_newton, lemke_motion
+from ..numerics.lemke import PIVOT_LIMIT, RAY, SOLUTION
+from ..numerics.levenberg_marquardt import fixed_mode_fit
 from ..result import BackendResult, Options
 from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
@@ -72,7 +77,8 @@ BALANCE_EDGES = 16  # polygon around each circle when a changed mode pattern's c
 
 
 def solve_exact_3d(problem: Problem, options: Options, by_patterns: bool = False) -> BackendResult:
-    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided.
+    """Certified pyramid search refined to the exact cone: 8 edges, then 32 where 8 leave it undecided (unless
+    the 8-edge pyramid jams and Newton's method finds an exact motion proven the only one: module docstring).
 
     ``by_patterns``: each pyramid's motions are first sought by the mode branch and bound
     (:mod:`.patterns`), and the SCIP search runs only where it leaves them undecided.
@@ -85,6 +91,11 @@ def solve_exact_3d(problem: Problem, options: Options, by_patterns: bool = False
             return result
         if undecided in ("wedged", "modes") and not relaxed:  # the pyramid has no motion: try to prove it for the circle
             relaxed = True
+            found = _newton_from_lemke(problem) if undecided == "wedged" else None
+            if found is not None:  # no proof that the circle has none can pass
+                if (alone := _proven_alone(problem, found, options)) is not None:
+                    return alone
+                continue  # the wider pyramid's search decides
             if proof := _wedge_proof(problem, options):
                 return _no_motion(problem, options, proof)
     if undecided == "wedged":
@@ -110,6 +121,33 @@ def _wedge_proof(problem: Problem, options: Options) -> str:
     if not proven:
         return ""
     return f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; {method})"
+
+
+def _newton_from_lemke(problem: Problem) -> RawMotion | None:
+    """A motion of the exact laws by the fast path's first start (Newton's method, quick rounds, from where Lemke's
+    path ends, as ``solvers/fast.py`` starts it), its forces checked by LP as the wedge proof checks a point it
+    meets; None where it finds none. The sector relaxation holds every exact motion, so where one is found the
+    relaxation's proof that none exists cannot pass, and is not tried (grasp-3d 6 #3: its 8-edge pyramid jams,
+    and that proof fails in ~60 ms)."""
+    status, _, q, c, _, _ = lemke_motion(problem)
+    if status in (RAY, PIVOT_LIMIT):
+        converged, q, c = exact_newton(problem, q, c, 0.0, QUICK_PATIENCE)
+    else:
+        converged = status == SOLUTION
+    return RawMotion(q, c) if converged and _exact_forces(problem, q) is not None else None
+
+
+def _proven_alone(problem: Problem, motion: RawMotion, options: Options) -> BackendResult | None:
+    """``solved``, certified, where :mod:`.exact_unique` proves ``motion`` (exact) the only one; else None.
+
+    Its proof covers every twist (near the motion and everywhere else), so it needs no pyramid's list: where the
+    8-edge pyramid jams and Newton's method finds an exact motion, the 32-edge search (which would find the same
+    motion, and prove it the same way) is not run (grasp-3d 6 #3: ~100 ms)."""
+    uniqueness = prove_unique_exact(problem, motion, options, lambda q: _exact_forces(problem, q) is not None)
+    if not uniqueness.proven:
+        return None
+    note = f"the {SEARCH_EDGES}-edge pyramid jams; the motion found by Newton's method from where Lemke's path ends"
+    return unique_exact_motion(problem, motion, options, EXACT_UNIQUENESS_PROOF).with_notes(pyramid=note)
 
 
 def _exact_forces(problem: Problem, q: np.ndarray) -> np.ndarray | None:
@@ -327,7 +365,8 @@ def _refine(problem: Problem, motion: RawMotion, necessary: _Necessary) -> RawMo
     slip runs between two edges, where the pyramid's friction is weaker), so
     those changes are tried, nearest first, before giving up. A changed pattern
     that an LP proves has no solution (``necessary``: no equilibrium on its
-    closed contacts, or no twist with its modes) is not tried.
+    closed contacts, or no twist with its modes) is not tried. Last, the modes
+    of the zero the pyramid's own modes lead to (:func:`_repaired_modes`).
     """
     if not motion.continuum and _max_dissipation_error(problem, motion) <= FRICTION_ALIGNMENT:
         return motion
@@ -339,7 +378,29 @@ def _refine(problem: Problem, motion: RawMotion, necessary: _Necessary) -> RawMo
         refined = _refine_with_modes(problem, motion, changed, evaluations=200 if attempt == 0 else 20)
         if refined is not None:
             return refined
-    return None
+    repaired = _repaired_modes(problem, motion, modes)
+    if repaired is None or not necessary.possible(repaired):
+        return None
+    return _refine_with_modes(problem, motion, repaired, evaluations=20)
+
+
+def _repaired_modes(problem: Problem, motion: RawMotion, modes: np.ndarray) -> np.ndarray | None:
+    """The modes at the zero of the fixed-mode laws with ``modes`` reached from the pyramid motion, where that zero
+    breaks them: a separating contact that penetrates there closes, a closed one pulled (normal force below
+    ``-CONE_ROUNDOFF``) opens. None where there is no zero, or it keeps ``modes``.
+
+    A pyramid whose edges miss a contact's slip may leave that contact open where the circle closes it
+    (grasp-3d 8 #1: with 8 edges one contact separates, and its zero penetrates it; with 32 edges it slides):
+    the pattern found this way is only a candidate, whose refinement must pass every check, as any other's."""
+    laws = FixedModeLaws(problem, ModeMasks.of(problem, modes))
+    x0 = laws.start(motion.q, motion.c)
+    fit = fixed_mode_fit(laws, x0, FIXED_MODE_RESIDUAL, 200 * x0.size)
+    if fit.worst > FIXED_MODE_RESIDUAL:
+        return None
+    q, c = laws.motion(fit.x)
+    reached = np.array(contact_modes(problem, q), dtype=object)
+    reached[c[:, -1] < -CONE_ROUNDOFF] = "separating"
+    return None if np.array_equal(reached, modes) else reached
 
 
 class _Necessary:
@@ -352,7 +413,13 @@ class _Necessary:
     more than ``MODE_SPEED``, and has forces in the exact cones (to ``CONE_ROUNDOFF``, inside the polygons) on its
     closed contacts only that balance the load to ``FIXED_MODE_RESIDUAL`` (or an LP's, to ``LP_FEASIBILITY``). So
     where HiGHS finds either LP infeasible (every row loosened by ``LP_FEASIBILITY``), no refinement with that
-    pattern can succeed: the test only skips work that would fail."""
+    pattern can succeed: the test only skips work that would fail.
+
+    A verdict also decides the patterns it implies, without their LP (:class:`_Verdicts`): forces that balance
+    the load on some closed contacts balance it on more (the others' forces zero), so a closed set whose polygons
+    cannot balance it makes every set inside it fail, and one that can makes every set around it pass; a twist
+    meeting a pattern's rows meets those of a pattern with fewer closed or rolling contacts (each row the same, or
+    dropped), so a kinematic verdict carries to every pattern with more of them (infeasible) or fewer (feasible)."""
 
     def __init__(self, problem: Problem) -> None:
         self.problem = problem
@@ -360,7 +427,9 @@ class _Necessary:
         m, n = problem.n_contacts, problem.n_dof
         friction = problem.mu[:, None, None] * edge_jacobian(problem, edges).reshape(m, BALANCE_EDGES, n)
         self.generators = problem.Jn[:, None, :] + friction  # (m, K, n): the polygon's edges as wrenches
-        self.known: dict[bytes, bool] = {}
+        self.balance = _Verdicts()  # by closed set: fewer closed contacts, fewer columns
+        self.kinematics = _Verdicts()  # by closed and rolling sets (negated: more of them, more rows)
+        self.lps = 0  # LPs solved (the rest were known or implied)
 
     def possible(self, modes: np.ndarray) -> bool:
         """False when no solution of the exact laws has these contact modes (proven by an infeasible LP)."""
@@ -370,24 +439,56 @@ class _Necessary:
     def _balances(self, closed: np.ndarray) -> bool:
         if not closed.any():
             return True  # nothing to test (the attempt decides)
-        key = b"f" + np.packbits(closed).tobytes()
-        if key not in self.known:
+        key = _bits(closed)
+        verdict = self.balance.implied(key)
+        if verdict is None:
             G = self.generators[closed].reshape(-1, self.problem.n_dof).T
             g = self.problem.g
-            self.known[key] = solve_lp(np.zeros(G.shape[1]), G, -g, -g, np.zeros(G.shape[1])).status != "infeasible"
-        return self.known[key]
+            self.lps += 1
+            verdict = solve_lp(np.zeros(G.shape[1]), G, -g, -g, np.zeros(G.shape[1]), simplex_first=True).status != "infeasible"
+            self.balance.add(key, verdict)
+        return verdict
 
     def _kinematic(self, masks: ModeMasks) -> bool:
-        key = b"q" + np.packbits(np.concatenate([masks.closed, masks.rolling])).tobytes()
-        if key not in self.known:
+        m = self.problem.n_contacts
+        key = _bits(~masks.closed) | _bits(~masks.rolling) << m  # more rows: fewer bits
+        verdict = self.kinematics.implied(key)
+        if verdict is None:
             p = self.problem
             rolling = masks.rolling
             A = np.vstack([p.Jn, p.Jt[rolling].reshape(-1, p.n_dof)])
             rhs = np.concatenate([p.bn, p.bt[rolling].ravel()])
             upper = np.concatenate([np.where(masks.closed, p.bn, np.inf), p.bt[rolling].ravel()])
-            lp = solve_lp(np.zeros(p.n_dof), A, rhs - LP_FEASIBILITY, upper + LP_FEASIBILITY)
-            self.known[key] = lp.status != "infeasible"
-        return self.known[key]
+            self.lps += 1
+            lp = solve_lp(np.zeros(p.n_dof), A, rhs - LP_FEASIBILITY, upper + LP_FEASIBILITY, simplex_first=True)
+            verdict = lp.status != "infeasible"
+            self.kinematics.add(key, verdict)
+        return verdict
+
+
+class _Verdicts:
+    """LP verdicts on sets (bits) where feasibility grows with the set: a feasible set's supersets are feasible,
+    an infeasible set's subsets infeasible."""
+
+    def __init__(self) -> None:
+        self.feasible: list[int] = []
+        self.infeasible: list[int] = []
+
+    def implied(self, key: int) -> bool | None:
+        """The verdict on ``key`` that a known one implies, or None."""
+        if any(key & known == known for known in self.feasible):
+            return True
+        if any(key & known == key for known in self.infeasible):
+            return False
+        return None
+
+    def add(self, key: int, feasible: bool) -> None:
+        (self.feasible if feasible else self.infeasible).append(key)
+
+
+def _bits(mask: np.ndarray) -> int:
+    """A boolean mask as an integer's bits (entry i: bit i)."""
+    return sum(1 << int(i) for i in np.flatnonzero(mask))
 
 
 def _mode_changes(modes: np.ndarray) -> Iterator[np.ndarray]:
@@ -404,7 +505,7 @@ def _mode_changes(modes: np.ndarray) -> Iterator[np.ndarray]:
 
 
 def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, evaluations: int) -> RawMotion | None:
-    """Bounded Gauss-Newton (trust region, normal forces >= 0) on the exact laws with the given contact modes.
+    """Levenberg-Marquardt on the exact laws with the given contact modes, from the pyramid motion.
 
     With the modes fixed, the exact laws are smooth equations
     (:mod:`quasistatic.laws.fixed_modes`). Returns None when they have no
@@ -420,19 +521,15 @@ def _refine_with_modes(problem: Problem, motion: RawMotion, modes: np.ndarray, e
     masks = ModeMasks.of(problem, modes)  # a frictionless contact gets no slip equation
     laws = FixedModeLaws(problem, masks)
     x0 = laws.start(motion.q, motion.c)
-    options = {"xtol": LEAST_SQUARES_STEP, "ftol": LEAST_SQUARES_STEP, "gtol": LEAST_SQUARES_STEP, "max_nfev": evaluations * x0.size}
-    fit = least_squares(laws.residual, x0, jac=laws.jacobian, bounds=(laws.lower_bounds(), np.inf), method="trf", **options)
-    if np.max(np.abs(fit.fun), initial=0.0) > FIXED_MODE_RESIDUAL:
-        # The bounded trust region can stall where unbounded Levenberg-Marquardt converges (a random
-        # 6-contact grasp); a negative normal force is then caught below, where forces are recovered by LP.
-        fit = least_squares(laws.residual, x0, jac=laws.jacobian, method="lm", **options)
+    # Unbounded: a zero with a negative normal force is caught below, where forces are recovered by LP.
+    fit = fixed_mode_fit(laws, x0, FIXED_MODE_RESIDUAL, evaluations * x0.size)
     q, c = laws.motion(fit.x)
     # A sliding contact may come to rest (its force then sits on the cone): still a solution.
     new_modes = np.array(contact_modes(problem, q))
     frictional = problem.mu > 0
     same = np.where(frictional, new_modes == modes, (new_modes == "separating") == (modes == "separating"))
     keeps_modes = bool(np.all(same | (masks.sliding & (new_modes == "rolling"))))
-    converged = float(np.max(np.abs(laws.residual(fit.x)), initial=0.0)) <= FIXED_MODE_RESIDUAL
+    converged = fit.worst <= FIXED_MODE_RESIDUAL
     if not (converged and keeps_modes):
         return None
     if not _inside_cones(problem, c, masks.rolling):

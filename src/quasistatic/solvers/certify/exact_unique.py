@@ -429,7 +429,7 @@ class _NearMotion:
 def _no_twist(A: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
     """Whether no twist meets ``lower <= A q <= upper`` with every row loosened by ``LP_FEASIBILITY`` (HiGHS finds
     it infeasible), as the relaxation's leaves are pruned by their twist rows."""
-    return solve_lp(np.zeros(A.shape[1]), A, lower - LP_FEASIBILITY, upper + LP_FEASIBILITY).status == "infeasible"
+    return solve_lp(np.zeros(A.shape[1]), A, lower - LP_FEASIBILITY, upper + LP_FEASIBILITY, simplex_first=True).status == "infeasible"
 
 
 def _narrowed(laws: FixedModeLaws, box: Interval) -> Interval | None:

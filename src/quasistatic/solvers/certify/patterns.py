@@ -673,7 +673,7 @@ def _relaxed_twist(rows: _Rows, node: _Node) -> tuple[str, np.ndarray]:
     rows.proof.lps += 1
     lower = np.concatenate([e - LP_FEASIBILITY, a - LP_FEASIBILITY])
     upper = np.concatenate([e + LP_FEASIBILITY, np.full(a.size, np.inf)])
-    lp = solve_lp(np.zeros(rows.g.size), np.vstack([E, A]), lower, upper)
+    lp = solve_lp(np.zeros(rows.g.size), np.vstack([E, A]), lower, upper, simplex_first=True)  # most leaves are infeasible
     return lp.status, lp.x
 
 
