@@ -229,12 +229,6 @@ class FixedModeLaws:
                 x[self.column[i] + 1 : self.column[i] + 1 + self.t] = c[i, :-1]
         return x
 
-    def lower_bounds(self) -> FloatArray:
-        """Normal forces >= 0, everything else free."""
-        lower = np.full(self.size, -np.inf)
-        lower[self.column[self.kind != SEPARATING]] = 0.0
-        return lower
-
     def residual(self, x: FloatArray) -> FloatArray:
         return self._system(x)[0]
 
