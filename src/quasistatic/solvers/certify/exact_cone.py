@@ -62,7 +62,7 @@ from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
 from .exact_unique import EXACT_UNIQUENESS_PROOF, prove_unique_exact
 from .min_power import solve_min_power
-from .patterns import ENUMERATION_PROOF, NO_MOTION_PROOF, PATTERN_PROOF, PatternVerdict, prove_by_patterns
+from .patterns import ENUMERATION_PROOF, NO_MOTION_PROOF, PATTERN_PROOF, PatternVerdict, mask_bits, prove_by_patterns
 from .search import enumerate_motions, summarise
 from .wedge import exact_cones_jam
 
@@ -439,7 +439,7 @@ class _Necessary:
     def _balances(self, closed: np.ndarray) -> bool:
         if not closed.any():
             return True  # nothing to test (the attempt decides)
-        key = _bits(closed)
+        key = mask_bits(closed)
         verdict = self.balance.implied(key)
         if verdict is None:
             G = self.generators[closed].reshape(-1, self.problem.n_dof).T
@@ -451,7 +451,7 @@ class _Necessary:
 
     def _kinematic(self, masks: ModeMasks) -> bool:
         m = self.problem.n_contacts
-        key = _bits(~masks.closed) | _bits(~masks.rolling) << m  # more rows: fewer bits
+        key = mask_bits(~masks.closed) | mask_bits(~masks.rolling) << m  # more rows: fewer bits
         verdict = self.kinematics.implied(key)
         if verdict is None:
             p = self.problem
@@ -484,11 +484,6 @@ class _Verdicts:
 
     def add(self, key: int, feasible: bool) -> None:
         (self.feasible if feasible else self.infeasible).append(key)
-
-
-def _bits(mask: np.ndarray) -> int:
-    """A boolean mask as an integer's bits (entry i: bit i)."""
-    return sum(1 << int(i) for i in np.flatnonzero(mask))
 
 
 def _mode_changes(modes: np.ndarray) -> Iterator[np.ndarray]:

@@ -162,6 +162,7 @@ from .cheap import satisfies_form
 from .search import relative_interior_point
 
 __all__ = [
+    "mask_bits",
     "PatternVerdict",
     "PatternProof",
     "prove_by_patterns",
@@ -338,13 +339,13 @@ def _settled_depth(levels: tuple[int, ...], modes: tuple[_Mode, ...], depth: int
     return depth
 
 
-def _bits(mask: np.ndarray) -> int:
+def mask_bits(mask: np.ndarray) -> int:
     """A boolean array as a bit set (bit ``j`` set where ``mask[j]``)."""
     return int.from_bytes(np.packbits(mask, bitorder="little").tobytes(), "little")
 
 
 def _mask(bits: int, size: int) -> np.ndarray:
-    """A bit set as a boolean array of ``size`` entries (the inverse of :func:`_bits`)."""
+    """A bit set as a boolean array of ``size`` entries (the inverse of :func:`mask_bits`)."""
     packed = np.frombuffer(bits.to_bytes((size + 7) // 8, "little"), dtype=np.uint8)
     return np.unpackbits(packed, count=size, bitorder="little").view(bool)
 
@@ -361,7 +362,7 @@ def _mode(
     contact: int, equal: list[int], at_least: list[int], keep: np.ndarray, children: tuple[_Mode, ...] = (), separating: bool = False
 ) -> _Mode:
     """Contact ``contact``'s set of modes (``keep``: its block of ``K = keep.size`` load columns)."""
-    removes = _bits(~keep) << (keep.size * contact)  # a relaxation's block holds ~60 columns: no loop over them
+    removes = mask_bits(~keep) << (keep.size * contact)  # a relaxation's block holds ~60 columns: no loop over them
     equal_bits, at_least_bits = sum(1 << r for r in set(equal)), sum(1 << r for r in set(at_least))
     return _Mode(np.array(equal, dtype=int), np.array(at_least, dtype=int), keep, children, separating, equal_bits, at_least_bits, removes)
 
@@ -650,7 +651,7 @@ def _slip_bits(slips: SlipSet, angles: np.ndarray, offset: int) -> int:
     """A contact's set of modes as bits of its field at ``offset`` (see :class:`_PassedOver`): the sectors wholly
     inside its angles."""
     inside = (slips.low <= angles[:-1]) & (angles[1:] <= slips.high)
-    return (int(slips.separating) | int(slips.rolling) << 1 | _bits(inside) << 2) << offset
+    return (int(slips.separating) | int(slips.rolling) << 1 | mask_bits(inside) << 2) << offset
 
 
 def _union(sets: list[SlipSet]) -> SlipSet | None:
@@ -690,7 +691,7 @@ class _SeedRows:
     def of(cls, layout: _Layout, q: np.ndarray) -> _SeedRows:
         values = layout.bank @ q - layout.rhs
         slack = LP_FEASIBILITY * (1.0 + np.abs(layout.rhs))
-        return cls(_bits(np.abs(values) <= slack), _bits(values >= -slack))
+        return cls(mask_bits(np.abs(values) <= slack), mask_bits(values >= -slack))
 
 
 def _seed_alone(rows: _Rows, node: _Node) -> bool:
@@ -897,8 +898,8 @@ def _seed_modes_first(layout: _Layout, form: LCPForm, seed_x: np.ndarray) -> tup
     q, _, beta, _ = form.split(seed_x)
     slack = layout.bank @ q - layout.rhs
     tolerance = ZERO * (np.linalg.norm(layout.bank, axis=1) + 1.0)
-    meets, above = _bits(np.abs(slack) <= tolerance), _bits(slack >= -tolerance)
-    loaded = _bits(beta > ZERO)  # the load columns the seed's forces use
+    meets, above = mask_bits(np.abs(slack) <= tolerance), mask_bits(slack >= -tolerance)
+    loaded = mask_bits(beta > ZERO)  # the load columns the seed's forces use
 
     def holds(mode: _Mode) -> bool:
         return not (mode.equal_bits & ~meets or mode.at_least_bits & ~above or loaded & mode.removes)
@@ -1338,12 +1339,12 @@ def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
     lam = np.empty(rows.loads.shape[1])
     residual = nonnegative_fit(rows.loads, rows.columns(columns), rows.target, lam)
     if residual <= rows.farkas.margin:
-        found = _Fit(lam, _bits(lam > 0.0))
+        found = _Fit(lam, mask_bits(lam > 0.0))
         rows.fits.add(found)
         return found
     if rows.farkas.add(-(rows.loads @ lam + rows.g), columns):
         return None  # excluded: the fit's support is never read
-    return _Fit(lam, _bits(lam > 0.0))
+    return _Fit(lam, mask_bits(lam > 0.0))
 
 
 @dataclass
@@ -1388,7 +1389,7 @@ class _FarkasVectors:
         reserve = -float(self.g @ y) - self.margin * math.sqrt(float(y @ y))  # np.linalg.norm's arithmetic, less its overhead
         if not reserve > 0.0:
             return False
-        blockers = _bits(self.loads.T @ y * FORCE_CEILING >= reserve)
+        blockers = mask_bits(self.loads.T @ y * FORCE_CEILING >= reserve)
         if blockers & columns:
             return False
         if len(self.blockers) < FARKAS_KEPT:
