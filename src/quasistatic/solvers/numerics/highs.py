@@ -123,9 +123,7 @@ def solve_lp(
 def _infeasible_by_simplex(solver: highspy.Highs, cost: np.ndarray, maximize: bool) -> LPResult | None:
     """The loaded LP's answer by the simplex without presolve where that is ``infeasible``, else None (the
     solver cleared, to be run as usual)."""
-    solver.setOptionValue("presolve", "off")
-    status = _solve(solver)
-    solver.setOptionValue("presolve", "choose")
+    status = _cold_simplex(solver)
     if status == "infeasible":
         return _result(solver, cost, maximize, status)
     solver.clearSolver()
@@ -274,10 +272,7 @@ def _run(solver: highspy.Highs, cost: np.ndarray, maximize: bool) -> LPResult:
         # redundant to round-off: a pattern of a peg sliding in a slot), or a warm-started simplex has
         # stopped without a status (kUnknown: a continuum's extent in the same slot); either is confirmed,
         # or answered, by the simplex alone from a cold start before anyone relies on it.
-        solver.setOptionValue("presolve", "off")
-        solver.clearSolver()
-        status = _solve(solver)
-        solver.setOptionValue("presolve", "choose")
+        status = _cold_simplex(solver)
     if status == "error":
         # The dual simplex can stop without a status on thin, degenerate sets (a sector relaxation's leaf of
         # four coplanar sliding supports, narrow sectors); the interior-point method answers them.
@@ -286,6 +281,15 @@ def _run(solver: highspy.Highs, cost: np.ndarray, maximize: bool) -> LPResult:
         status = _solve(solver)
         solver.setOptionValue("solver", "choose")
     return _result(solver, cost, maximize, status)
+
+
+def _cold_simplex(solver: highspy.Highs) -> LPStatus:
+    """The loaded LP solved by the simplex alone (no presolve), from a cold start."""
+    solver.setOptionValue("presolve", "off")
+    solver.clearSolver()
+    status = _solve(solver)
+    solver.setOptionValue("presolve", "choose")
+    return status
 
 
 def _result(solver: highspy.Highs, cost: np.ndarray, maximize: bool, status: LPStatus) -> LPResult:
