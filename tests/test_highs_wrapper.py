@@ -1,7 +1,7 @@
 """The HiGHS wrapper (``solvers/numerics/highs.py``): a dense constraint matrix goes to HiGHS column by column
 exactly as SciPy's CSC conversion holds it (every LP the same model, to the bit, as before it skipped SciPy); an LP
 solved ``simplex_first`` answers as without it, its infeasible verdict resting on a checked Farkas vector (HiGHS's
-dual ray), and a ray that proves nothing is not taken."""
+dual ray), and a ray that proves nothing is not taken (the vectors' check: ``test_farkas.py``)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from quasistatic.solvers.numerics import highs
+from quasistatic.solvers.numerics import farkas, highs
 
 
 @pytest.mark.parametrize("shape", [(19, 6), (1, 3), (0, 4), (7, 1)])
@@ -54,48 +54,24 @@ def _leaves() -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     return [feasible, infeasible, (rows, lower, upper)]
 
 
+@pytest.mark.parametrize("by_fit", [True, False])
 @pytest.mark.parametrize("which", [0, 1, 2])
-def test_simplex_first_answers_as_without_it(which: int) -> None:
+def test_simplex_first_answers_as_without_it(which: int, by_fit: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    if not by_fit:
+        monkeypatch.setattr(highs, "infeasible_by_fit", lambda *a: False)  # HiGHS's cold simplex and its ray answer
     A, lower, upper = _leaves()[which]
     cost = np.zeros(A.shape[1])
     usual, first = highs.solve_lp(cost, A, lower, upper), highs.solve_lp(cost, A, lower, upper, simplex_first=True)
     assert usual.status == first.status == ("optimal" if which == 0 else "infeasible")
-    np.testing.assert_array_equal(usual.x, first.x)
-
-
-class _GivenRay:
-    """Stands for a solver whose dual ray is ``y``."""
-
-    def __init__(self, y: list[float], exists: bool = True) -> None:
-        self.ray = (None, exists, np.array(y, dtype=float))
-
-    def getDualRay(self) -> tuple[None, bool, np.ndarray]:
-        return self.ray
-
-
-def _proves(y: list[float], A: np.ndarray, rows: highs.Bounds, columns: highs.Bounds = (None, None), exists: bool = True) -> bool:
-    return highs._ray_proves_infeasible(_GivenRay(y, exists), A, rows, columns)  # type: ignore[arg-type]
-
-
-def test_a_farkas_ray_proves_only_what_it_bounds() -> None:
-    # x1 <= 1, x2 <= 1, x1 + x2 >= 2.5: y = (-1, -1, 1) gives 0 = y.(A x) >= 2.5 - 2.
-    A, lower, upper = _leaves()[1]
-    rows = (lower, upper)
-    assert _proves([-1.0, -1.0, 1.0], A, rows)
-    assert not _proves([-1.0, -1.0, 1.0], A, rows, exists=False)
-    assert not _proves([1.0, 1.0, -1.0], A, rows)  # the opposite sign bounds nothing
-    assert not _proves([-1.0, 0.0, 1.0], A, rows)  # A^T y = (0, 1) with x2 free: no bound
-    assert _proves([-1.0, 0.0, 1.0], A, rows, (None, np.array([np.inf, 1.0])))  # unless x2 <= 1 bounds it
-    assert not _proves([-1.0, -1.0, 1.0], A, (np.array([0.0, 0.0, 1.5]), upper))  # 1.5 - 2 < 0: x = (1, 0.5) is a point
-    # a round-off entry on a row with no upper bound is dropped, not read as an unbounded term
-    four = (np.vstack([A, A[2]]), (np.append(lower, -1.0), np.append(upper, np.inf)))
-    assert _proves([-1.0, -1.0, 1.0, -1e-14], *four)
-    assert not _proves([-1.0, -1.0, 1.0, -1e-3], *four)
+    if which == 0:  # an infeasible LP's point means nothing
+        np.testing.assert_array_equal(usual.x, first.x)
 
 
 def test_an_infeasible_verdict_without_a_proving_ray_is_solved_again(monkeypatch: pytest.MonkeyPatch) -> None:
-    A, lower, upper = _leaves()[1]
-    cost = np.zeros(2)
+    n = farkas.FIT_COLUMNS + 1  # too large for the Farkas fit: x <= 1 and sum(x) >= n + 1
+    A = np.vstack([np.eye(n), np.ones((1, n))])
+    lower, upper = np.append(np.full(n, -np.inf), n + 1.0), np.append(np.ones(n), np.inf)
+    cost = np.zeros(n)
     runs: list[str] = []
     run = highs._run
     monkeypatch.setattr(highs, "_run", lambda *a: runs.append("run") or run(*a))

@@ -44,7 +44,7 @@ __all__ = [
     "BATCH_TIE",
     "FLOAT_ARRANGEMENT_PLANES",
     "HIGHS_SMALLEST_ENTRY",
-    "FARKAS_RAY_ROUNDOFF",
+    "FARKAS_ROUNDOFF",
     "PIVOT",
     "BASIS_FEASIBILITY",
     "LEMKE_PAIR",
@@ -230,10 +230,11 @@ Not a tolerance: the same claim, the same margins, either way."""
 HIGHS_SMALLEST_ENTRY = 1e-12
 """HiGHS drops matrix entries below this (its smallest allowed): a 1e-10 tilt is data, not noise [-]."""
 
-FARKAS_RAY_ROUNDOFF = 1e-12
-"""An LP's infeasibility checked on HiGHS's dual ray ``y``: entries of ``y`` (of ``A^T y``) below this fraction of
-its largest (of their own scale, ``|A|^T |y|``) are round-off, taken as zero; the bound the ray proves must exceed
-this fraction of its terms (measured: 283 infeasible leaves of the bench grasps pass by 9e-4 or more) [-]."""
+FARKAS_ROUNDOFF = 1e-12
+"""An LP's infeasibility checked on a Farkas vector ``y`` (HiGHS's dual ray, or a non-negative fit's): entries of
+``y`` (of ``A^T y``) below this fraction of its largest (of their own scale, ``|A|^T |y|``) are round-off, taken as
+zero; the bound the vector proves must exceed this fraction of its terms (measured: HiGHS's rays on 283
+infeasible leaves of the bench grasps pass by 9e-4 of them or more) [-]."""
 
 PIVOT = 1e-11
 """Lemke's pivot tolerance and tie width, relative to the entering column's largest entry [-]."""

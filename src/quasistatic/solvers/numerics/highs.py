@@ -19,7 +19,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import SolverError
-from ...tolerances import FARKAS_RAY_ROUNDOFF, HIGHS_SMALLEST_ENTRY
+from ...tolerances import HIGHS_SMALLEST_ENTRY, LP_FEASIBILITY
+from .farkas import FIT_COLUMNS, Bounds, infeasible_by_fit, proves_infeasible
 
 __all__ = ["LPResult", "solve_lp", "solve_qp", "optimise_each", "WarmLP", "INF"]
 
@@ -105,55 +106,32 @@ def solve_lp(
 
     Columns are free unless bounds are given. Infinite bounds use ``float('inf')``.
 
-    ``simplex_first``: the simplex without presolve runs first, and where it finds the LP infeasible and its dual
-    ray proves it (:func:`_ray_proves_infeasible`), that is the answer; else the LP is solved as without it, so an
-    optimal point is the same. For LPs that are mostly infeasible (a branch and bound's leaves): one run each
-    instead of two, and a verdict that rests on a checked Farkas vector rather than on HiGHS's word.
+    ``simplex_first``, for LPs that are mostly infeasible (a branch and bound's leaves). A small dense LP (at most
+    :data:`.farkas.FIT_COLUMNS` columns) is proven infeasible without HiGHS where a non-negative fit finds a
+    Farkas vector for it with every row loosened by ``LP_FEASIBILITY`` more (:func:`.farkas.infeasible_by_fit`:
+    microseconds, where a HiGHS run costs ~0.3-1 ms; an LP that close to a point is left to HiGHS's tolerance).
+    A larger one is solved by the simplex without presolve first, and where it finds the LP infeasible and its
+    dual ray proves it (:func:`_ray_proves_infeasible`), that is the answer. Otherwise the LP is solved as
+    without ``simplex_first``, so an optimal point is the same.
     """
     if cost.size == 0:  # HiGHS calls a model without columns "empty" whatever its rows demand
         return _without_columns(row_lower, row_upper)
+    rows, columns = (row_lower, row_upper), (col_lower, col_upper)
+    small = not sp.issparse(A) and A.shape[1] <= FIT_COLUMNS
+    if simplex_first and small and infeasible_by_fit(np.asarray(A), rows, columns, LP_FEASIBILITY):
+        return _infeasible(cost.size, A.shape[0])
     solver = _load(_thread_highs(), cost, A, row_lower, row_upper, col_lower, col_upper, maximize)
-    if simplex_first:
-        if _cold_simplex(solver) == "infeasible" and _ray_proves_infeasible(solver, A, (row_lower, row_upper), (col_lower, col_upper)):
+    if simplex_first and not small:  # (a small LP the fit left is mostly feasible: the usual run answers it at once)
+        if _cold_simplex(solver) == "infeasible" and _ray_proves_infeasible(solver, A, rows, columns):
             return _result(solver, cost, maximize, "infeasible")
         solver.clearSolver()
     return _run(solver, cost, maximize)
 
 
-Bounds = tuple[np.ndarray | None, np.ndarray | None]  # least and greatest values; None: unbounded
-
-
 def _ray_proves_infeasible(solver: highspy.Highs, A: np.ndarray | sp.spmatrix, rows: Bounds, columns: Bounds) -> bool:
-    """Whether HiGHS's dual ray ``y`` of the infeasible LP just solved is a Farkas vector, checked on the LP's
-    own data: the rows give ``y.(A x) >= sum(y_i lower_i, y_i > 0) + sum(y_i upper_i, y_i < 0)`` at every point,
-    while ``w = A^T y`` and the column bounds cap ``w.x`` below that. Round-off (:data:`FARKAS_RAY_ROUNDOFF`) is
-    taken as zero, so the proof holds for points of the LP's own scale, not for ones 1e12 times larger."""
+    """Whether HiGHS's dual ray of the infeasible LP just solved is a Farkas vector (:func:`.farkas.proves_infeasible`)."""
     _, exists, ray = solver.getDualRay()  # type: ignore[attr-defined]  # missing from highspy 1.16's stubs
-    if not exists:
-        return False
-    y = np.array(ray, dtype=float)
-    if not y.size:
-        return False
-    size = np.abs(y)
-    y[size <= FARKAS_RAY_ROUNDOFF * size.max()] = 0.0
-    w = np.asarray(A.T @ y, dtype=float)
-    w[np.abs(w) <= FARKAS_RAY_ROUNDOFF * np.asarray(abs(A).T @ np.abs(y), dtype=float)] = 0.0
-    by_rows = _least_terms(y, *rows)  # sum: the least y.(A x) the rows allow
-    by_columns = _least_terms(-w, *columns)  # sum: minus the most w.x the columns allow
-    if by_rows is None or by_columns is None:
-        return False
-    margin = FARKAS_RAY_ROUNDOFF * (np.abs(by_rows).sum() + np.abs(by_columns).sum())
-    return bool(by_rows.sum() + by_columns.sum() > margin)
-
-
-def _least_terms(v: np.ndarray, lower: np.ndarray | None, upper: np.ndarray | None) -> np.ndarray | None:
-    """The terms of the least ``v.z`` over ``lower <= z <= upper`` (None: unbounded): ``v_i lower_i`` where
-    ``v_i > 0``, ``v_i upper_i`` where ``v_i < 0``, zero where ``v_i`` is; None where one is infinite."""
-    up, down = v > 0.0, v < 0.0
-    if (lower is None and up.any()) or (upper is None and down.any()):
-        return None
-    terms = v * np.where(up, 0.0 if lower is None else lower, np.where(down, 0.0 if upper is None else upper, 0.0))
-    return terms if np.isfinite(terms).all() else None
+    return bool(exists) and proves_infeasible(np.asarray(ray), A, rows, columns)
 
 
 def solve_qp(
@@ -190,6 +168,11 @@ def solve_qp(
     result = _run(solver, cost, False)
     objective = 0.5 * float(result.x @ (hessian @ result.x)) + float(cost @ result.x) if result.status == "optimal" else float("nan")
     return LPResult(result.status, result.x, result.row_dual, objective)
+
+
+def _infeasible(n: int, m: int) -> LPResult:
+    """An LP proven infeasible without HiGHS: no point, no duals."""
+    return LPResult("infeasible", np.zeros(n), np.zeros(m), float("nan"))
 
 
 def _without_columns(row_lower: np.ndarray, row_upper: np.ndarray) -> LPResult:
