@@ -305,11 +305,13 @@ def test_without_numba_the_default_install_runs_the_kernels() -> None:
             assert lp._analyse is lp._analyse_compiled and audit._array_kernel(2, 3) is compiled.audit_laws
             assert motion._drop_roundoff is compiled.drop_roundoff
             assert nnls.nonnegative_fit is nnls._nonnegative_fit_compiled
+            assert nnls.fit_or_farkas is nnls._fit_or_farkas_compiled
             assert polygon.polygon_vertices is compiled.polygon_vertices
         else:
             assert lp._analyse is lp._analyse_numpy and audit._array_kernel(2, 3) is None
             assert motion._drop_roundoff is motion._drop_roundoff_numpy
             assert nnls.nonnegative_fit is nnls._nonnegative_fit_scipy
+            assert nnls.fit_or_farkas is nnls._fit_or_farkas_numpy
             assert polygon.polygon_vertices is polygon._polygon_vertices_numpy
         solution = qs.solve(FAMILIES["grasp-3d-nf"].make(8, 0), method="lp")
         assert solution.status == "solved" and solution.audit.passed, solution.message

@@ -38,6 +38,10 @@
  *   polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center) -> reach
  *       solvers/numerics/polygon.py::polygon_ball: the twists q0 + vertices directions, -1 when all lie in the seed's box,
  *       else the ball around them: center (n,) filled, its radius returned.
+ *   fit_or_farkas(A, keep, b, margin, ceiling, independent, x, y, bits) -> outcome
+ *       solvers/numerics/nnls.py::fit_or_farkas: nonnegative_fit on the columns whose bits keep (int64 words) sets;
+ *       where its residual passes margin, y = b - A x checked as a Farkas vector (the columns it cannot exclude in
+ *       bits); else the fit's support in bits. 0: the fit balances, 1: y excludes the kept columns, 2: neither.
  *
  * The Python C API and buffers only (every array C-contiguous, no numpy headers), so setuptools
  * alone builds it; quasistatic/compiled.py wraps it. Shapes and indices are checked
@@ -1353,6 +1357,89 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- a force fit, or a Farkas vector */
+
+enum { FIT_BALANCES, FIT_EXCLUDED, FIT_CANDIDATE };
+
+/* solvers/numerics/nnls.py::fit_or_farkas, loop for loop: the fit on the columns whose bits `keep` (words) sets,
+ * then its residual's Farkas check; x, y and bits filled; work as nonnegative_fit_loops's, and N chars for the mask. */
+static int fit_or_farkas_loops(Py_ssize_t m, Py_ssize_t N, Py_ssize_t W, const double *A, const int64_t *keep, const double *b,
+                               double margin, double ceiling, double independent, double *x, double *y, int64_t *bits,
+                               double *work, int64_t *passive, char *rejected, char *mask) {
+    for (Py_ssize_t k = 0; k < N; k++) mask[k] = (char)(((uint64_t)keep[k >> 6] >> (k & 63)) & 1);
+    double residual = nonnegative_fit_loops(m, N, A, mask, b, independent, x, work, passive, rejected);
+    if (residual > margin) {
+        double toward = 0.0, square = 0.0;
+        for (Py_ssize_t i = 0; i < m; i++) {
+            double s = 0.0;
+            for (Py_ssize_t k = 0; k < N; k++) s += A[i * N + k] * x[k];
+            y[i] = b[i] - s;
+            toward += b[i] * y[i];
+            square += y[i] * y[i];
+        }
+        double reserve = toward - margin * sqrt(square);
+        if (reserve > 0.0) {
+            int64_t met = 0;
+            for (Py_ssize_t w = 0; w < W; w++) bits[w] = 0;
+            for (Py_ssize_t k = 0; k < N; k++) {
+                double s = 0.0;
+                for (Py_ssize_t i = 0; i < m; i++) s += A[i * N + k] * y[i];
+                if (s * ceiling >= reserve) bits[k >> 6] |= (int64_t)((uint64_t)1 << (k & 63));
+            }
+            for (Py_ssize_t w = 0; w < W; w++) met |= bits[w] & keep[w];
+            if (!met) return FIT_EXCLUDED;
+        }
+    }
+    for (Py_ssize_t w = 0; w < W; w++) bits[w] = 0;
+    for (Py_ssize_t k = 0; k < N; k++)
+        if (x[k] > 0.0) bits[k >> 6] |= (int64_t)((uint64_t)1 << (k & 63));
+    return residual <= margin ? FIT_BALANCES : FIT_CANDIDATE;
+}
+
+static PyObject *fit_or_farkas(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 9) {
+        PyErr_SetString(PyExc_TypeError, "fit_or_farkas(A, keep, b, margin, ceiling, independent, x, y, bits) takes 9 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t A[2] = {-1, -1}, keep[1] = {-1}, rhs[1] = {-1}, x[1] = {-1}, y[1] = {-1}, bits[1] = {-1};
+    double margin, ceiling, independent;
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "A", FLOATS, 0, 2, A) < 0) goto done;
+    keep[0] = bits[0] = (A[1] + 63) / 64;
+    rhs[0] = y[0] = A[0];
+    x[0] = A[1];
+    if (take_next(&b, args[1], "keep", INTEGERS, 0, 1, keep) < 0) goto done;
+    if (take_next(&b, args[2], "b", FLOATS, 0, 1, rhs) < 0) goto done;
+    if (take_floats(args[3], &margin, "margin") < 0 || take_floats(args[4], &ceiling, "ceiling") < 0 ||
+        take_floats(args[5], &independent, "independent") < 0)
+        goto done;
+    if (take_next(&b, args[6], "x", FLOATS, 1, 1, x) < 0) goto done;
+    if (take_next(&b, args[7], "y", FLOATS, 1, 1, y) < 0) goto done;
+    if (take_next(&b, args[8], "bits", INTEGERS, 1, 1, bits) < 0) goto done;
+    Py_ssize_t m = A[0], N = A[1];
+    double *work = PyMem_Malloc(sizeof(double) * (size_t)(4 * m + m * m + 1));
+    int64_t *passive = PyMem_Malloc(sizeof(int64_t) * (size_t)(m + 1));
+    char *chars = PyMem_Malloc((size_t)(2 * N + 1));
+    if (work == NULL || passive == NULL || chars == NULL) {
+        PyErr_NoMemory();
+    } else {
+        int outcome;
+        Py_BEGIN_ALLOW_THREADS
+        outcome = fit_or_farkas_loops(m, N, keep[0], b.views[0].buf, b.views[1].buf, b.views[2].buf, margin, ceiling, independent,
+                                      b.views[3].buf, b.views[4].buf, b.views[5].buf, work, passive, chars, chars + N);
+        Py_END_ALLOW_THREADS
+        result = PyLong_FromLong(outcome);
+    }
+    PyMem_Free(work);
+    PyMem_Free(passive);
+    PyMem_Free(chars);
+done:
+    release(&b);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"audit_laws", (PyCFunction)(void (*)(void))audit_laws, METH_FASTCALL,
      "audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed, sums, u, slips, normal):\n"
@@ -1394,6 +1481,10 @@ static PyMethodDef methods[] = {
      "polygon_ball(q0, directions, vertices, seed, spread, same, distinct, center) -> reach: the ball around a polygon of\n"
      "twists, the numba kernel's loops; fills center (n,), returns its radius, or -1 when every twist is the seed's.\n"
      "See quasistatic.solvers.numerics.polygon."},
+    {"fit_or_farkas", (PyCFunction)(void (*)(void))fit_or_farkas, METH_FASTCALL,
+     "fit_or_farkas(A, keep, b, margin, ceiling, independent, x, y, bits) -> outcome: the non-negative fit on the columns\n"
+     "whose bits keep (int64 words) sets, then its residual's Farkas check, the numba kernel's loops; fills x (N,), y (m,)\n"
+     "and bits (words); returns 0 (balances), 1 (excluded) or 2 (neither). See quasistatic.solvers.numerics.nnls."},
     {NULL, NULL, 0, NULL},
 };
 

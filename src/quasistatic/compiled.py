@@ -8,8 +8,8 @@ built (:func:`lemke`, :func:`fixed_mode_system`: the numba kernels
 ``HAVE_KERNELS`` whether ``_kernels`` was (:func:`audit_laws`, the audit's
 ``check/audit.py::_laws_2d`` / ``_laws_3d``; :func:`analyse_frictionless`,
 ``solvers/lp.py::_analyse``; :func:`to_world` and :func:`drop_roundoff`,
-``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`nonnegative_fit`,
-``solvers/numerics/nnls.py::nonnegative_fit``; :func:`polygon_vertices` and :func:`polygon_ball`,
+``laws/motion.py::_to_world_kernel`` and ``check/motion.py::_drop_roundoff``; :func:`nonnegative_fit` and :func:`fit_or_farkas`
+(``HAVE_FIT_OR_FARKAS``), ``solvers/numerics/nnls.py``; :func:`polygon_vertices` and :func:`polygon_ball`,
 ``solvers/numerics/polygon.py``; :func:`closed_rows` and :func:`row_bounds`, ``solvers/numerics/closed_set.py``;
 :func:`assemble_scene`, ``laws/assemble.py::assemble_numpy``; :func:`stack_rows`,
 numpy's ``array`` of small vectors).
@@ -62,6 +62,8 @@ __all__ = [
     "to_world",
     "drop_roundoff",
     "nonnegative_fit",
+    "HAVE_FIT_OR_FARKAS",
+    "fit_or_farkas",
     "polygon_vertices",
     "polygon_ball",
     "closed_rows",
@@ -72,6 +74,8 @@ __all__ = [
 
 HAVE_EXTENSION = extension is not None
 HAVE_KERNELS = kernels is not None
+# An editable install may keep a _kernels .so built before fit_or_farkas was added: its callers then take its twin.
+HAVE_FIT_OR_FARKAS = HAVE_KERNELS and hasattr(kernels, "fit_or_farkas")
 # quasistatic_lemke(n, M, q, d, max_pivots, tol, free, z, basis, pivots, work, rows) -> status; 0 when not built
 LEMKE_ADDRESS: int = extension.lemke_address if HAVE_EXTENSION else 0
 
@@ -344,6 +348,32 @@ def nonnegative_fit(A: np.ndarray, keep: np.ndarray, b: np.ndarray, x: np.ndarra
         When the shapes or dtypes disagree, or ``x`` cannot be filled.
     """
     return float(kernels.nonnegative_fit(A, keep, b, x, independent))
+
+
+def fit_or_farkas(
+    A: np.ndarray,
+    keep: np.ndarray,
+    b: np.ndarray,
+    margin: float,
+    ceiling: float,
+    independent: float,
+    x: np.ndarray,
+    y: np.ndarray,
+    bits: np.ndarray,
+) -> int:
+    """A non-negative fit, or a Farkas vector, in C, as ``solvers/numerics/nnls.py::fit_or_farkas``: ``x``, ``y`` and
+    ``bits`` filled, the outcome (0: the fit balances, 1: ``y`` excludes the kept columns, 2: neither) returned.
+
+    ``A`` (m, N) C-contiguous float64, ``keep`` ((N + 63) // 64,) int64 words (bit ``j`` of word ``j // 64``: column
+    ``j``), ``b`` (m,); ``x`` (N,), ``y`` (m,) writable float64 and ``bits`` (words) writable int64;
+    ``margin`` [-], ``ceiling`` (the Farkas check's force ceiling) [-], ``independent``: the fit's ``INDEPENDENT`` [-].
+
+    Raises
+    ------
+    ValueError
+        When the shapes or dtypes disagree, or an output cannot be filled.
+    """
+    return int(kernels.fit_or_farkas(A, keep, b, margin, ceiling, independent, x, y, bits))
 
 
 def polygon_vertices(

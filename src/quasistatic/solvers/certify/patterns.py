@@ -156,7 +156,7 @@ from ...tolerances import (
 from ..numerics.closed_set import closed_rows, row_bounds
 from ..numerics.highs import WarmLP, solve_lp
 from ..numerics.line_extent import AxisExtents, line_axis_extents
-from ..numerics.nnls import nonnegative_fit
+from ..numerics.nnls import FIT_BALANCES, FIT_EXCLUDED, column_words, fit_or_farkas
 from ..numerics.polygon import NEAR_SEED, UNBOUNDED, polygon_ball, polygon_vertices
 from .cheap import satisfies_form
 from .search import relative_interior_point
@@ -1334,17 +1334,20 @@ def _known_forces(rows: _Rows, columns: int, fit: _Fit) -> _Fit | None:
 def _fitted_forces(rows: _Rows, columns: int) -> _Fit | None:
     """Non-negative forces on ``columns`` (bits) by a non-negative least-squares fit, balancing the load within
     the margin, or None with a checked Farkas vector (kept in ``rows.farkas``: it may exclude the next nodes'
-    columns too); a fit that does neither is returned (the node is not excluded)."""
+    columns too); a fit that does neither is returned (the node is not excluded). One compiled call
+    (:func:`~..numerics.nnls.fit_or_farkas`) makes the fit, the check and the bit sets."""
     rows.proof.fits += 1
     lam = np.empty(rows.loads.shape[1])
-    residual = nonnegative_fit(rows.loads, rows.columns(columns), rows.target, lam)
-    if residual <= rows.farkas.margin:
-        found = _Fit(lam, mask_bits(lam > 0.0))
-        rows.fits.add(found)
-        return found
-    if rows.farkas.add(-(rows.loads @ lam + rows.g), columns):
-        return None  # excluded: the fit's support is never read
-    return _Fit(lam, mask_bits(lam > 0.0))
+    farkas, bits = rows.farkas.work, rows.farkas.bits
+    outcome = fit_or_farkas(rows.loads, column_words(columns, lam.size), rows.target, rows.farkas.margin, FORCE_CEILING, lam, farkas, bits)
+    found = int.from_bytes(bits.tobytes(), "little")
+    if outcome == FIT_EXCLUDED:
+        rows.farkas.keep(farkas.copy(), found)
+        return None
+    fit = _Fit(lam, found)
+    if outcome == FIT_BALANCES:
+        rows.fits.add(fit)
+    return fit
 
 
 @dataclass
@@ -1383,6 +1386,12 @@ class _FarkasVectors:
     blockers: list[int] = field(default_factory=list)  # newest last
     vectors: list[np.ndarray] = field(default_factory=list)  # the vectors themselves, as ``blockers``
     count: int = 0
+    work: np.ndarray = field(init=False)  # a fit's residual (as ``g``), filled by each fit
+    bits: np.ndarray = field(init=False)  # a fit's bit set over the load columns, int64 words, filled by each fit
+
+    def __post_init__(self) -> None:
+        self.work = np.empty(self.g.size)
+        self.bits = np.empty((self.loads.shape[1] + 63) // 64, dtype=np.int64)
 
     def add(self, y: np.ndarray, columns: int) -> bool:
         """Keep ``y`` when it excludes ``columns`` (bits; then True)."""
@@ -1392,6 +1401,12 @@ class _FarkasVectors:
         blockers = mask_bits(self.loads.T @ y * FORCE_CEILING >= reserve)
         if blockers & columns:
             return False
+        self.keep(y, blockers)
+        return True
+
+    def keep(self, y: np.ndarray, blockers: int) -> None:
+        """Keep ``y``, a checked Farkas vector, as the columns it cannot exclude (``blockers``, bits), in place of the oldest
+        when :data:`FARKAS_KEPT` are kept."""
         if len(self.blockers) < FARKAS_KEPT:
             self.blockers.append(blockers)
             self.vectors.append(y)
@@ -1399,7 +1414,6 @@ class _FarkasVectors:
             self.blockers[self.count % FARKAS_KEPT] = blockers
             self.vectors[self.count % FARKAS_KEPT] = y
         self.count += 1
-        return True
 
     def excludes(self, columns: int, outside: int, modes: tuple[_Mode, ...]) -> list[bool]:
         """For each of ``modes`` (of one contact; ``outside``: every column not in its block, bits): whether a kept
