@@ -435,3 +435,17 @@ def test_stacked_rows_are_numpys_array_of_them(monkeypatch: pytest.MonkeyPatch) 
     np.testing.assert_array_equal(compiled.stack_rows([np.arange(3)], 3), [[0.0, 1.0, 2.0]])  # integers: numpy's copy
     monkeypatch.setattr(compiled, "kernels", None)
     np.testing.assert_array_equal(compiled.stack_rows(rows, 3), np.array(rows))
+
+
+@needs_kernels
+def test_assembly_reads_a_scene_once_and_keeps_each_problem_its_own() -> None:
+    """The second problem of one scene (its numbers kept with the scene) has the first one's bits, its own ``mu``, and
+    ``is_frictionless`` as its ``mu`` says, with friction and without."""
+    for scene in (*_assembly_scenes(), grasp_3d(4, 0, friction="none")):
+        first, second = qs.assemble(scene), qs.assemble(scene)
+        laws = ("frames", "J", "b", "g", "mu")
+        _assert_same_bits(tuple(getattr(first, name) for name in laws), tuple(getattr(second, name) for name in laws))
+        assert second.mu is not first.mu and second.mu.flags.writeable
+        assert second.is_frictionless == (not (second.mu > 0.0).any())
+    assert qs.assemble(grasp_3d(4, 0, friction="none")).is_frictionless and not qs.assemble(grasp_3d(4, 0)).is_frictionless
+
