@@ -449,3 +449,34 @@ def test_assembly_reads_a_scene_once_and_keeps_each_problem_its_own() -> None:
         assert second.is_frictionless == (not (second.mu > 0.0).any())
     assert qs.assemble(grasp_3d(4, 0, friction="none")).is_frictionless and not qs.assemble(grasp_3d(4, 0)).is_frictionless
 
+
+def _rows_of(scene: qs.Scene) -> tuple[list[tuple[int, int]], bool]:
+    index = {body.name: i for i, body in enumerate(scene.bodies)}
+    return [(index[c.body], index.get(c.other, -1)) for c in scene.contacts], scene.friction.kind != "none"
+
+
+@needs_kernels
+def test_audit_rows_in_c_are_the_python_loops_bits() -> None:
+    """The audit's contact rows from the C kernel are its Python loop's, double for double (-0.0 too): movers that turn,
+    contacts between free bodies, a robot's fingertip, pyramids and ``friction: none``."""
+    scenes = [*_assembly_scenes(), grasp_3d(6, 1, friction="pyramid:4"), grasp_3d(4, 0, friction="none"), random_scene(2, 3, "none")]
+    for scene in scenes:
+        links, frictional = _rows_of(scene)
+        got = audit._contact_rows_compiled(scene, links, frictional)
+        want = audit._contact_rows_python(scene, links, frictional)
+        assert got.shape == want.shape and got.tobytes() == want.tobytes()
+    assert any(mover.robot is not None for scene in scenes for mover in scene.movers)  # a row read through a Jacobian
+
+
+@needs_kernels
+def test_audit_rows_refuse_links_outside_the_bodies() -> None:
+    m, d = 2, 3
+    floats = (np.tile([0.0, 0.0, 1.0], (m, 1)), np.zeros((m, d)), np.zeros((1, d)))
+    movers = (np.zeros((m, 6)), np.zeros((m, d)), np.zeros((m, d)), np.zeros(m, dtype=bool), np.ones(m))
+    assert compiled.audit_rows(*floats, np.array([[0, -1], [0, -1]]), *movers).shape == (m, 1 + d * (d + 3))
+    with pytest.raises(ValueError, match="outside 0..0"):
+        compiled.audit_rows(*floats, np.array([[0, -1], [1, -1]]), *movers)
+    with pytest.raises(ValueError, match="outside 0..0"):
+        compiled.audit_rows(*floats, np.array([[0, -2], [0, -1]]), *movers)
+    with pytest.raises(ValueError, match="links must have 2 dimensions"):
+        compiled.audit_rows(*floats, np.array([[0, -1]]), *movers)

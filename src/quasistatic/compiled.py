@@ -68,6 +68,8 @@ __all__ = [
     "row_bounds",
     "assemble_scene",
     "stack_rows",
+    "HAVE_AUDIT_ROWS",
+    "audit_rows",
 ]
 
 HAVE_EXTENSION = extension is not None
@@ -490,3 +492,39 @@ def stack_rows(rows: Sequence[np.ndarray], width: int) -> np.ndarray:
     except ValueError:
         return np.array(rows, dtype=float).reshape(len(rows), width)
     return out
+
+
+HAVE_AUDIT_ROWS = HAVE_KERNELS and hasattr(kernels, "audit_rows")  # an extension built before it lacks it
+
+
+def audit_rows(
+    normals: np.ndarray,
+    points: np.ndarray,
+    coms: np.ndarray,
+    links: np.ndarray,
+    twists: np.ndarray,
+    origins: np.ndarray,
+    driven: np.ndarray,
+    through_joints: np.ndarray,
+    mu: np.ndarray,
+) -> np.ndarray:
+    """The audit's contact rows in C, as ``check/audit.py::_read_geometry``'s Python loop computes them: (m, 1 + d (d + 3)),
+    each ``(normal, tangents, arm from the body's com, arm from the other free body's com or zeros, the mover's point
+    velocity or zeros, mu)``.
+
+    ``normals`` and ``points`` (m, d), ``coms`` (bodies, d), ``links`` (m, 2) int64 (body, other; -1 a mover), each
+    contact's mover ``twists`` (m, k) and ``origins`` (m, d), ``driven`` (m, d) the point velocity of the contacts
+    ``through_joints`` (m,) bool (a robot's link: taken as it is), ``mu`` (m,).
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree or a link is outside the bodies.
+    """
+    m, d = normals.shape
+    rows = np.empty((m, 1 + d * (d + 3)))
+    floats = [np.ascontiguousarray(a, np.float64) for a in (normals, points, coms)]
+    rest = [np.ascontiguousarray(a, np.float64) for a in (twists, origins, driven)]
+    joints = np.ascontiguousarray(through_joints, np.bool_)
+    kernels.audit_rows(*floats, np.ascontiguousarray(links, np.int64), *rest, joints, np.ascontiguousarray(mu, np.float64), rows)
+    return rows
