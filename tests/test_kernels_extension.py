@@ -417,6 +417,26 @@ def test_assembly_kernel_refuses_what_it_cannot_read() -> None:
 
 
 @needs_kernels
+def test_assembly_kernel_converts_arrays_it_cannot_read_as_they_are() -> None:
+    """Views that are not C-contiguous (normals, masses) and int32 links give the contiguous arrays' laws."""
+    scene = grasp_3d(4, 0)
+    numbers = assembly_numbers(scene)
+    want = compiled.assemble_scene(*numbers, scene.gravity, 1e-150)
+    wide = np.zeros((len(scene.contacts), 6))
+    wide[:, ::2] = numbers[0]  # normals as a strided view
+    odd = (wide[:, ::2], *numbers[1:3], numbers[3].astype(np.int32), numbers[4].astype(np.int32), *numbers[5:10])
+    got = compiled.assemble_scene(*odd, np.repeat(numbers[10], 2)[::2], scene.gravity, 1e-150)
+    _assert_same_bits(got[:5], want[:5])
+    assert got[5] == want[5]
+
+
+def assembly_numbers(scene: qs.Scene) -> tuple[np.ndarray, ...]:
+    """The arrays before gravity that ``assemble`` hands the compiled kernel."""
+    n = importlib.import_module("quasistatic.laws.assemble").scene_numbers(scene)
+    return (n.normals, n.points, n.coms, n.owners, n.others, n.twists, n.origins, n.places, n.driven, n.wrenches, n.masses)
+
+
+@needs_kernels
 def test_stacked_rows_are_numpys_array_of_them(monkeypatch: pytest.MonkeyPatch) -> None:
     """``stack_rows`` copies contiguous float rows in C, gives numpy's array where a row is not one (a strided view,
     another length, integers), and numpy's everywhere when the extension was not built."""

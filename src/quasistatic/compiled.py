@@ -472,10 +472,12 @@ def assemble_scene(
     m, d = normals.shape
     k, bodies = (3 if d == 2 else 6), len(coms)
     frames, J, b, out = np.empty((m, d, d)), np.zeros((m, d, k * bodies)), np.empty((m, d)), np.empty(k * bodies + d + 3)
-    floats = [np.ascontiguousarray(a, np.float64) for a in (normals, points, coms)]
-    indices = [np.ascontiguousarray(a, np.int64) for a in (owners, others)]
-    rest = [np.ascontiguousarray(a, np.float64) for a in (twists, origins, places, driven, wrenches, masses, gravity)]
-    kernels.assemble_scene(*floats, *indices, *rest, smallest_length, frames, J, b, out)
+    arrays = (normals, points, coms, owners, others, twists, origins, places, driven, wrenches, masses, gravity)
+    try:  # a scene's kept numbers already are C-contiguous of their dtypes (the kernel checks each before it computes)
+        kernels.assemble_scene(*arrays, smallest_length, frames, J, b, out)
+    except ValueError:  # converted where one is not; the kernel's other refusals are raised again
+        types = (np.float64,) * 3 + (np.int64,) * 2 + (np.float64,) * 7
+        kernels.assemble_scene(*map(np.ascontiguousarray, arrays, types), smallest_length, frames, J, b, out)
     g, scales = out[: k * bodies], out[k * bodies :]
     return frames, J, b, g, scales[:d].copy(), (float(scales[d]), float(scales[d + 1]), float(scales[d + 2]))
 
