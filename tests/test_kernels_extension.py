@@ -419,6 +419,26 @@ def test_assembly_kernel_refuses_what_it_cannot_read() -> None:
 
 
 @needs_kernels
+def test_assembly_kernel_converts_arrays_it_cannot_read_as_they_are() -> None:
+    """Views that are not C-contiguous (normals, masses) and int32 links give the contiguous arrays' laws."""
+    scene = grasp_3d(4, 0)
+    numbers = assembly_numbers(scene)
+    want = compiled.assemble_scene(*numbers, scene.gravity, 1e-150)
+    wide = np.zeros((len(scene.contacts), 6))
+    wide[:, ::2] = numbers[0]  # normals as a strided view
+    odd = (wide[:, ::2], *numbers[1:3], numbers[3].astype(np.int32), numbers[4].astype(np.int32), *numbers[5:10])
+    got = compiled.assemble_scene(*odd, np.repeat(numbers[10], 2)[::2], scene.gravity, 1e-150)
+    _assert_same_bits(got[:5], want[:5])
+    assert got[5] == want[5]
+
+
+def assembly_numbers(scene: qs.Scene) -> tuple[np.ndarray, ...]:
+    """The arrays before gravity that ``assemble`` hands the compiled kernel."""
+    n = importlib.import_module("quasistatic.laws.assemble").scene_numbers(scene)
+    return (n.normals, n.points, n.coms, n.owners, n.others, n.twists, n.origins, n.places, n.driven, n.wrenches, n.masses)
+
+
+@needs_kernels
 def test_stacked_rows_are_numpys_array_of_them(monkeypatch: pytest.MonkeyPatch) -> None:
     """``stack_rows`` copies contiguous float rows in C, gives numpy's array where a row is not one (a strided view,
     another length, integers), and numpy's everywhere when the extension was not built."""
@@ -437,3 +457,48 @@ def test_stacked_rows_are_numpys_array_of_them(monkeypatch: pytest.MonkeyPatch) 
     np.testing.assert_array_equal(compiled.stack_rows([np.arange(3)], 3), [[0.0, 1.0, 2.0]])  # integers: numpy's copy
     monkeypatch.setattr(compiled, "kernels", None)
     np.testing.assert_array_equal(compiled.stack_rows(rows, 3), np.array(rows))
+
+
+@needs_kernels
+def test_assembly_reads_a_scene_once_and_keeps_each_problem_its_own() -> None:
+    """The second problem of one scene (its numbers kept with the scene) has the first one's bits, its own ``mu``, and
+    ``is_frictionless`` as its ``mu`` says, with friction and without."""
+    for scene in (*_assembly_scenes(), grasp_3d(4, 0, friction="none")):
+        first, second = qs.assemble(scene), qs.assemble(scene)
+        laws = ("frames", "J", "b", "g", "mu")
+        _assert_same_bits(tuple(getattr(first, name) for name in laws), tuple(getattr(second, name) for name in laws))
+        assert second.mu is not first.mu and second.mu.flags.writeable
+        assert second.is_frictionless == (not (second.mu > 0.0).any())
+    assert qs.assemble(grasp_3d(4, 0, friction="none")).is_frictionless and not qs.assemble(grasp_3d(4, 0)).is_frictionless
+
+
+def _rows_of(scene: qs.Scene) -> tuple[list[tuple[int, int]], bool]:
+    index = {body.name: i for i, body in enumerate(scene.bodies)}
+    return [(index[c.body], index.get(c.other, -1)) for c in scene.contacts], scene.friction.kind != "none"
+
+
+@needs_kernels
+def test_audit_rows_in_c_are_the_python_loops_bits() -> None:
+    """The audit's contact rows from the C kernel are its Python loop's, double for double (-0.0 too): movers that turn,
+    contacts between free bodies, a robot's fingertip, pyramids and ``friction: none``."""
+    scenes = [*_assembly_scenes(), grasp_3d(6, 1, friction="pyramid:4"), grasp_3d(4, 0, friction="none"), random_scene(2, 3, "none")]
+    for scene in scenes:
+        links, frictional = _rows_of(scene)
+        got = audit._contact_rows_compiled(scene, links, frictional)
+        want = audit._contact_rows_python(scene, links, frictional)
+        assert got.shape == want.shape and got.tobytes() == want.tobytes()
+    assert any(mover.robot is not None for scene in scenes for mover in scene.movers)  # a row read through a Jacobian
+
+
+@needs_kernels
+def test_audit_rows_refuse_links_outside_the_bodies() -> None:
+    m, d = 2, 3
+    floats = (np.tile([0.0, 0.0, 1.0], (m, 1)), np.zeros((m, d)), np.zeros((1, d)))
+    movers = (np.zeros((m, 6)), np.zeros((m, d)), np.zeros((m, d)), np.zeros(m, dtype=bool), np.ones(m))
+    assert compiled.audit_rows(*floats, np.array([[0, -1], [0, -1]]), *movers).shape == (m, 1 + d * (d + 3))
+    with pytest.raises(ValueError, match="outside 0..0"):
+        compiled.audit_rows(*floats, np.array([[0, -1], [1, -1]]), *movers)
+    with pytest.raises(ValueError, match="outside 0..0"):
+        compiled.audit_rows(*floats, np.array([[0, -2], [0, -1]]), *movers)
+    with pytest.raises(ValueError, match="links must have 2 dimensions"):
+        compiled.audit_rows(*floats, np.array([[0, -1]]), *movers)

@@ -42,6 +42,9 @@
  *       solvers/numerics/nnls.py::fit_or_farkas: nonnegative_fit on the columns whose bits keep (int64 words) sets;
  *       where its residual passes margin, y = b - A x checked as a Farkas vector (the columns it cannot exclude in
  *       bits); else the fit's support in bits. 0: the fit balances, 1: y excludes the kept columns, 2: neither.
+ *   audit_rows(normals, points, coms, links, twists, origins, driven, through_joints, mu, rows) -> None
+ *       check/audit.py::_read_geometry's contact rows: normal, tangents, arms to the coms, the mover's point
+ *       velocity (rigid, or a robot's row of driven), mu; each number as the Python loop computes it; rows filled.
  *
  * The Python C API and buffers only (every array C-contiguous, no numpy headers), so setuptools
  * alone builds it; quasistatic/compiled.py wraps it. Shapes and indices are checked
@@ -1440,6 +1443,107 @@ done:
     return result;
 }
 
+/* ---------------------------------------------------------------- the audit's rows of a scene */
+
+/* check/audit.py::_tangents for the unit normal n (d = 2 or 3): the tangent rows, flattened, in Python's order. */
+static void audit_tangents(const double *n, Py_ssize_t d, double *out) {
+    if (d == 2) {
+        out[0] = n[1], out[1] = -n[0];
+        return;
+    }
+    const double x = n[0], y = n[1], z = n[2], a[3] = {fabs(x), fabs(y), fabs(z)};
+    int axis = 0; /* Python's a.index(min(a)): the first smallest */
+    if (a[1] < a[axis]) axis = 1;
+    if (a[2] < a[axis]) axis = 2;
+    double t[3];
+    if (axis == 0) t[0] = 0.0, t[1] = z, t[2] = -y;
+    else if (axis == 1) t[0] = -z, t[1] = 0.0, t[2] = x;
+    else t[0] = y, t[1] = -x, t[2] = 0.0;
+    const double norm = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    const double t0 = t[0] / norm, t1 = t[1] / norm, t2 = t[2] / norm;
+    out[0] = t0, out[1] = t1, out[2] = t2;
+    out[3] = y * t2 - z * t1, out[4] = z * t0 - x * t2, out[5] = x * t1 - y * t0;
+}
+
+/* check/audit.py::_mover_velocity of a rigidly moving mover (twist (k,), origin (d,)) at `point`, in Python's order. */
+static void audit_mover_velocity(const double *twist, const double *origin, const double *point, Py_ssize_t d, double *out) {
+    double r[3];
+    for (Py_ssize_t j = 0; j < d; j++) r[j] = point[j] - origin[j];
+    if (d == 2) {
+        out[0] = twist[0] - twist[2] * r[1], out[1] = twist[1] + twist[2] * r[0];
+        return;
+    }
+    const double wx = twist[3], wy = twist[4], wz = twist[5];
+    out[0] = twist[0] + wy * r[2] - wz * r[1];
+    out[1] = twist[1] + wz * r[0] - wx * r[2];
+    out[2] = twist[2] + wx * r[1] - wy * r[0];
+}
+
+/* audit_rows(normals, points, coms, links, twists, origins, driven, through_joints, mu, rows): check/audit.py's
+ * contact rows (normal, tangents, arm to the body's com, arm to the other free body's com or zeros, the mover's
+ * point velocity or zeros, mu), each number as its Python loop computes it. A contact whose other is a mover
+ * (links[i, 1] == -1) moves as its rigid twist and origin, or, where through_joints[i], at its row of driven. */
+static PyObject *audit_rows(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 10) {
+        PyErr_SetString(PyExc_TypeError, "audit_rows(normals, points, coms, links, twists, origins, driven, through_joints, mu, rows) "
+                                         "takes 10 arguments");
+        return NULL;
+    }
+    Buffers b = {.taken = 0};
+    Py_ssize_t normals[2] = {-1, -1};
+    PyObject *result = NULL;
+    if (take_next(&b, args[0], "normals", FLOATS, 0, 2, normals) < 0) goto done;
+    const Py_ssize_t m = normals[0], d = normals[1], k = d == 2 ? 3 : 6, width = 1 + d * (d + 3);
+    if (d != 2 && d != 3) {
+        PyErr_SetString(PyExc_ValueError, "normals must be (m, 2) or (m, 3)");
+        goto done;
+    }
+    Py_ssize_t points[2] = {m, d}, coms[2] = {-1, d}, links[2] = {m, 2}, twists[2] = {m, k}, origins[2] = {m, d}, driven[2] = {m, d};
+    Py_ssize_t joints[1] = {m}, mu[1] = {m}, rows[2] = {m, width};
+    if (take_next(&b, args[1], "points", FLOATS, 0, 2, points) < 0 || take_next(&b, args[2], "coms", FLOATS, 0, 2, coms) < 0 ||
+        take_next(&b, args[3], "links", INTEGERS, 0, 2, links) < 0 || take_next(&b, args[4], "twists", FLOATS, 0, 2, twists) < 0 ||
+        take_next(&b, args[5], "origins", FLOATS, 0, 2, origins) < 0 || take_next(&b, args[6], "driven", FLOATS, 0, 2, driven) < 0 ||
+        take_next(&b, args[7], "through_joints", BOOLEANS, 0, 1, joints) < 0 || take_next(&b, args[8], "mu", FLOATS, 0, 1, mu) < 0 ||
+        take_next(&b, args[9], "rows", FLOATS, 1, 2, rows) < 0)
+        goto done;
+    const double *n = b.views[0].buf, *p = b.views[1].buf, *c = b.views[2].buf, *tw = b.views[4].buf, *o = b.views[5].buf;
+    const double *dv = b.views[6].buf, *f = b.views[8].buf;
+    const int64_t *l = b.views[3].buf;
+    const char *through = b.views[7].buf;
+    double *out = b.views[9].buf;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        if (l[2 * i] < 0 || l[2 * i] >= coms[0] || l[2 * i + 1] < -1 || l[2 * i + 1] >= coms[0]) {
+            PyErr_Format(PyExc_ValueError, "contact %zd links body %lld or other %lld outside 0..%zd", i, (long long)l[2 * i],
+                         (long long)l[2 * i + 1], coms[0] - 1);
+            goto done;
+        }
+    }
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < m; i++) {
+        const double *point = p + i * d;
+        const int64_t body = l[2 * i], other = l[2 * i + 1];
+        double *row = out + i * width, *arm_body = row + d * d, *arm_other = arm_body + d, *velocity = arm_other + d;
+        for (Py_ssize_t j = 0; j < d; j++) row[j] = n[i * d + j];
+        audit_tangents(n + i * d, d, row + d);
+        for (Py_ssize_t j = 0; j < d; j++) arm_body[j] = point[j] - c[body * d + j];
+        for (Py_ssize_t j = 0; j < d; j++) arm_other[j] = other >= 0 ? point[j] - c[other * d + j] : 0.0;
+        if (other >= 0) {
+            for (Py_ssize_t j = 0; j < d; j++) velocity[j] = 0.0;
+        } else if (through[i]) {
+            for (Py_ssize_t j = 0; j < d; j++) velocity[j] = dv[i * d + j];
+        } else {
+            audit_mover_velocity(tw + i * k, o + i * d, point, d, velocity);
+        }
+        row[width - 1] = f[i];
+    }
+    Py_END_ALLOW_THREADS
+    result = Py_NewRef(Py_None);
+done:
+    release(&b);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"audit_laws", (PyCFunction)(void (*)(void))audit_laws, METH_FASTCALL,
      "audit_laws(links, contacts, loads, T, f, facets, directions, facet_scale, slide_speed, sums, u, slips, normal):\n"
@@ -1485,6 +1589,10 @@ static PyMethodDef methods[] = {
      "fit_or_farkas(A, keep, b, margin, ceiling, independent, x, y, bits) -> outcome: the non-negative fit on the columns\n"
      "whose bits keep (int64 words) sets, then its residual's Farkas check, the numba kernel's loops; fills x (N,), y (m,)\n"
      "and bits (words); returns 0 (balances), 1 (excluded) or 2 (neither). See quasistatic.solvers.numerics.nnls."},
+    {"audit_rows", (PyCFunction)(void (*)(void))audit_rows, METH_FASTCALL,
+     "audit_rows(normals, points, coms, links, twists, origins, driven, through_joints, mu, rows): the audit's contact rows\n"
+     "(normal, tangents, arms, mover point velocity, mu), as its Python loop computes them; fills rows (m, 1 + d (d + 3)).\n"
+     "See quasistatic.check.audit."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -70,6 +70,8 @@ __all__ = [
     "row_bounds",
     "assemble_scene",
     "stack_rows",
+    "HAVE_AUDIT_ROWS",
+    "audit_rows",
 ]
 
 HAVE_EXTENSION = extension is not None
@@ -500,10 +502,12 @@ def assemble_scene(
     m, d = normals.shape
     k, bodies = (3 if d == 2 else 6), len(coms)
     frames, J, b, out = np.empty((m, d, d)), np.zeros((m, d, k * bodies)), np.empty((m, d)), np.empty(k * bodies + d + 3)
-    floats = [np.ascontiguousarray(a, np.float64) for a in (normals, points, coms)]
-    indices = [np.ascontiguousarray(a, np.int64) for a in (owners, others)]
-    rest = [np.ascontiguousarray(a, np.float64) for a in (twists, origins, places, driven, wrenches, masses, gravity)]
-    kernels.assemble_scene(*floats, *indices, *rest, smallest_length, frames, J, b, out)
+    arrays = (normals, points, coms, owners, others, twists, origins, places, driven, wrenches, masses, gravity)
+    try:  # a scene's kept numbers already are C-contiguous of their dtypes (the kernel checks each before it computes)
+        kernels.assemble_scene(*arrays, smallest_length, frames, J, b, out)
+    except ValueError:  # converted where one is not; the kernel's other refusals are raised again
+        types = (np.float64,) * 3 + (np.int64,) * 2 + (np.float64,) * 7
+        kernels.assemble_scene(*map(np.ascontiguousarray, arrays, types), smallest_length, frames, J, b, out)
     g, scales = out[: k * bodies], out[k * bodies :]
     return frames, J, b, g, scales[:d].copy(), (float(scales[d]), float(scales[d + 1]), float(scales[d + 2]))
 
@@ -520,3 +524,39 @@ def stack_rows(rows: Sequence[np.ndarray], width: int) -> np.ndarray:
     except ValueError:
         return np.array(rows, dtype=float).reshape(len(rows), width)
     return out
+
+
+HAVE_AUDIT_ROWS = HAVE_KERNELS and hasattr(kernels, "audit_rows")  # an extension built before it lacks it
+
+
+def audit_rows(
+    normals: np.ndarray,
+    points: np.ndarray,
+    coms: np.ndarray,
+    links: np.ndarray,
+    twists: np.ndarray,
+    origins: np.ndarray,
+    driven: np.ndarray,
+    through_joints: np.ndarray,
+    mu: np.ndarray,
+) -> np.ndarray:
+    """The audit's contact rows in C, as ``check/audit.py::_read_geometry``'s Python loop computes them: (m, 1 + d (d + 3)),
+    each ``(normal, tangents, arm from the body's com, arm from the other free body's com or zeros, the mover's point
+    velocity or zeros, mu)``.
+
+    ``normals`` and ``points`` (m, d), ``coms`` (bodies, d), ``links`` (m, 2) int64 (body, other; -1 a mover), each
+    contact's mover ``twists`` (m, k) and ``origins`` (m, d), ``driven`` (m, d) the point velocity of the contacts
+    ``through_joints`` (m,) bool (a robot's link: taken as it is), ``mu`` (m,).
+
+    Raises
+    ------
+    ValueError
+        When the shapes disagree or a link is outside the bodies.
+    """
+    m, d = normals.shape
+    rows = np.empty((m, 1 + d * (d + 3)))
+    floats = [np.ascontiguousarray(a, np.float64) for a in (normals, points, coms)]
+    rest = [np.ascontiguousarray(a, np.float64) for a in (twists, origins, driven)]
+    joints = np.ascontiguousarray(through_joints, np.bool_)
+    kernels.audit_rows(*floats, np.ascontiguousarray(links, np.int64), *rest, joints, np.ascontiguousarray(mu, np.float64), rows)
+    return rows

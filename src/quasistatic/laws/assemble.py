@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, TypeVar, cast
+from typing import Any, NamedTuple, TypeVar, cast
 
 import numpy as np
 
@@ -20,7 +20,7 @@ from ..model import FloatArray, FrictionModel, Scales, Scene, scene_scales
 from ..model.kinematics import contact_frames, cross, mover_parts, mover_point_velocities
 from ..tolerances import SMALLEST_LENGTH
 
-__all__ = ["Problem", "assemble"]
+__all__ = ["Problem", "SceneNumbers", "assemble", "scene_numbers"]
 
 T = TypeVar("T")
 
@@ -124,17 +124,60 @@ def assemble(scene: Scene) -> Problem:
 
     In the extension's C where it was built (one call for what costs two dozen small numpy calls on a few
     contacts), else by :func:`assemble_numpy`: the same arithmetic in the same order, so the same bits.
+    The scene's numbers are gathered once per scene (:func:`scene_numbers`, kept with it): a scene solved
+    again pays for the C call and the Problem only.
     """
     if not (HAVE_KERNELS and scene.contacts):
         return assemble_numpy(scene)
-    bodies = scene.bodies
-    wrenches = stack_rows([cast(FloatArray, body.wrench) for body in bodies], scene.twist_size)  # a Scene fills each
-    masses = np.array([body.mass for body in bodies], dtype=float)
-    laws = compiled_assemble(*_contact_numbers(scene), *mover_parts(scene), wrenches, masses, scene.gravity, SMALLEST_LENGTH)
+    n = scene.derived("assembly_numbers", scene_numbers)
+    movers = (n.twists, n.origins, n.places, n.driven)
+    laws = compiled_assemble(n.normals, n.points, n.coms, n.owners, n.others, *movers, n.wrenches, n.masses, scene.gravity, SMALLEST_LENGTH)
     frames, J, b, g, origin, (length, force, velocity) = laws
     origin.setflags(write=False)
     scales = Scales(length=length, force=force, velocity=velocity, origin=origin)
-    return Problem(scene, frames, J, b, g, _friction_coefficients(scene), scene.friction, scales)
+    problem = Problem(scene, frames, J, b, g, n.mu.copy(), scene.friction, scales)
+    problem._derived["frictionless"] = n.frictionless  # known from the scene: no array reduction per problem
+    return problem
+
+
+class SceneNumbers(NamedTuple):
+    """What the C assembly reads of a scene, gathered into read-only arrays (kept with the scene).
+
+    Attributes
+    ----------
+    normals, points : (m, d) the contacts' world normals and points
+    coms : (bodies, d) the bodies' centres of mass
+    owners, others : (m,) each contact's body and other body as indices into the bodies (-1: a mover)
+    twists, origins, places, driven : the movers' parts (:func:`~quasistatic.model.kinematics.mover_parts`)
+    wrenches : (bodies, k) applied wrenches; masses : (bodies,)
+    mu : (m,) friction coefficients [-], zero under ``friction: none``
+    frictionless : no contact has mu > 0 (:attr:`Problem.is_frictionless`)
+    """
+
+    normals: FloatArray
+    points: FloatArray
+    coms: FloatArray
+    owners: np.ndarray
+    others: np.ndarray
+    twists: FloatArray
+    origins: FloatArray
+    places: FloatArray
+    driven: FloatArray
+    wrenches: FloatArray
+    masses: FloatArray
+    mu: FloatArray
+    frictionless: bool
+
+
+def scene_numbers(scene: Scene) -> SceneNumbers:
+    """The numbers :func:`assemble` hands the compiled kernel, read from ``scene`` (frozen: they can be kept)."""
+    wrenches = stack_rows([cast(FloatArray, body.wrench) for body in scene.bodies], scene.twist_size)  # a Scene fills each
+    masses = np.array([body.mass for body in scene.bodies], dtype=float)
+    arrays = (*_contact_numbers(scene), *mover_parts(scene), wrenches, masses, _friction_coefficients(scene))
+    for array in arrays:
+        array.setflags(write=False)
+    mu = arrays[-1]
+    return SceneNumbers(*arrays, frictionless=not (mu > 0.0).any())
 
 
 def assemble_numpy(scene: Scene) -> Problem:

@@ -79,7 +79,13 @@ class LemkeInputs:
             self.base = PLANAR_EDGES
         else:
             self.base = _edge_angles(FAST_EDGES if self.exact else problem.friction.edges).copy()  # (a copy is cheaper than arange)
-        self.J, self.b, self.mu, self.g = (np.ascontiguousarray(a, dtype=float) for a in (problem.J, problem.b, problem.mu, problem.g))
+        contiguous = np.ascontiguousarray  # assembly's arrays already are: each call returns its argument
+        self.J, self.b, self.mu, self.g = (
+            contiguous(problem.J, float),
+            contiguous(problem.b, float),
+            contiguous(problem.mu, float),
+            contiguous(problem.g, float),
+        )
         self.frictional = (self.mu > 0.0).nonzero()[0]  # (np.flatnonzero's ravel and dispatch cost twice this)
 
 
