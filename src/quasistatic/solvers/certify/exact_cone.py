@@ -16,7 +16,10 @@ call), the search runs again with 32 edges; but where the 8-edge pyramid jams
 and Newton's method from where Lemke's path ends finds an exact motion, that
 motion is first proven the only one directly (the proof of :mod:`.exact_unique`
 covers every twist: it needs no pyramid's list), and the sector relaxation's
-proof that no motion exists (which cannot pass) is not tried.
+proof that no motion exists (which cannot pass) is not tried. The certified
+method tries that proof before any pyramid: one far-part round on the fast
+path's motion; where it closes, no pyramid is searched, and where it pauses,
+it resumes once a later stage needs the same motion proven.
 
 What is proven: ``unstable`` (no equilibrium even in a pyramid circumscribing
 the exact cone), kinematic ``jammed`` (a Farkas certificate), wedged
@@ -45,6 +48,7 @@ from ...laws.polyhedral import LCPForm, aligned_edges, edge_jacobian, polyhedral
 from ...solution import Certificate, CertificateKind, Diagnosis
 from ...tolerances import (
     CONE_ROUNDOFF,
+    DISTINCT_TWIST,
     FIXED_MODE_RESIDUAL,
     FREE_TWIST_DIRECTION,
     FRICTION_ALIGNMENT,
@@ -358,8 +362,9 @@ def _proven_unique(problem: Problem, motion: RawMotion, options: Options, note: 
 
 
 def _first_besides(problem: Problem, motion: RawMotion, first: _FirstProof | None, options: Options) -> RawMotion | None:
-    """The first proof's motion, refined, where it is an exact motion other than ``motion``; else None."""
-    if first is None or first.motion is None or _same_exact(problem, motion, first.motion):
+    """The first proof's motion, refined, where it is an exact motion other than ``motion`` (their twists farther
+    apart than ``DISTINCT_TWIST``, as the proof's far part asks of a second motion); else None."""
+    if first is None or first.motion is None or np.max(np.abs(first.motion.q - motion.q)) <= DISTINCT_TWIST:
         return None
     return _other_motion(problem, motion, first.motion.q, options)
 
