@@ -13,7 +13,7 @@ from quasistatic.laws import ModeMasks, contact_modes
 from quasistatic.laws.fixed_modes import FixedModeLaws
 from quasistatic.solvers import Options
 from quasistatic.solvers.certified import solve_cheap_certified
-from quasistatic.solvers.certify import exact_unique
+from quasistatic.solvers.certify import exact_cone, exact_unique
 from quasistatic.tools.bench.families import grasp_3d
 from random_scenes import random_scene
 
@@ -192,15 +192,41 @@ def test_a_benchmark_grasp_is_certified_on_the_exact_cones() -> None:
     assert solution.modes.count("sliding") == 2
 
 
-def test_a_second_exact_motion_met_by_the_far_part_makes_the_answer_ambiguous() -> None:
+@pytest.mark.parametrize("first_proof", [True, False])
+def test_a_second_exact_motion_met_by_the_far_part_makes_the_answer_ambiguous(first_proof: bool, monkeypatch: pytest.MonkeyPatch) -> None:
     """Seed 181: the 8-edge pyramid's only motion tips the box about two table corners, but the circles also let
-    it slide flat on all three (the pyramid misses it). The far part's surviving leaf is no motion itself;
-    Newton's method from it with the leaf's modes reaches that one, so the answer lists both, each audited."""
+    it slide flat on all three (the pyramid misses it). With the fast path's motion withheld, the far part's
+    surviving leaf is no motion itself; Newton's method from it with the leaf's modes reaches that one. With it,
+    the fast path's motion is that one (its first proof pauses), so no proof runs. Either way the answer lists
+    both, each audited."""
+    if not first_proof:
+        monkeypatch.setattr(exact_cone, "_newton_from_lemke", lambda problem: None)
     solution = qs.solve(random_scene(3, 181))
     assert solution.status == "ambiguous", solution.message
     assert len(solution.solutions) == 2 and all(motion.audit.passed for motion in solution.solutions)
     assert sorted(motion.modes.count("sliding") for motion in solution.solutions) == [1, 4]
     assert "incomplete" in solution.message
+    found = "Newton's method from where Lemke's path ends found" if first_proof else "the exact-cone uniqueness proof met"
+    assert f"{found} a second exact motion" in dict(solution.notes)["exact_cone"]
+
+
+@pytest.mark.parametrize(("seed", "paused_in"), [(172, "far"), (26, "near")])
+def test_a_paused_proof_resumed_ends_as_the_proof_run_at_once(seed: int, paused_in: str) -> None:
+    """A proof paused after one round (seed 172's takes two), or at the near part's first arc (seed 26's fails it),
+    and then resumed, reaches the verdict and the round count of the proof run without a pause."""
+    problem = qs.assemble(random_scene(3, seed))
+    motion = exact_cone._newton_from_lemke(problem)
+    assert motion is not None
+
+    def is_motion(q: np.ndarray) -> bool:
+        return exact_cone._exact_forces(problem, q) is not None
+
+    whole = exact_unique.prove_unique_exact(problem, motion, Options(time_limit=30.0).start_clock(), is_motion)
+    first = exact_unique.prove_unique_exact(problem, motion, Options(time_limit=30.0).start_clock(), is_motion, pause_after=1)
+    assert whole.proven and whole.rounds >= 2
+    assert not first.proven and first.paused is not None and (first.paused.far is None) == (paused_in == "near")
+    resumed = exact_unique.resume_unique_exact(first.paused, Options(time_limit=30.0).start_clock(), is_motion)
+    assert (resumed.proven, resumed.rounds) == (whole.proven, whole.rounds)
 
 
 def test_an_arc_that_passes_after_a_wider_one_failed_is_widened_and_then_closes_the_far_part() -> None:

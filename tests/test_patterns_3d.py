@@ -209,7 +209,8 @@ def test_certified_3d_grasps_take_the_branch_and_bound_without_the_scip_pyramid_
     contacts: int, instance: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The default solve of the exact-cone bench grasps never runs SCIP's pyramid search, and says which proof
-    the pyramid's completeness rests on; its answer is the one of ``method="scip"``."""
+    the pyramid's completeness rests on (or that no pyramid was searched: the fast path's motion was proven the
+    only one first); its answer is the one of ``method="scip"``."""
     scene = grasp_3d(contacts, instance)
     reference = qs.solve(scene, method="scip")
 
@@ -221,7 +222,8 @@ def test_certified_3d_grasps_take_the_branch_and_bound_without_the_scip_pyramid_
     assert solution.status == reference.status
     assert solution.certified == reference.certified
     if solution.status in ("solved", "ambiguous"):  # (a jam is proven on the exact cones, after the pyramid's)
-        assert dict(solution.notes)["pyramid_search"] in PROOFS
+        notes = dict(solution.notes)
+        assert notes.get("pyramid_search") in PROOFS or notes["pyramid"].startswith("not searched")
     if solution.status == "solved":
         assert solution.motion is not None and reference.motion is not None
         for body, twist in solution.motion.twists.items():

@@ -38,7 +38,9 @@ def _answer(solution: qs.Solution) -> tuple[object, ...]:
 
 
 def _with_and_without(monkeypatch: pytest.MonkeyPatch, scene: qs.Scene) -> tuple[tuple[object, ...], tuple[object, ...], int]:
-    """The certified answer with the refinement's test, then with it disabled; and how many of its LPs were infeasible."""
+    """The certified answer with the refinement's test, then with it disabled; and how many of its LPs were infeasible.
+    The first proof is withheld: where it closes, no pyramid motion is refined (seed 70, grasp-3d 8 #1)."""
+    monkeypatch.setattr(exact_cone, "_newton_from_lemke", lambda problem: None)
     real = exact_cone.solve_lp
     infeasible = 0
 

@@ -16,7 +16,10 @@ call), the search runs again with 32 edges; but where the 8-edge pyramid jams
 and Newton's method from where Lemke's path ends finds an exact motion, that
 motion is first proven the only one directly (the proof of :mod:`.exact_unique`
 covers every twist: it needs no pyramid's list), and the sector relaxation's
-proof that no motion exists (which cannot pass) is not tried.
+proof that no motion exists (which cannot pass) is not tried. The certified
+method tries that proof before any pyramid: one far-part round on the fast
+path's motion; where it closes, no pyramid is searched, and where it pauses,
+it resumes once a later stage needs the same motion proven.
 
 What is proven: ``unstable`` (no equilibrium even in a pyramid circumscribing
 the exact cone), kinematic ``jammed`` (a Farkas certificate), wedged
@@ -34,7 +37,8 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -44,6 +48,7 @@ from ...laws.polyhedral import LCPForm, aligned_edges, edge_jacobian, polyhedral
 from ...solution import Certificate, CertificateKind, Diagnosis
 from ...tolerances import (
     CONE_ROUNDOFF,
+    DISTINCT_TWIST,
     FIXED_MODE_RESIDUAL,
     FREE_TWIST_DIRECTION,
     FRICTION_ALIGNMENT,
@@ -60,7 +65,7 @@ from ..numerics.levenberg_marquardt import fixed_mode_fit
 from ..result import BackendResult, Options
 from .cheap import seed_point
 from .diagnose import diagnose, equilibrium_exists, no_equilibrium_certificate, no_motion
-from .exact_unique import EXACT_UNIQUENESS_PROOF, prove_unique_exact
+from .exact_unique import EXACT_UNIQUENESS_PROOF, Uniqueness, prove_unique_exact, resume_unique_exact
 from .min_power import solve_min_power
 from .patterns import ENUMERATION_PROOF, NO_MOTION_PROOF, PATTERN_PROOF, PatternVerdict, mask_bits, prove_by_patterns
 from .search import enumerate_motions, summarise
@@ -69,11 +74,13 @@ from .wedge import exact_cones_jam
 __all__ = ["solve_exact_3d", "unique_exact_motion", "SEARCH_EDGES"]
 
 _SCIP = "the complete SCIP search over contact modes"
+_NEWTON_START = "Newton's method from where Lemke's path ends"  # the fast path's first start (_newton_from_lemke)
 SEARCH_EDGES = 8  # pyramid edges of the first certified search
 VERDICT_EDGES = 256  # polygons tried when the searched ones cannot decide between unstable and at rest
 WIDER_SEARCH_EDGES = 32  # the most edges the mixed-integer search is run with (its size grows with them)
 RANGE_EDGES = 64  # polygon used for force ranges at rolling contacts (inner, within 0.12 %)
 BALANCE_EDGES = 16  # polygon around each circle when a changed mode pattern's closed contacts are tested for equilibrium
+FIRST_PROOF_ROUNDS = 1  # far-part rounds of the uniqueness proof tried before the pyramid search
 
 
 def solve_exact_3d(problem: Problem, options: Options, by_patterns: bool = False) -> BackendResult:
@@ -81,19 +88,26 @@ def solve_exact_3d(problem: Problem, options: Options, by_patterns: bool = False
     the 8-edge pyramid jams and Newton's method finds an exact motion proven the only one: module docstring).
 
     ``by_patterns``: each pyramid's motions are first sought by the mode branch and bound
-    (:mod:`.patterns`), and the SCIP search runs only where it leaves them undecided.
+    (:mod:`.patterns`), and the SCIP search runs only where it leaves them undecided; and before any pyramid,
+    the fast path's exact motion is proven the only one where a short first attempt can (:func:`_first_proof`).
     """
     options = options.start_clock()
+    first = _first_proof(problem, options) if by_patterns and options.modes is None else None
+    if first is not None and first.motion is not None and first.uniqueness.proven:
+        note = f"not searched: the motion found by {_NEWTON_START} was proven the only one first"
+        return unique_exact_motion(problem, first.motion, options, EXACT_UNIQUENESS_PROOF).with_notes(pyramid=note)
     undecided, relaxed = "", False
     for count in (SEARCH_EDGES, WIDER_SEARCH_EDGES):
-        result, undecided = _search(problem, options, count, by_patterns)
+        result, undecided = _search(problem, options, count, by_patterns, first)
         if result is not None:
             return result
         if undecided in ("wedged", "modes") and not relaxed:  # the pyramid has no motion: try to prove it for the circle
             relaxed = True
-            found = _newton_from_lemke(problem) if undecided == "wedged" else None
+            found = None
+            if undecided == "wedged":
+                found = _newton_from_lemke(problem) if first is None else first.motion
             if found is not None:  # no proof that the circle has none can pass
-                if (alone := _proven_alone(problem, found, options)) is not None:
+                if (alone := _proven_alone(problem, found, options, first)) is not None:
                     return alone
                 continue  # the wider pyramid's search decides
             if proof := _wedge_proof(problem, options):
@@ -125,28 +139,70 @@ def _wedge_proof(problem: Problem, options: Options) -> str:
 
 def _newton_from_lemke(problem: Problem) -> RawMotion | None:
     """A motion of the exact laws by the fast path's first start (Newton's method, quick rounds, from where Lemke's
-    path ends, as ``solvers/fast.py`` starts it), its forces checked by LP as the wedge proof checks a point it
-    meets; None where it finds none. The sector relaxation holds every exact motion, so where one is found the
-    relaxation's proof that none exists cannot pass, and is not tried (grasp-3d 6 #3: its 8-edge pyramid jams,
-    and that proof fails in ~60 ms)."""
+    path ends, as ``solvers/fast.py`` starts it); None where it finds none. Its own forces witness it where they
+    lie in the cones (as a refinement's do); else forces are sought by LP, as the wedge proof checks a point it
+    meets (that LP costs about as much as the rest of this together). The sector relaxation holds every exact
+    motion, so where one is found the relaxation's proof that none exists cannot pass, and is not tried
+    (grasp-3d 6 #3: its 8-edge pyramid jams, and that proof fails in ~60 ms)."""
     status, _, q, c, _, _ = lemke_motion(problem)
     if status in (RAY, PIVOT_LIMIT):
         converged, q, c = exact_newton(problem, q, c, 0.0, QUICK_PATIENCE)
     else:
         converged = status == SOLUTION
-    return RawMotion(q, c) if converged and _exact_forces(problem, q) is not None else None
+    if not converged or np.min(problem.velocities(q)[:, -1], initial=0.0) < -MODE_SPEED:
+        return None
+    rolling = ModeMasks.of(problem, contact_modes(problem, q)).rolling
+    return RawMotion(q, c) if _inside_cones(problem, c, rolling) or _exact_forces(problem, q) is not None else None
 
 
-def _proven_alone(problem: Problem, motion: RawMotion, options: Options) -> BackendResult | None:
+@dataclass
+class _FirstProof:
+    """The fast path's exact motion (:func:`_newton_from_lemke`; None where it finds none) and its uniqueness proof
+    so far: a first attempt paused after :data:`FIRST_PROOF_ROUNDS` rounds of the far part (or at the near part's
+    first arc), continued (once, in place) where a later stage needs the same motion proven."""
+
+    motion: RawMotion | None
+    uniqueness: Uniqueness
+
+
+def _first_proof(problem: Problem, options: Options) -> _FirstProof:
+    """The fast path's exact motion and a first, short attempt at its uniqueness proof, before any pyramid search.
+
+    The proof covers every twist (near the motion and everywhere else), so where it closes no pyramid is searched
+    (grasp-3d 4 #0, 6 #2, 8 #1: the 8-edge search and refinement are 20-40 % of their solve). Where it does not,
+    it pauses: an ambiguous grasp pays only the short attempt, and a solved one whose proof needs more rounds
+    resumes it once the pyramid leaves that same motion (:func:`_uniqueness`)."""
+    motion = _newton_from_lemke(problem)
+    if motion is None:
+        return _FirstProof(None, Uniqueness(False, reason=f"{_NEWTON_START} found no exact motion"))
+    return _FirstProof(motion, prove_unique_exact(problem, motion, options, _is_motion(problem), FIRST_PROOF_ROUNDS))
+
+
+def _is_motion(problem: Problem) -> Callable[[np.ndarray], bool]:
+    """Whether a twist is an exact motion (forces satisfying the exact laws there exist): the proof's question."""
+    return lambda q: _exact_forces(problem, q) is not None
+
+
+def _uniqueness(problem: Problem, motion: RawMotion, options: Options, first: _FirstProof | None) -> Uniqueness:
+    """The uniqueness proof of ``motion``: the first attempt's, resumed where it paused, where ``motion`` is the
+    first's (its answer then kept for any later stage); else a proof of its own."""
+    if first is None or first.motion is None or not _same_exact(problem, motion, first.motion):
+        return prove_unique_exact(problem, motion, options, _is_motion(problem))
+    if first.uniqueness.paused is not None:
+        first.uniqueness = resume_unique_exact(first.uniqueness.paused, options, _is_motion(problem))
+    return first.uniqueness
+
+
+def _proven_alone(problem: Problem, motion: RawMotion, options: Options, first: _FirstProof | None) -> BackendResult | None:
     """``solved``, certified, where :mod:`.exact_unique` proves ``motion`` (exact) the only one; else None.
 
     Its proof covers every twist (near the motion and everywhere else), so it needs no pyramid's list: where the
     8-edge pyramid jams and Newton's method finds an exact motion, the 32-edge search (which would find the same
     motion, and prove it the same way) is not run (grasp-3d 6 #3: ~100 ms)."""
-    uniqueness = prove_unique_exact(problem, motion, options, lambda q: _exact_forces(problem, q) is not None)
+    uniqueness = _uniqueness(problem, motion, options, first)
     if not uniqueness.proven:
         return None
-    note = f"the {SEARCH_EDGES}-edge pyramid jams; the motion found by Newton's method from where Lemke's path ends"
+    note = f"the {SEARCH_EDGES}-edge pyramid jams; the motion found by {_NEWTON_START}"
     return unique_exact_motion(problem, motion, options, EXACT_UNIQUENESS_PROOF).with_notes(pyramid=note)
 
 
@@ -157,8 +213,11 @@ def _exact_forces(problem: Problem, q: np.ndarray) -> np.ndarray | None:
     return _forces_at(problem, q, ModeMasks.of(problem, contact_modes(problem, q)))
 
 
-def _search(problem: Problem, options: Options, count: int, by_patterns: bool) -> tuple[BackendResult | None, str]:
-    """Motions of a ``count``-edge pyramid refined to the exact cone, or None and why the pyramid cannot decide.
+def _search(
+    problem: Problem, options: Options, count: int, by_patterns: bool, first: _FirstProof | None
+) -> tuple[BackendResult | None, str]:
+    """Motions of a ``count``-edge pyramid refined to the exact cone, or None and why the pyramid cannot decide
+    (``first``: the first uniqueness proof, continued where the pyramid leaves its motion alone).
 
     Undecided: ``refinement`` (a pyramid motion has no exact motion next to
     it), ``wedged`` (the pyramid jams but the wider exact cone may not),
@@ -173,7 +232,7 @@ def _search(problem: Problem, options: Options, count: int, by_patterns: bool) -
         motions, complete = enumerate_motions(form, options)
         how = _SCIP
     if motions:
-        result = _refined_result(problem, motions, complete, options, count)
+        result = _refined_result(problem, motions, complete, options, count, first)
         if result is None:
             return None, "refinement"
         return result.with_notes(pyramid_search=how), ""
@@ -245,7 +304,9 @@ def _confirm_wedged(problem: Problem, options: Options) -> BackendResult:
     )
 
 
-def _refined_result(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, count: int) -> BackendResult | None:
+def _refined_result(
+    problem: Problem, motions: list[RawMotion], complete: bool, options: Options, count: int, first: _FirstProof | None
+) -> BackendResult | None:
     """Every pyramid motion refined to the exact cone, summarised; None when that decides nothing.
 
     Where some motion cannot be refined, two distinct exact motions (or a
@@ -262,26 +323,32 @@ def _refined_result(problem: Problem, motions: list[RawMotion], complete: bool, 
         return None
     if not unrefined:
         note = f"motions refined from a {count}-edge pyramid; completeness proven for the pyramid"
-        return _summary(problem, unique, complete, options, note)
+        return _summary(problem, unique, complete, options, note, first)
     if len(unique) >= 2 or any(motion.continuum for motion in unique):
         note = f"{unrefined} motion(s) of the {count}-edge pyramid did not converge to one of the exact cone: the list is incomplete"
         return _summary(problem, unique, False, options, note)
     return None
 
 
-def _summary(problem: Problem, motions: list[RawMotion], complete: bool, options: Options, note: str) -> BackendResult:
+def _summary(
+    problem: Problem, motions: list[RawMotion], complete: bool, options: Options, note: str, first: _FirstProof | None = None
+) -> BackendResult:
     """Exact motions refined from a pyramid search. Completeness holds for the pyramid only, so: one motion is
-    ``solved`` (certified) only once the exact cones are proven to allow no other (:mod:`.exact_unique`); a
-    list is marked incomplete."""
+    ``solved`` (certified) only once the exact cones are proven to allow no other (:mod:`.exact_unique`; the
+    first proof continued where it is ``first``'s motion); a list is marked incomplete."""
     if len(motions) == 1 and not motions[0].continuum and complete:
-        return _proven_unique(problem, motions[0], options, note)
+        return _proven_unique(problem, motions[0], options, note, first)
     return summarise(_range_form(problem, motions[0]), motions, False, options).with_notes(exact_cone=note)
 
 
-def _proven_unique(problem: Problem, motion: RawMotion, options: Options, note: str) -> BackendResult:
+def _proven_unique(problem: Problem, motion: RawMotion, options: Options, note: str, first: _FirstProof | None) -> BackendResult:
     """The pyramid's only motion, refined: ``solved`` and certified once the exact cones are proven to hold no
-    other; ``ambiguous`` (an incomplete list) when the proof meets another exact motion; else uncertified."""
-    uniqueness = prove_unique_exact(problem, motion, options, lambda q: _exact_forces(problem, q) is not None)
+    other; ``ambiguous`` (an incomplete list) when the proof meets another exact motion, or where the first
+    proof's motion is another one (then no proof runs: two exact motions exist); else uncertified."""
+    if (fast := _first_besides(problem, motion, first, options)) is not None:
+        note += f"; {_NEWTON_START} found a second exact motion, which the pyramid misses: the list is incomplete"
+        return summarise(_range_form(problem, motion), [motion, fast], False, options).with_notes(exact_cone=note)
+    uniqueness = _uniqueness(problem, motion, options, first)
     if uniqueness.proven:
         return unique_exact_motion(problem, motion, options, EXACT_UNIQUENESS_PROOF).with_notes(pyramid=note)
     other = _other_motion(problem, motion, uniqueness.other, options)
@@ -292,6 +359,14 @@ def _proven_unique(problem: Problem, motion: RawMotion, options: Options, note: 
     return _unique_for_the_pyramid(summarise(range_form, [motion], True, options)).with_notes(
         exact_cone=note, uniqueness=f"not proven for the exact cones: {uniqueness.reason}"
     )
+
+
+def _first_besides(problem: Problem, motion: RawMotion, first: _FirstProof | None, options: Options) -> RawMotion | None:
+    """The first proof's motion, refined, where it is an exact motion other than ``motion`` (their twists farther
+    apart than ``DISTINCT_TWIST``, as the proof's far part asks of a second motion); else None."""
+    if first is None or first.motion is None or np.max(np.abs(first.motion.q - motion.q)) <= DISTINCT_TWIST:
+        return None
+    return _other_motion(problem, motion, first.motion.q, options)
 
 
 def _other_motion(problem: Problem, motion: RawMotion, q: np.ndarray | None, options: Options) -> RawMotion | None:

@@ -64,10 +64,10 @@ from ...tolerances import DISTINCT_TWIST, FIXED_MODE_RESIDUAL, JACOBIAN_RANK, LP
 from ..numerics.highs import optimise_each, solve_lp
 from ..numerics.line_extent import line_axis_extents
 from ..result import Options
-from .patterns import CLOSED_LEAF, SEPARATING_LEAF, TreeShape, relaxation_excluded
+from .patterns import CLOSED_LEAF, SEPARATING_LEAF, PassedRegions, TreeShape, relaxation_excluded
 from .wedge import split_sectors
 
-__all__ = ["Uniqueness", "prove_unique_exact", "EXACT_UNIQUENESS_PROOF"]
+__all__ = ["Uniqueness", "PausedProof", "prove_unique_exact", "resume_unique_exact", "EXACT_UNIQUENESS_PROOF"]
 
 EXACT_UNIQUENESS_PROOF = (
     "Krawczyk's interval test near the motion, and a sector relaxation of the exact laws excluding every other "
@@ -95,18 +95,25 @@ Extents = tuple[np.ndarray, np.ndarray]  # least and greatest values, one entry 
 
 @dataclass(frozen=True)
 class Uniqueness:
-    """Whether the motion was proven the only one; if not, another exact motion's twist when one was met, and why."""
+    """Whether the motion was proven the only one; if not, another exact motion's twist when one was met, and why.
+    ``paused``: where a proof asked to pause stopped before it decided (:func:`resume_unique_exact` continues it)."""
 
     proven: bool
     other: np.ndarray | None = None
     reason: str = ""
     rounds: int = 0
+    paused: PausedProof | None = None
 
 
-def prove_unique_exact(problem: Problem, motion: RawMotion, options: Options, is_motion: Callable[[np.ndarray], bool]) -> Uniqueness:
+def prove_unique_exact(
+    problem: Problem, motion: RawMotion, options: Options, is_motion: Callable[[np.ndarray], bool], pause_after: int | None = None
+) -> Uniqueness:
     """Prove that ``motion`` (an exact 3-D motion, checked by the caller) is the only one, within ``options``' clock.
 
     ``is_motion`` tells whether a twist is an exact motion (it is asked of a surviving leaf's twist).
+    ``pause_after``: a first, cheap attempt: where the near part's first arc fails, or the far part has run that
+    many rounds without closing (before it examines the last one's surviving leaf), the proof stops undecided with
+    its state (:attr:`Uniqueness.paused`), which :func:`resume_unique_exact` continues; None: run to the end.
     """
     modes = np.array(contact_modes(problem, motion.q), dtype=object)
     masks = ModeMasks.of(problem, modes)
@@ -114,16 +121,30 @@ def prove_unique_exact(problem: Problem, motion: RawMotion, options: Options, is
     x = laws.start(motion.q, motion.c, nonnegative=False)
     slips = problem.velocities(motion.q)[:, :2]
     angles = np.arctan2(slips[:, 1], slips[:, 0])
-    arc = _near_arc(problem, laws, masks, x, angles)
+    arc = _near_arc(problem, laws, masks, x, angles, first_only=pause_after is not None)
+    if arc is None and pause_after is not None:
+        return Uniqueness(False, reason="paused: the near part's first arc failed", paused=PausedProof(problem, motion, None))
     if arc is None:
         return Uniqueness(False, reason="the fixed-mode equations are not proven to have one zero near the motion")
     residual = laws.enclosure(point(x))
     near = None if residual is None else _NearMotion(problem, laws, x, residual[0])
-    return _far(problem, motion.q, masks, angles, arc, options, is_motion, near, _far_order(masks, motion.c))
+    return _FarPart(problem, motion, masks, angles, arc, near, _far_order(masks, motion.c)).run(options, is_motion, pause_after)
 
 
-def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.ndarray, angles: np.ndarray) -> float | None:
-    """The widest arc tried (from :data:`FIRST_ARC`) whose box holds only the motion; None if none does.
+def resume_unique_exact(paused: PausedProof, options: Options, is_motion: Callable[[np.ndarray], bool]) -> Uniqueness:
+    """The proof :func:`prove_unique_exact` paused, run to the end from where it stopped (the far part's sectors,
+    exclusions, Farkas vectors, passed regions, rounds and surviving leaf; the near part in full where its first
+    arc failed). A paused proof is resumed once: its far part advances in place."""
+    if paused.far is None:
+        return prove_unique_exact(paused.problem, paused.motion, options, is_motion)
+    return paused.far.run(options, is_motion, None)
+
+
+def _near_arc(
+    problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.ndarray, angles: np.ndarray, first_only: bool = False
+) -> float | None:
+    """The widest arc tried (from :data:`FIRST_ARC`) whose box holds only the motion; None if none does
+    (``first_only``: None where the first arc fails).
 
     The box holds one twist when the rows pin it (every contact rolling or separating, say: the forces may
     still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and an arc whose box fails is
@@ -143,7 +164,7 @@ def _near_arc(problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.nda
         tried = verdict(arc)
         if tried.proven:
             return arc if failed is None else _widened(verdict, arc, failed)
-        if tried.shrink == 0.0:
+        if tried.shrink == 0.0 or first_only:
             return None
         failed = arc
         arc /= tried.shrink
@@ -288,76 +309,113 @@ def _force_box(laws: FixedModeLaws, x: np.ndarray, directions: Interval) -> Inte
     return linear_solutions(matmul(C, laws.force_matrix(directions)), matmul(C, point(-laws.g)))
 
 
-def _far(
-    problem: Problem,
-    q: np.ndarray,
-    masks: ModeMasks,
-    angles: np.ndarray,
-    arc: float,
-    options: Options,
-    is_motion: Callable[[np.ndarray], bool],
-    near: _NearMotion | None,
-    order: list[int],
-) -> Uniqueness:
+@dataclass(frozen=True)
+class PausedProof:
+    """A proof :func:`prove_unique_exact` paused: its problem and motion, and the far part as it stopped (None where
+    the near part's first arc failed: the near part then runs again in full)."""
+
+    problem: Problem
+    motion: RawMotion
+    far: _FarPart | None
+
+
+class _FarPart:
     """Every leaf of the sector relaxation outside the arcs (or with other modes) excluded, refining the sectors.
 
-    ``order``: the contacts as the tree splits them (:func:`_far_order`), in arcs of :data:`FAR_ARC`. Each round
-    resumes where the last stopped (:class:`~.patterns.PassedRegions`: the regions it excluded before its
-    surviving leaf).
+    The state lives here between rounds, so a paused proof resumes where it stopped: the sectors, the leaves
+    Krawczyk's operator excluded, the last round's Farkas vectors (tried first on the next) and passed regions
+    (:class:`~.patterns.PassedRegions`: each round resumes where the last stopped), the rounds and refinements so
+    far, and the last round's surviving leaf and twist where it is not examined yet.
 
-    A node whose twists are all the motion's (its rows pin them: a rolling contact whose force may reach the
-    circle, say) holds no other motion; the branch and bound passes it over (``twist=q``). A surviving leaf with
-    the motion's modes that ``near`` proves holds no zero of the fixed-mode laws (:meth:`_NearMotion.excludes`)
-    is passed over from then on, with every leaf inside its sectors, and the round is run again unrefined.
+    ``order``: the contacts as the tree splits them (:func:`_far_order`), in arcs of :data:`FAR_ARC`. A node
+    whose twists are all the motion's (its rows pin them: a rolling contact whose force may reach the circle,
+    say) holds no other motion; the branch and bound passes it over (``twist=q``). A surviving leaf with the
+    motion's modes that ``near`` proves holds no zero of the fixed-mode laws (:meth:`_NearMotion.excludes`) is
+    passed over from then on, with every leaf inside its sectors, and the round is run again unrefined.
     """
-    sectors = [_first_sectors(float(angles[i]), arc) if masks.sliding[i] else _even_sectors() for i in range(problem.n_contacts)]
-    wanted = np.where(masks.closed, CLOSED_LEAF, SEPARATING_LEAF)
-    arc_end = [float(first[0]) + 2.0 * arc * (1.0 + 1e-12) for first in sectors]  # the arcs' sectors end there
-    excluded: list[np.ndarray] = []  # slip angle bounds (m, 2) of leaves with the motion's modes holding no zero
 
-    def bounds(leaf: tuple[int, ...]) -> np.ndarray | None:
-        """The leaf's sectors as angle bounds (m, 2) (zero rows where no contact slides), if it has the motion's modes."""
-        if any(k < 0 if masks.sliding[i] else k != wanted[i] for i, k in enumerate(leaf)):
-            return None
-        return np.array([sectors[i][k : k + 2] if masks.sliding[i] else (0.0, 0.0) for i, k in enumerate(leaf)])
+    def __init__(
+        self,
+        problem: Problem,
+        motion: RawMotion,
+        masks: ModeMasks,
+        angles: np.ndarray,
+        arc: float,
+        near: _NearMotion | None,
+        order: list[int],
+    ) -> None:
+        self.problem, self.motion, self.q, self.masks, self.arc, self.near = problem, motion, motion.q, masks, arc, near
+        self.shape = TreeShape(order, FAR_ARC)
+        self.sectors = [_first_sectors(float(angles[i]), arc) if masks.sliding[i] else _even_sectors() for i in range(problem.n_contacts)]
+        self.wanted = np.where(masks.closed, CLOSED_LEAF, SEPARATING_LEAF)
+        self.arc_end = [float(first[0]) + 2.0 * arc * (1.0 + 1e-12) for first in self.sectors]  # the arcs' sectors end there
+        self.excluded: list[np.ndarray] = []  # slip angle bounds (m, 2) of leaves with the motion's modes holding no zero
+        self.rounds = self.refinements = 0
+        self.farkas: tuple[np.ndarray, ...] = ()  # the last round's, tried first on the next
+        self.passed: PassedRegions | None = None  # what the rounds before excluded: the next resumes where the last stopped
+        self.survivor: tuple[tuple[int, ...], np.ndarray] | None = None  # the last round's leaf and twist, not yet examined
 
-    def covered(leaf: tuple[int, ...]) -> bool:
-        if all(k >= 0 and sectors[i][k + 1] <= arc_end[i] if masks.sliding[i] else k == wanted[i] for i, k in enumerate(leaf)):
-            return True  # inside the arcs, with the motion's modes
-        ends = None if not excluded else bounds(leaf)
-        return ends is not None and any(bool(np.all((box[:, 0] <= ends[:, 0]) & (ends[:, 1] <= box[:, 1]))) for box in excluded)
+    def run(self, options: Options, is_motion: Callable[[np.ndarray], bool], pause_after: int | None) -> Uniqueness:
+        """Rounds until the proof is decided, or paused once ``pause_after`` rounds have run undecided."""
+        while options.remaining() > 0.0 and self.refinements < FAR_ROUNDS:
+            survivor, self.survivor = self.survivor, None
+            if survivor is None:
+                found = self._round(options)
+                if isinstance(found, Uniqueness):
+                    return found
+                survivor = found
+                if pause_after is not None and self.rounds >= pause_after:
+                    self.survivor = survivor
+                    paused = PausedProof(self.problem, self.motion, self)
+                    return Uniqueness(False, reason=f"paused after {self.rounds} round(s)", rounds=self.rounds, paused=paused)
+            leaf, twist = survivor
+            other = _other_motion(self.problem, self.q, leaf, twist, is_motion)
+            if other is not None:
+                return Uniqueness(False, other=other, reason="another exact motion exists", rounds=self.rounds)
+            if self._exclude(leaf, options):
+                continue  # the same sectors again, this leaf passed over
+            self.refinements += 1
+            if not split_sectors(self.sectors, leaf, FINEST_FRACTION * self.arc):
+                return Uniqueness(False, reason="a leaf of the sector relaxation survives at the finest sectors", rounds=self.rounds)
+        return Uniqueness(False, reason=f"out of time or of refinements ({self.refinements})", rounds=self.rounds)
 
-    def exclude(leaf: tuple[int, ...]) -> bool:
-        """Whether a surviving leaf with the motion's modes is proven to hold no zero (then passed over)."""
-        ends = bounds(leaf)
-        if near is None or ends is None or len(excluded) >= EXCLUDED_LEAVES or options.remaining() <= 0.0:
-            return False
-        if near.excludes(masks, ends):
-            excluded.append(ends)
-            return True
-        return False
-
-    rounds = refinements = 0
-    farkas: tuple[np.ndarray, ...] = ()  # the last round's, tried first on the next
-    passed = None  # what the rounds before excluded: the next resumes where the last stopped
-    while options.remaining() > 0.0 and refinements < FAR_ROUNDS:
-        rounds += 1
-        proof = relaxation_excluded(problem, sectors, options.remaining, covered, q, farkas, passed, TreeShape(order, FAR_ARC))
-        farkas, passed = proof.farkas, proof.passed
+    def _round(self, options: Options) -> Uniqueness | tuple[tuple[int, ...], np.ndarray]:
+        """One branch and bound over the current sectors: proven, failed, or its surviving leaf and a twist of it."""
+        self.rounds += 1
+        proof = relaxation_excluded(
+            self.problem, self.sectors, options.remaining, self._covered, self.q, self.farkas, self.passed, self.shape
+        )
+        self.farkas, self.passed = proof.farkas, proof.passed
         options.report(1, proof.nodes)  # a long proof shows on the CLI's status line
         if proof.excluded:
-            return Uniqueness(True, rounds=rounds)
+            return Uniqueness(True, rounds=self.rounds)
         if proof.sectors is None or proof.q is None:
-            return Uniqueness(False, reason="the sector relaxation's branch and bound gave no answer", rounds=rounds)
-        other = _other_motion(problem, q, proof.sectors, proof.q, is_motion)
-        if other is not None:
-            return Uniqueness(False, other=other, reason="another exact motion exists", rounds=rounds)
-        if exclude(proof.sectors):
-            continue  # the same sectors again, this leaf passed over
-        refinements += 1
-        if not split_sectors(sectors, proof.sectors, FINEST_FRACTION * arc):
-            return Uniqueness(False, reason="a leaf of the sector relaxation survives at the finest sectors", rounds=rounds)
-    return Uniqueness(False, reason=f"out of time or of refinements ({refinements})", rounds=rounds)
+            return Uniqueness(False, reason="the sector relaxation's branch and bound gave no answer", rounds=self.rounds)
+        return proof.sectors, proof.q
+
+    def _bounds(self, leaf: tuple[int, ...]) -> np.ndarray | None:
+        """The leaf's sectors as angle bounds (m, 2) (zero rows where no contact slides), if it has the motion's modes."""
+        sliding = self.masks.sliding
+        if any(k < 0 if sliding[i] else k != self.wanted[i] for i, k in enumerate(leaf)):
+            return None
+        return np.array([self.sectors[i][k : k + 2] if sliding[i] else (0.0, 0.0) for i, k in enumerate(leaf)])
+
+    def _covered(self, leaf: tuple[int, ...]) -> bool:
+        sliding = self.masks.sliding
+        if all(k >= 0 and self.sectors[i][k + 1] <= self.arc_end[i] if sliding[i] else k == self.wanted[i] for i, k in enumerate(leaf)):
+            return True  # inside the arcs, with the motion's modes
+        ends = None if not self.excluded else self._bounds(leaf)
+        return ends is not None and any(bool(np.all((box[:, 0] <= ends[:, 0]) & (ends[:, 1] <= box[:, 1]))) for box in self.excluded)
+
+    def _exclude(self, leaf: tuple[int, ...], options: Options) -> bool:
+        """Whether a surviving leaf with the motion's modes is proven to hold no zero (then passed over)."""
+        ends = self._bounds(leaf)
+        if self.near is None or ends is None or len(self.excluded) >= EXCLUDED_LEAVES or options.remaining() <= 0.0:
+            return False
+        if self.near.excludes(self.masks, ends):
+            self.excluded.append(ends)
+            return True
+        return False
 
 
 def _far_order(masks: ModeMasks, forces: np.ndarray) -> list[int]:
