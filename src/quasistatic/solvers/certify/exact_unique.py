@@ -121,12 +121,12 @@ def prove_unique_exact(
     x = laws.start(motion.q, motion.c, nonnegative=False)
     slips = problem.velocities(motion.q)[:, :2]
     angles = np.arctan2(slips[:, 1], slips[:, 0])
-    arc = _near_arc(problem, laws, masks, x, angles, first_only=pause_after is not None)
+    residual = laws.enclosure(point(x))  # never None: the motion's sliding contacts slip
+    arc = _near_arc(problem, laws, masks, x, angles, None if residual is None else residual[0], first_only=pause_after is not None)
     if arc is None and pause_after is not None:
         return Uniqueness(False, reason="paused: the near part's first arc failed", paused=PausedProof(problem, motion, None))
     if arc is None:
         return Uniqueness(False, reason="the fixed-mode equations are not proven to have one zero near the motion")
-    residual = laws.enclosure(point(x))
     near = None if residual is None else _NearMotion(problem, laws, x, residual[0])
     return _FarPart(problem, motion, masks, angles, arc, near, _far_order(masks, motion.c)).run(options, is_motion, pause_after)
 
@@ -141,10 +141,16 @@ def resume_unique_exact(paused: PausedProof, options: Options, is_motion: Callab
 
 
 def _near_arc(
-    problem: Problem, laws: FixedModeLaws, masks: ModeMasks, x: np.ndarray, angles: np.ndarray, first_only: bool = False
+    problem: Problem,
+    laws: FixedModeLaws,
+    masks: ModeMasks,
+    x: np.ndarray,
+    angles: np.ndarray,
+    residual: Interval | None,
+    first_only: bool = False,
 ) -> float | None:
     """The widest arc tried (from :data:`FIRST_ARC`) whose box holds only the motion; None if none does
-    (``first_only``: None where the first arc fails).
+    (``residual``: the laws' enclosure at the motion ``x``; ``first_only``: None where the first arc fails).
 
     The box holds one twist when the rows pin it (every contact rolling or separating, say: the forces may
     still be indeterminate, even unbounded); otherwise Krawczyk's test decides, and an arc whose box fails is
@@ -152,12 +158,11 @@ def _near_arc(
     passes after one that failed is widened towards it (:func:`_widened`): the far part closes sooner, or only,
     with a wider arc (its relaxation cannot tell slips just outside a narrow arc from the motion's).
     """
-    residual = laws.enclosure(point(x))  # never None: the motion's sliding contacts slip
     sigma = np.linalg.svd(laws.jacobian(x), compute_uv=False)
     singular = sigma[-1] <= JACOBIAN_RANK * sigma[0]  # indeterminate forces: no box passes, only pinned twists
 
     def verdict(arc: float) -> _ArcVerdict:
-        return _arc_verdict(problem, laws, masks, x, angles, arc, None if singular or residual is None else residual[0])
+        return _arc_verdict(problem, laws, masks, x, angles, arc, None if singular else residual)
 
     arc, failed = FIRST_ARC, None
     while arc >= LAST_ARC:
