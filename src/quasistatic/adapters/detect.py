@@ -713,10 +713,13 @@ def _in_planes(
 ) -> tuple[FloatArray, FloatArray, BoolArray]:
     """Where ``q[k] + t u`` satisfies ``normals @ x <= offsets`` (unit normals): ``(t_in, t_out, hit)``.
 
-    A plane within :data:`GRAZING_FACE` of parallel to the line bounds neither end: the line through a patch
-    corner along the contact normal runs along the side faces at that corner, and their bounds ``room / rate``
-    would be round-off (coal's, on the corner) divided by a small rate, anything at all. The line still misses
-    the shape where such a plane leaves it outside by more than ``slack`` all the way between the ends.
+    A plane within :data:`GRAZING_FACE` of parallel to the line bounds the ends only moved out by ``slack``: the
+    line through a patch corner along the contact normal runs along the side faces at that corner, and their
+    bounds ``room / rate`` would be round-off (coal's, on the corner) divided by a small rate, anything at all;
+    moved out, a bound lies at least ``slack / rate`` beyond the corner, and where the face overhangs (a thin
+    plate tilted by less than ``GRAZING_FACE``) it still stops the line within ``slack`` of the face, instead of
+    at the far face's plane (0.002 low under a plate 0.002 thick, 1.9e-6 outside it). The line misses the shape
+    where such a plane leaves it outside by more than ``slack`` all the way between the ends.
     """
     rate, room = normals @ u, offsets - q @ normals.T  # (m,), (k, m)
     steep = np.abs(rate) <= GRAZING_FACE
@@ -730,7 +733,8 @@ def _in_planes(
     first = np.where(steep_rate < 0.0, reach, -math.inf).max(axis=1, initial=-math.inf)
     last = np.where(steep_rate > 0.0, reach, math.inf).min(axis=1, initial=math.inf)
     along = ((steep_rate == 0.0) & (loose < 0.0)).any(axis=1)  # exactly along a plane, outside it
-    return low, high, ~along & (np.maximum(low, first) <= np.minimum(high, last) + slack)
+    enter, leave = np.maximum(low, first), np.minimum(high, last)
+    return enter, leave, ~along & (enter <= leave + slack)
 
 
 def _in_ball(q: FloatArray, u: FloatArray, radius: float, slack: float) -> tuple[FloatArray, FloatArray, BoolArray]:
