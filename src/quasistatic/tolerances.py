@@ -345,6 +345,8 @@ the line through a patch corner, rather than crossing it [-]. The corner lies on
 round-off (7e-11 of a 0.25 box, measured), which a crossing divides by the cosine: a box tilted 1e-5 rad on a block
 had its corners' gaps off by 7e-6 (3e-5 of its size, swapped between corners). At 1e-3 round-off moves a gap by
 1e-7 of the size, below :data:`DUPLICATE_POINT`, and a face this steep spans a thousandth of the shape across.
+Such a face still bounds the line once moved out by the contact slack (``adapters/detect._in_planes``): an
+overhanging one then stops it within the slack of the face.
 """
 
 CURVED_PATCH_POINTS = 8
