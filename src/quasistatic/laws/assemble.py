@@ -23,6 +23,7 @@ from ..tolerances import SMALLEST_LENGTH
 __all__ = ["Problem", "SceneNumbers", "assemble", "scene_numbers"]
 
 T = TypeVar("T")
+_FRICTIONLESS = "frictionless"  # the derived key of Problem.is_frictionless, which assembly may fill from the scene
 
 
 @dataclass(frozen=True)
@@ -112,7 +113,7 @@ class Problem:
 
     @property
     def is_frictionless(self) -> bool:
-        return self.derived("frictionless", lambda p: not (p.mu > 0.0).any())  # (np.any's dispatch costs 5x more)
+        return self.derived(_FRICTIONLESS, lambda p: not (p.mu > 0.0).any())  # (np.any's dispatch costs 5x more)
 
     def velocities(self, q: FloatArray) -> FloatArray:
         """Relative contact velocities ``u = J q - b`` in contact frames, (m, d), at the scene-relative twist ``q``."""
@@ -136,7 +137,7 @@ def assemble(scene: Scene) -> Problem:
     origin.setflags(write=False)
     scales = Scales(length=length, force=force, velocity=velocity, origin=origin)
     problem = Problem(scene, frames, J, b, g, n.mu.copy(), scene.friction, scales)
-    problem._derived["frictionless"] = n.frictionless  # known from the scene: no array reduction per problem
+    problem._derived[_FRICTIONLESS] = n.frictionless  # known from the scene: no array reduction per problem
     return problem
 
 

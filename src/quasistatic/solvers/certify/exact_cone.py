@@ -131,7 +131,7 @@ def _no_motion(problem: Problem, options: Options, proof: str) -> BackendResult:
 
 def _wedge_proof(problem: Problem, options: Options) -> str:
     """A certificate that the exact cones admit no motion (a sector relaxation of the exact laws is infeasible), or ''."""
-    proven, sectors, method = exact_cones_jam(problem, options, options.modes, lambda q: _exact_forces(problem, q) is not None)
+    proven, sectors, method = exact_cones_jam(problem, options, options.modes, _is_motion(problem))
     if not proven:
         return ""
     return f"no solution of the exact laws relaxed to slip sectors (up to {sectors} per contact; {method})"
